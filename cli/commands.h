@@ -1,0 +1,10 @@
+// The hadynet subcommands. Each takes the arguments after its name and
+// returns the process exit code (0 ok, 1 failure, 2 usage error).
+#pragma once
+
+namespace hadynet::cli {
+
+int run_collect(int argc, char** argv);
+int run_validate(int argc, char** argv);
+
+}  // namespace hadynet::cli

@@ -1,0 +1,85 @@
+// The flexible hand as a MuJoCo plant: one dynamics state (HandSpec), driven
+// at the 0.2 s control step by target muscle lengths in encoder millimetres,
+// returning the true (noise-free) sensor values. Sensor noise and the
+// switchable sensor effects are applied afterwards by SensorModel.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "host-sim/plant/hand_spec.h"
+
+struct mjModel_;
+struct mjData_;
+
+namespace hadynet::plant {
+
+// One sample of every signal the robot measures (y of DESIGN.md).
+struct SensorFrame {
+  std::array<double, kMuscles> muscle_length_mm{};  // l: encoder, incl. offsets
+  std::array<double, kMuscles> tension_N{};         // f
+  std::array<double, kLoadcells> loadcell_N{};      // f_contact
+  std::array<double, kWristJoints> wrist_rad{};     // theta: pitch, yaw
+};
+
+class HandPlant {
+ public:
+  // Builds the MJCF for `spec` and loads it. Throws std::runtime_error with
+  // MuJoCo's message if the model does not compile.
+  explicit HandPlant(const HandSpec& spec);
+  ~HandPlant();
+  HandPlant(const HandPlant&) = delete;
+  HandPlant& operator=(const HandPlant&) = delete;
+
+  // Holds `target_mm` for `seconds` (start-up settling); time is not advanced
+  // in the logged clock.
+  void settle(const std::array<double, kMuscles>& target_mm, double seconds);
+  // One control step (0.2 s): the servo targets ramp linearly from the
+  // previous target to `target_mm`. Throws std::runtime_error if the physics
+  // diverged.
+  void step(const std::array<double, kMuscles>& target_mm);
+
+  // True sensor values at the end of the last step (loadcells averaged over
+  // the step's last 20 ms).
+  const SensorFrame& state() const { return state_; }
+  const std::array<double, kMuscles>& target_mm() const { return target_mm_; }
+  // Physics steps taken so far (for benchmarks).
+  long physics_steps() const { return physics_steps_; }
+
+  // For tests: joint angle by name (rad or m), and the raw model/data.
+  double joint_position(const std::string& joint) const;
+  const mjModel_* model() const { return model_; }
+  const mjData_* data() const { return data_; }
+
+ private:
+  void substep(const std::array<double, kMuscles>& ctrl_m, bool average_loadcells);
+  void apply_spring_gain();
+  void read_state();
+
+  HandSpec spec_;
+  mjModel_* model_ = nullptr;
+  mjData_* data_ = nullptr;
+  std::array<int, kMuscles> actuator_id_{};
+  std::array<int, kMuscles> tendon_id_{};
+  std::array<int, kLoadcells> sensor_adr_{};
+  std::array<int, kWristJoints> wrist_qpos_adr_{};
+  int press_qpos_adr_ = -1;
+  struct SpringDof {
+    int joint_id;
+    double stiffness_Nm_per_rad;
+  };
+  std::vector<SpringDof> springs_;
+  std::array<double, kMuscles> target_mm_{};
+  std::array<double, kLoadcells> loadcell_sum_{};
+  int loadcell_samples_ = 0;
+  SensorFrame state_;
+  long physics_steps_ = 0;
+};
+
+// Muscle length (encoder mm) -> servo target tendon length (m) for a spec:
+// removes the rest length, the encoder offset and the wear elongation.
+double servo_target_m(const HandSpec& spec, int muscle, double length_mm);
+
+}  // namespace hadynet::plant
