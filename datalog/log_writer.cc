@@ -107,7 +107,6 @@ class TemporaryFile {
     if (!released_) ::unlink(path_.c_str());
   }
   void release() { released_ = true; }
-  const std::filesystem::path& path() const { return path_; }
 
  private:
   std::filesystem::path path_;
@@ -144,8 +143,9 @@ void write_log(const std::filesystem::path& path, const LogTable& table) {
     name += std::to_string(temporary_counter.fetch_add(1));
     temporary_path = folder / name;
     fd = ::open(temporary_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd < 0 && (errno != EEXIST || attempt >= 100)) {
-      throw fail("create temporary file " + temporary_path.string(), errno);
+    const int error = errno;
+    if (fd < 0 && (error != EEXIST || attempt >= 100)) {
+      throw fail("create temporary file " + temporary_path.string(), error);
     }
   }
   TemporaryFile temporary(temporary_path);
@@ -154,8 +154,8 @@ void write_log(const std::filesystem::path& path, const LogTable& table) {
   while (written < text.size()) {
     const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
     if (n < 0) {
-      if (errno == EINTR) continue;
       const int error = errno;
+      if (error == EINTR) continue;
       ::close(fd);
       throw fail("write " + temporary_path.string(), error);
     }
@@ -166,9 +166,13 @@ void write_log(const std::filesystem::path& path, const LogTable& table) {
     ::close(fd);
     throw fail("fsync " + temporary_path.string(), error);
   }
-  if (::close(fd) != 0) throw fail("close " + temporary_path.string(), errno);
+  if (::close(fd) != 0) {
+    const int error = errno;
+    throw fail("close " + temporary_path.string(), error);
+  }
   if (::rename(temporary_path.c_str(), path.c_str()) != 0) {
-    throw fail("rename " + temporary_path.string() + " to " + file, errno);
+    const int error = errno;
+    throw fail("rename " + temporary_path.string() + " to " + file, error);
   }
   temporary.release();
 
