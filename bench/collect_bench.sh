@@ -17,13 +17,13 @@ run() {  # run JOBS -> prints the collect summary line, sets $seconds
   start=$(date +%s.%N)
   "$hadynet" collect --preset paper --seed 1 --jobs "$jobs" --quiet --out "$work/j$jobs" >"$work/out$jobs"
   end=$(date +%s.%N)
-  seconds=$(echo "$end - $start" | bc -l)
+  seconds=$(awk -v a="$start" -v b="$end" 'BEGIN { print b - a }')
   cat "$work/out$jobs"
 }
 run 1; base=$seconds
 run "$(nproc)"; all=$seconds
 printf 'paper preset: %.1f s with %d jobs, %.1f s with 1 job (baseline): speed-up %.2fx\n' \
-  "$all" "$(nproc)" "$base" "$(echo "$base / $all" | bc -l)"
+  "$all" "$(nproc)" "$base" "$(awk -v a="$base" -v b="$all" 'BEGIN { print a / b }')"
 cmp -s <(cd "$work/j1" && find . -type f -exec md5sum {} + | sort) \
        <(cd "$work/j$(nproc)" && find . -type f -exec md5sum {} + | sort) \
   && echo "outputs identical across job counts" || { echo "outputs differ across job counts" >&2; exit 1; }
