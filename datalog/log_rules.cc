@@ -49,11 +49,7 @@ double check_required_metadata(const LogMetadata& metadata, const std::string& f
 
   const auto version = metadata.get("format_version");
   if (!version) missing(file, "format_version", std::to_string(kFormatVersion));
-  int version_number = 0;
-  const char* first = version->data();
-  const char* last = first + version->size();
-  const auto [end, ec] = std::from_chars(first, last, version_number);
-  if (ec != std::errc() || end != last || version_number != kFormatVersion) {
+  if (*version != std::to_string(kFormatVersion)) {
     throw LogError(file, line_of(metadata, "format_version"), 0, "",
                    "unsupported format_version " + quoted(*version) +
                        "; the supported format_version is " + std::to_string(kFormatVersion));

@@ -163,6 +163,8 @@ INSTANTIATE_TEST_SUITE_P(Metadata, ParseLogRejects, ::testing::Values(
     // A newer version: the message names the supported one.
     BadLog{"UnsupportedVersion", "# format: hadynet-log\n# format_version: 2\n# dt_s: 0.2\nt,l0\n0,1\n",
            2, 0, "", "unsupported format_version '2'; the supported format_version is 1"},
+    BadLog{"VersionWithLeadingZero", "# format: hadynet-log\n# format_version: 01\n# dt_s: 0.2\nt,l0\n0,1\n",
+           2, 0, "", "unsupported format_version '01'"},
     BadLog{"MissingDt", "# format: hadynet-log\n# format_version: 1\nt,l0\n0,1\n", 0, 0, "",
            "missing required metadata line '# dt_s: ...'"},
     BadLog{"NegativeDt", "# format: hadynet-log\n# format_version: 1\n# dt_s: -0.2\nt,l0\n0,1\n",
