@@ -6,5 +6,6 @@ namespace hadynet::cli {
 
 int run_collect(int argc, char** argv);
 int run_validate(int argc, char** argv);
+int run_plot(int argc, char** argv);
 
 }  // namespace hadynet::cli

@@ -17,6 +17,7 @@ constexpr Command kCommands[] = {
     {"collect", "record logs from the MuJoCo hand plant (a preset dataset or one experiment)",
      hadynet::cli::run_collect},
     {"validate", "check logs or a dataset folder strictly and print a summary", hadynet::cli::run_validate},
+    {"plot", "draw a log as a PNG (gnuplot): one panel per channel group", hadynet::cli::run_plot},
 };
 
 void print_help() {

@@ -16,3 +16,8 @@ echo "== collect: the paper preset from the MuJoCo hand -> $out"
 "$hadynet" collect --preset paper --seed 1 --out "$out"
 echo "== validate"
 "$hadynet" validate "$out"
+echo "== plot: one grasp (Random-2) log per object -> $out/plots/"
+mkdir -p "$out/plots"
+for log in "$out"/train/*_random2_i0_w0.csv "$out"/novel/*_random2_*.csv; do
+  "$hadynet" plot "$log" --out "$out/plots/$(basename "${log%.csv}").png"
+done
