@@ -19,6 +19,17 @@ std::string wear_text(double wear) {
 }
 std::uint64_t wear_key(double wear) { return static_cast<std::uint64_t>(std::llround(wear * 1000.0)); }
 enum SeedSalt : std::uint64_t { kSaltOffsets = 11, kSaltMotion = 12, kSaltNoise = 13 };
+
+// Seed of one random stream (motion or sensor noise) of one experiment.
+std::uint64_t experiment_seed(const ExperimentSpec& spec, SeedSalt salt) {
+  const auto motion_and_init = static_cast<std::uint64_t>(spec.motion) * 1000 + static_cast<std::uint64_t>(spec.init_id);
+  return derive_seed(spec.seed, salt, static_cast<std::uint64_t>(spec.object), motion_and_init, wear_key(spec.wear_level));
+}
+
+// Rounds a length (mm) to the command resolution, printing as e.g. -2.991.
+double to_command_resolution(double mm) {
+  return std::round(mm / kCommandResolution_mm) / (1.0 / kCommandResolution_mm);
+}
 }  // namespace
 
 std::string state_id(const ExperimentSpec& spec) {
@@ -45,14 +56,9 @@ HandSpec hand_spec_for(const ExperimentSpec& spec) {
 
 ExperimentResult run_experiment(const ExperimentSpec& spec) {
   const HandSpec hand = hand_spec_for(spec);
-  const auto object_key = static_cast<std::uint64_t>(spec.object);
-  const auto motion_key = static_cast<std::uint64_t>(spec.motion);
-  const auto init_key = static_cast<std::uint64_t>(spec.init_id);
   HandPlant plant(hand);
-  MotionGenerator motion(spec.motion, spec.object,
-                         derive_seed(spec.seed, kSaltMotion, object_key, motion_key * 1000 + init_key, wear_key(spec.wear_level)));
-  SensorModel sensors(hand.effects, hand.sensor_realism,
-                      derive_seed(spec.seed, kSaltNoise, object_key, motion_key * 1000 + init_key, wear_key(spec.wear_level)));
+  MotionGenerator motion(spec.motion, spec.object, experiment_seed(spec, kSaltMotion));
+  SensorModel sensors(hand.effects, hand.sensor_realism, experiment_seed(spec, kSaltNoise));
 
   datalog::LogTable log;
   auto& meta = log.metadata;
@@ -78,7 +84,7 @@ ExperimentResult run_experiment(const ExperimentSpec& spec) {
 
   // Start from the open hand, held for 1 s so that the row at t = 0 is at rest.
   std::array<double, kMuscles> target = nominal_muscle_lengths_mm(start_pose());
-  for (auto& v : target) v = std::round(v / kCommandResolution_mm) / (1.0 / kCommandResolution_mm);
+  for (auto& v : target) v = to_command_resolution(v);
   plant.settle(target, 1.0);
   SensorFrame y = sensors.measure(plant.state());
   std::vector<double> row;
@@ -88,7 +94,7 @@ ExperimentResult run_experiment(const ExperimentSpec& spec) {
     const auto wanted = motion.next_target();
     std::array<double, kMuscles> u{};
     for (int m = 0; m < kMuscles; ++m) {
-      u[m] = std::round((wanted[m] - target[m]) / kCommandResolution_mm) / (1.0 / kCommandResolution_mm);
+      u[m] = to_command_resolution(wanted[m] - target[m]);
       target[m] += u[m];
     }
     row.clear();

@@ -26,12 +26,6 @@ constexpr const char* kPhalanxJoint[3] = {"mcp", "pip", "dip"};
 constexpr double kPalmHalf_m[3] = {0.045, 0.042, 0.010};
 constexpr double kFingerBaseX_m = 0.090;
 
-// Object geometry (m) and contact softness.
-struct ObjectGeometry {
-  double radius_m = 0;      // cylinder/ball radius or box half-height
-  double mass_kg = 0;
-};
-
 void write_finger(std::ostringstream& x, const FingerLayout& f, const HandSpec& spec) {
   const double scale = spec.wear.spring_stiffness_scale;
   x << "<body name='" << f.name << "_0' pos='" << kFingerBaseX_m << ' ' << f.base_y_m << " 0.002'>\n";
