@@ -7,5 +7,11 @@ namespace hadynet::cli {
 int run_collect(int argc, char** argv);
 int run_validate(int argc, char** argv);
 int run_plot(int argc, char** argv);
+int run_train(int argc, char** argv);
+int run_adapt(int argc, char** argv);
+int run_recognize(int argc, char** argv);
+int run_calibrate_detect(int argc, char** argv);
+int run_simulate(int argc, char** argv);
+int run_detect(int argc, char** argv);
 
 }  // namespace hadynet::cli

@@ -1,5 +1,6 @@
 // hadynet: one program, one subcommand per job (collect, validate, and the
 // trainer, codegen and replay commands as they land).
+#include <Eigen/Core>
 #include <cstdio>
 #include <cstring>
 
@@ -18,18 +19,31 @@ constexpr Command kCommands[] = {
      hadynet::cli::run_collect},
     {"validate", "check logs or a dataset folder strictly and print a summary", hadynet::cli::run_validate},
     {"plot", "draw a log as a PNG (gnuplot): one panel per channel group", hadynet::cli::run_plot},
+    {"train", "train HADYNET and the PB table from logs; write a model file", hadynet::cli::run_train},
+    {"adapt", "fit the PB alone to new logs (offline, or --online over a stream)", hadynet::cli::run_adapt},
+    {"recognize", "adapt the PB, name the nearest trained state's object, plot the PB map",
+     hadynet::cli::run_recognize},
+    {"calibrate-detect", "contact-detection statistics and threshold from contact-free logs",
+     hadynet::cli::run_calibrate_detect},
+    {"detect", "contact detection over logs: d per step, flags, traces plot", hadynet::cli::run_detect},
+    {"simulate", "predict a log from a start state, commands and any PB (contact simulation)",
+     hadynet::cli::run_simulate},
 };
 
 void print_help() {
   std::puts("usage: hadynet COMMAND [options]   (hadynet COMMAND --help for a command's options)\n");
   std::puts("HADYNET: a learned dynamics model with parametric bias for a flexible tendon-driven hand.\n");
   std::puts("commands:");
-  for (const auto& c : kCommands) std::printf("  %-10s %s\n", c.name, c.summary);
+  for (const auto& c : kCommands) std::printf("  %-17s %s\n", c.name, c.summary);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Matrix products run on one thread unless a command asks for more (train
+  // --threads): OpenMP's spinning threads slow down badly when the cores are
+  // shared with other work, and the small products of adapt/detect gain nothing.
+  Eigen::setNbThreads(1);
   if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0 ||
       std::strcmp(argv[1], "help") == 0) {
     print_help();

@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
 # The main job, end to end on the built-in defaults (the MuJoCo hand):
 # install dependencies, build, record the seed paper's dataset from the plant,
-# validate it and print its summary. Later stages (train, adapt, recognise,
-# codegen, replay) join here as they land.
-# Usage: scripts/main.sh [OUT_DIR]   (default: data/paper)
+# validate it and plot it, then the seed paper's experiments with the trainer
+# (scripts/paper_experiments.sh: train, adapt, recognise, online PB, detection,
+# simulation; summary in out/paper/summary.md). Later stages (codegen, replay)
+# join here as they land.
+# Usage: scripts/main.sh [DATA_DIR] [RESULTS_DIR]   (defaults: data/paper, out/paper)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out="${1:-data/paper}"
+results="${2:-out/paper}"
 
 scripts/setup.sh
 scripts/build.sh release
@@ -21,3 +24,5 @@ mkdir -p "$out/plots"
 for log in "$out"/train/*_random2_i0_w0.csv "$out"/novel/*_random2_*.csv; do
   "$hadynet" plot "$log" --out "$out/plots/$(basename "${log%.csv}").png"
 done
+echo "== the seed paper's experiments -> $results"
+scripts/paper_experiments.sh "$out" "$results"

@@ -5,6 +5,7 @@
 // optimiser state of theirs change.
 #pragma once
 
+#include <utility>
 #include <vector>
 
 #include "trainer/hadynet_params.h"
@@ -34,6 +35,19 @@ class Adam {
   void set_trainable(GroupSet trainable) { trainable_ = trainable; }
   GroupSet trainable() const { return trainable_; }
   const Options& options() const { return options_; }
+
+  // Moments and step counts per tensor (tensors() order; a tensor never
+  // updated has empty m, v and t 0). Saved in checkpoints to resume exactly.
+  struct State {
+    std::vector<Vector<S>> m, v;
+    std::vector<long> t;
+  };
+  State state() const { return State{m_, v_, t_}; }
+  void set_state(State state) {
+    m_ = std::move(state.m);
+    v_ = std::move(state.v);
+    t_ = std::move(state.t);
+  }
 
  private:
   Options options_;

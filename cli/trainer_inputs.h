@@ -1,0 +1,34 @@
+// Shared input handling of the trainer subcommands (train, adapt, recognize,
+// calibrate-detect, simulate): loading logs for a model's channels, grouping
+// them by dynamics state, and choosing a PB from the command line.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "trainer/hadynet_model.h"
+#include "trainer/log_dataset.h"
+
+namespace hadynet::cli {
+
+// Reads every log under `args` (files or folders) for the model's channels.
+// Throws (LogError / std::runtime_error) naming the file on any problem.
+std::vector<trainer::LogSequence> read_sequences(const std::vector<std::string>& args,
+                                                 const trainer::FeatureLayout& layout);
+
+// Sequences grouped by state id, groups in first-appearance order.
+struct StateGroup {
+  std::string state;
+  std::string object;
+  std::vector<trainer::LogSequence> sequences;
+};
+std::vector<StateGroup> group_by_state(std::vector<trainer::LogSequence> sequences);
+
+// A PB chosen on the command line: "zero", a state name of the model's PB
+// table, or comma-separated numbers. Throws std::runtime_error with a message.
+Eigen::VectorXf parse_pb(const trainer::HadynetModel& model, const std::string& text);
+
+std::string format_pb(const Eigen::VectorXf& pb);
+
+}  // namespace hadynet::cli

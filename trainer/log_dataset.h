@@ -1,0 +1,81 @@
+// From recorded logs to HADYNET's signals (DESIGN.md sections 2 and 4).
+//
+// Nothing here knows the hand: the channels come from the log header.
+//   y_t : every observed group (every numbered group but "u"), header order
+//   u_t : the "u" group (change of target per step; u_t acts on y_{t+1}, ...)
+//   x_t : per observed group in header order, the group at t, followed, for
+//         the "delta groups" only, by the group at t minus the group at t-1.
+//         With the hand's logs and delta groups {l, th} this is the paper's
+//         x = (l, dl, f, fc, th, dth); x_t exists for t >= 1.
+// `aux_*` columns are not model inputs (the residual loop may add them).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "datalog/log_table.h"
+
+namespace hadynet::trainer {
+
+// The paper's choice: differences of muscle lengths and wrist angles.
+inline const std::vector<std::string> kDefaultDeltaGroups = {"l", "th"};
+
+// Channel names of x, u and y. Equal layouts mean interchangeable logs.
+struct FeatureLayout {
+  std::vector<std::string> y_names;       // e.g. l0..l7, f0..f7, fc0..fc8, th0, th1
+  std::vector<std::string> u_names;       // u0..u7
+  std::vector<std::string> x_names;       // l0..l7, dl0..dl7, f0.., fc0.., th0, th1, dth0, dth1
+  std::vector<std::string> delta_groups;  // prefixes whose differences are in x
+  // For each x channel: its index in y, and whether it is a difference.
+  std::vector<int> x_source;
+  std::vector<bool> x_is_delta;
+
+  bool operator==(const FeatureLayout&) const = default;
+};
+
+// Layout of a log's header. Throws std::runtime_error naming `file` if the
+// log has no "u" group, or a delta group is not an observed group.
+FeatureLayout feature_layout(const datalog::LogTable& table, const std::string& file,
+                             const std::vector<std::string>& delta_groups);
+
+// Rebuilds a layout from stored channel names (model file). Throws
+// std::runtime_error if x_names does not follow the rules above for y_names.
+FeatureLayout feature_layout_from_names(std::vector<std::string> y_names,
+                                        std::vector<std::string> u_names,
+                                        std::vector<std::string> delta_groups);
+
+// One log in physical units, columns per time step.
+struct LogSequence {
+  std::string file;    // path, for messages
+  std::string state;   // dynamics-state id (metadata "state"; the file stem if absent)
+  std::string object;  // metadata "object" ("" if absent)
+  Eigen::MatrixXd y;   // y_names.size() x T
+  Eigen::MatrixXd u;   // u_names.size() x T
+
+  int steps() const { return static_cast<int>(y.cols()); }
+};
+
+// Extracts y and u of `layout` from a log, by column name. Throws
+// std::runtime_error naming the file and the first missing channel.
+LogSequence log_sequence(const datalog::LogTable& table, const std::string& file,
+                         const FeatureLayout& layout);
+
+// Reads and checks a log (datalog::read_log) and extracts it. LogError and
+// std::runtime_error name the file.
+LogSequence read_sequence(const std::string& path, const FeatureLayout& layout);
+
+// x_t of a sequence in physical units; requires 1 <= t < steps().
+Eigen::VectorXd initial_state(const FeatureLayout& layout, const LogSequence& seq, int t);
+
+// Every *.csv file under each argument (a file is taken as is; a folder is
+// searched recursively), sorted by path, duplicates removed. Throws
+// std::runtime_error for a missing path or when nothing is found.
+std::vector<std::string> expand_log_paths(const std::vector<std::string>& args);
+
+// Identifies a dataset: FNV-1a 64 over, per path in the given order, the
+// file name (not the folder) and the bytes. 16 hex digits. Throws
+// std::runtime_error naming an unreadable file.
+std::string content_hash(const std::vector<std::string>& paths);
+
+}  // namespace hadynet::trainer

@@ -1,0 +1,297 @@
+#include "trainer/model_file.h"
+
+#include <cmath>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <stdexcept>
+
+namespace hadynet::trainer {
+
+namespace st = safetensors;
+using nlohmann::json;
+
+namespace {
+
+std::vector<std::int64_t> shape_of(const NamedTensor<const float>& t) {
+  if (t.rank == 1) return {t.rows};
+  return {t.rows, t.cols};
+}
+
+st::Tensor f64_vector(const Eigen::VectorXd& v) {
+  return st::make_f64({v.size()}, std::span<const double>(v.data(), static_cast<std::size_t>(v.size())));
+}
+
+// Row-major bytes of a (symmetric or not) matrix.
+st::Tensor f64_matrix(const Eigen::MatrixXd& m) {
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> r = m;
+  return st::make_f64({r.rows(), r.cols()},
+                      std::span<const double>(r.data(), static_cast<std::size_t>(r.size())));
+}
+
+[[noreturn]] void fail(const std::string& origin, const std::string& message) {
+  throw ModelFileError(origin + ": " + message);
+}
+
+json parse_metadata_json(const st::File& file, const std::string& key, const std::string& origin) {
+  const auto it = file.metadata.find(key);
+  if (it == file.metadata.end()) fail(origin, "metadata has no '" + key + "'");
+  try {
+    return json::parse(it->second);
+  } catch (const json::exception& e) {
+    fail(origin, "metadata '" + key + "' is not valid JSON: " + e.what());
+  }
+}
+
+template <class T>
+T json_get(const json& j, const std::string& key, const std::string& where,
+           const std::string& origin) {
+  if (!j.is_object() || !j.contains(key)) fail(origin, where + " has no '" + key + "'");
+  try {
+    return j.at(key).get<T>();
+  } catch (const json::exception&) {
+    fail(origin, where + " '" + key + "' has the wrong type");
+  }
+}
+
+Eigen::VectorXd read_vector(const st::File& file, const std::string& name, std::int64_t n) {
+  const std::vector<double> v = st::as_f64(file, name, {n});
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
+
+Eigen::MatrixXd read_matrix(const st::File& file, const std::string& name, std::int64_t n) {
+  const std::vector<double> v = st::as_f64(file, name, {n, n});
+  return Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+      v.data(), static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
+}
+
+const char* const kNormTensors[] = {"norm.x_mean", "norm.x_std", "norm.u_mean",
+                                    "norm.u_std",  "norm.y_mean", "norm.y_std"};
+
+}  // namespace
+
+int HadynetModel::state_index(const std::string& name) const {
+  for (std::size_t k = 0; k < states.size(); ++k)
+    if (states[k].name == name) return static_cast<int>(k);
+  return -1;
+}
+
+void HadynetModel::check_consistent() const {
+  const HadynetDims& d = params.dims;
+  params.check_shapes();
+  const auto need = [](bool ok, const std::string& what) {
+    if (!ok) throw std::invalid_argument("model: " + what);
+  };
+  need(static_cast<int>(layout.x_names.size()) == d.x, "x channels differ from dims.x");
+  need(static_cast<int>(layout.u_names.size()) == d.u, "u channels differ from dims.u");
+  need(static_cast<int>(layout.y_names.size()) == d.y, "y channels differ from dims.y");
+  need(static_cast<int>(states.size()) == d.states, "PB states differ from the PB table rows");
+  need(norm.x.mean.size() == d.x && norm.x.std.size() == d.x, "x normalisation size");
+  need(norm.u.mean.size() == d.u && norm.u.std.size() == d.u, "u normalisation size");
+  need(norm.y.mean.size() == d.y && norm.y.std.size() == d.y, "y normalisation size");
+  need((norm.x.std.array() > 0).all() && (norm.u.std.array() > 0).all() &&
+           (norm.y.std.array() > 0).all(),
+       "a normalisation std is not positive");
+  need(train_steps >= 1, "train_steps < 1");
+  if (detection) {
+    const DetectionCalibration& c = *detection;
+    need(c.steps >= 1, "detection steps < 1");
+    need(c.pb.size() == d.pb, "detection PB size");
+    need(c.mean.size() == d.y && c.covariance.rows() == d.y && c.covariance.cols() == d.y &&
+             c.inverse.rows() == d.y && c.inverse.cols() == d.y,
+         "detection statistics sizes");
+    need(std::isfinite(c.threshold) && c.threshold > 0, "detection threshold not positive");
+  }
+}
+
+st::File model_to_safetensors(const HadynetModel& model) {
+  model.check_consistent();
+  st::File file;
+  for (const NamedTensor<const float>& t : model.params.tensors()) {
+    file.tensors[std::string(t.name)] = st::make_f32(
+        shape_of(t), std::span<const float>(t.data, static_cast<std::size_t>(t.size())));
+  }
+  st::Tensor tracked;  // I64 scalar, as PyTorch stores it
+  tracked.dtype = st::DType::kI64;
+  tracked.bytes.resize(sizeof(std::int64_t));
+  const std::int64_t batches = model.bn_batches_tracked;
+  std::memcpy(tracked.bytes.data(), &batches, sizeof batches);
+  file.tensors["enc_bn.num_batches_tracked"] = std::move(tracked);
+  const Eigen::VectorXd* norm[] = {&model.norm.x.mean, &model.norm.x.std, &model.norm.u.mean,
+                                   &model.norm.u.std,  &model.norm.y.mean, &model.norm.y.std};
+  for (std::size_t i = 0; i < 6; ++i) file.tensors[kNormTensors[i]] = f64_vector(*norm[i]);
+
+  const HadynetDims& d = model.params.dims;
+  file.metadata["format"] = kModelFormat;
+  file.metadata["format_version"] = std::to_string(kModelFormatVersion);
+  file.metadata["dims"] = json{{"x", d.x},         {"u", d.u},           {"y", d.y},
+                               {"pb", d.pb},       {"hidden", d.hidden}, {"states", d.states},
+                               {"train_steps", model.train_steps}}
+                              .dump();
+  file.metadata["channels"] = json{{"x", model.layout.x_names},
+                                   {"u", model.layout.u_names},
+                                   {"y", model.layout.y_names},
+                                   {"delta_groups", model.layout.delta_groups}}
+                                  .dump();
+  json states = json::array();
+  for (const PbState& s : model.states) states.push_back({{"name", s.name}, {"object", s.object}});
+  file.metadata["states"] = states.dump();
+  file.metadata["hyper_parameters"] = json(model.hyper_parameters).dump();
+  file.metadata["provenance"] = json(model.provenance).dump();
+  if (model.detection) {
+    const DetectionCalibration& c = *model.detection;
+    file.metadata["detection"] = json{{"steps", c.steps},
+                                      {"threshold", c.threshold},
+                                      {"samples", c.samples},
+                                      {"source", c.source}}
+                                     .dump();
+    file.tensors["detect.pb"] = f64_vector(c.pb);
+    file.tensors["detect.mean"] = f64_vector(c.mean);
+    file.tensors["detect.covariance"] = f64_matrix(c.covariance);
+    file.tensors["detect.inverse"] = f64_matrix(c.inverse);
+  }
+  return file;
+}
+
+HadynetModel model_from_safetensors(const st::File& file, const std::string& origin,
+                                    bool allow_optimizer_state) {
+  const auto format = file.metadata.find("format");
+  if (format == file.metadata.end() || format->second != kModelFormat) {
+    fail(origin, std::string("not a HADYNET model (metadata 'format' must be '") + kModelFormat +
+                     "')");
+  }
+  const auto version = file.metadata.find("format_version");
+  if (version == file.metadata.end() || version->second != std::to_string(kModelFormatVersion)) {
+    fail(origin, "unsupported model format_version '" +
+                     (version == file.metadata.end() ? std::string() : version->second) +
+                     "'; this build reads version " + std::to_string(kModelFormatVersion));
+  }
+  HadynetModel model;
+  try {
+    const json dims = parse_metadata_json(file, "dims", origin);
+    HadynetDims d;
+    d.x = json_get<int>(dims, "x", "dims", origin);
+    d.u = json_get<int>(dims, "u", "dims", origin);
+    d.y = json_get<int>(dims, "y", "dims", origin);
+    d.pb = json_get<int>(dims, "pb", "dims", origin);
+    d.hidden = json_get<int>(dims, "hidden", "dims", origin);
+    d.states = json_get<int>(dims, "states", "dims", origin);
+    model.train_steps = json_get<int>(dims, "train_steps", "dims", origin);
+    try {
+      validate(d);
+    } catch (const std::invalid_argument& e) {
+      fail(origin, std::string("metadata 'dims': ") + e.what());
+    }
+    if (d.x > 1 << 16 || d.u > 1 << 16 || d.y > 1 << 16 || d.pb > 1 << 16 ||
+        d.hidden > 1 << 16 || d.states > 1 << 20) {
+      fail(origin, "metadata 'dims' holds an absurd size");
+    }
+
+    const json channels = parse_metadata_json(file, "channels", origin);
+    model.layout = feature_layout_from_names(
+        json_get<std::vector<std::string>>(channels, "y", "channels", origin),
+        json_get<std::vector<std::string>>(channels, "u", "channels", origin),
+        json_get<std::vector<std::string>>(channels, "delta_groups", "channels", origin));
+    if (json_get<std::vector<std::string>>(channels, "x", "channels", origin) !=
+        model.layout.x_names) {
+      fail(origin, "metadata 'channels': x does not follow from y and delta_groups");
+    }
+
+    const json states = parse_metadata_json(file, "states", origin);
+    if (!states.is_array()) fail(origin, "metadata 'states' must be a list");
+    for (const json& s : states) {
+      model.states.push_back({json_get<std::string>(s, "name", "a state", origin),
+                              json_get<std::string>(s, "object", "a state", origin)});
+    }
+    model.hyper_parameters = parse_metadata_json(file, "hyper_parameters", origin)
+                                 .get<std::map<std::string, std::string>>();
+    model.provenance =
+        parse_metadata_json(file, "provenance", origin).get<std::map<std::string, std::string>>();
+
+    // Tensors: exactly the expected set.
+    std::set<std::string> expected;
+    model.params = HadynetParams<float>::zeros(d);
+    for (NamedTensor<float> t : model.params.tensors()) {
+      const std::string name(t.name);
+      expected.insert(name);
+      std::vector<std::int64_t> shape{t.rows};
+      if (t.rank == 2) shape.push_back(t.cols);
+      const std::vector<float> v = st::as_f32(file, name, shape);
+      for (std::size_t i = 0; i < v.size(); ++i) {
+        if (!std::isfinite(v[i])) fail(origin, "tensor '" + name + "' holds a non-finite value");
+        t.data[i] = v[i];
+      }
+    }
+    expected.insert("enc_bn.num_batches_tracked");
+    const auto tracked = file.tensors.find("enc_bn.num_batches_tracked");
+    if (tracked == file.tensors.end() || tracked->second.dtype != st::DType::kI64 ||
+        !tracked->second.shape.empty()) {
+      fail(origin, "tensor 'enc_bn.num_batches_tracked' missing or not an I64 scalar");
+    }
+    std::int64_t batches = 0;
+    std::memcpy(&batches, tracked->second.bytes.data(), sizeof batches);
+    model.bn_batches_tracked = static_cast<long>(batches);
+
+    const std::int64_t sizes[] = {d.x, d.x, d.u, d.u, d.y, d.y};
+    Eigen::VectorXd* norm[] = {&model.norm.x.mean, &model.norm.x.std, &model.norm.u.mean,
+                               &model.norm.u.std,  &model.norm.y.mean, &model.norm.y.std};
+    for (std::size_t i = 0; i < 6; ++i) {
+      expected.insert(kNormTensors[i]);
+      *norm[i] = read_vector(file, kNormTensors[i], sizes[i]);
+      if (!norm[i]->allFinite()) fail(origin, std::string(kNormTensors[i]) + " is not finite");
+    }
+
+    if (file.metadata.count("detection") != 0) {
+      const json det = parse_metadata_json(file, "detection", origin);
+      DetectionCalibration c;
+      c.steps = json_get<int>(det, "steps", "detection", origin);
+      c.threshold = json_get<double>(det, "threshold", "detection", origin);
+      c.samples = json_get<long>(det, "samples", "detection", origin);
+      c.source = json_get<std::string>(det, "source", "detection", origin);
+      c.pb = read_vector(file, "detect.pb", d.pb);
+      c.mean = read_vector(file, "detect.mean", d.y);
+      c.covariance = read_matrix(file, "detect.covariance", d.y);
+      c.inverse = read_matrix(file, "detect.inverse", d.y);
+      if (!c.pb.allFinite() || !c.mean.allFinite() || !c.covariance.allFinite() ||
+          !c.inverse.allFinite()) {
+        fail(origin, "detection statistics are not finite");
+      }
+      for (const char* n : {"detect.pb", "detect.mean", "detect.covariance", "detect.inverse"})
+        expected.insert(n);
+      model.detection = std::move(c);
+    }
+
+    for (const auto& [name, tensor] : file.tensors) {
+      if (expected.count(name) != 0) continue;
+      if (allow_optimizer_state && name.rfind("optim.", 0) == 0) continue;
+      fail(origin, "unexpected tensor '" + name + "'");
+    }
+    model.check_consistent();
+  } catch (const st::FormatError& e) {
+    fail(origin, e.message());
+  } catch (const std::invalid_argument& e) {
+    fail(origin, e.what());
+  } catch (const std::runtime_error& e) {
+    if (dynamic_cast<const ModelFileError*>(&e) != nullptr) throw;
+    fail(origin, e.what());
+  } catch (const json::exception& e) {
+    fail(origin, std::string("metadata: ") + e.what());
+  }
+  return model;
+}
+
+void save_model(const std::string& path, const HadynetModel& model) {
+  st::write_file(path, model_to_safetensors(model));
+}
+
+HadynetModel load_model(const std::string& path) {
+  st::File file;
+  try {
+    file = st::read_file(path);
+  } catch (const st::FormatError& e) {
+    throw ModelFileError(e.what());
+  }
+  return model_from_safetensors(file, path);
+}
+
+}  // namespace hadynet::trainer

@@ -1,0 +1,133 @@
+#include "trainer/pb_adaptation.h"
+
+#include <limits>
+#include <stdexcept>
+
+namespace hadynet::trainer {
+
+namespace {
+
+// The model's weights with a one-row PB table holding `pb`.
+HadynetParams<float> single_pb_params(const HadynetModel& model, const Eigen::VectorXf& pb) {
+  if (pb.size() != model.params.dims.pb) {
+    throw std::invalid_argument("PB has " + std::to_string(pb.size()) + " values, the model " +
+                                std::to_string(model.params.dims.pb));
+  }
+  HadynetParams<float> p = model.params;
+  p.dims.states = 1;
+  p.pb = pb.transpose();
+  return p;
+}
+
+// Full-batch MomentumSGD epochs on one gathered batch; appends the loss
+// before each epoch and after the last to `loss`.
+void fit(HadynetParams<float>& params, MomentumSgd<float>& sgd, const WindowBatch<float>& batch,
+         const Matrix<float>& y, int epochs, std::vector<double>& loss) {
+  HadynetNetwork<float> net;
+  HadynetGrads<float> grads;
+  Matrix<float> d_y;
+  for (int e = 0; e < epochs; ++e) {
+    const Matrix<float>& y_hat = net.forward(params, batch, BnMode::kEval);
+    loss.push_back(static_cast<double>(mse_loss(y_hat, y, &d_y)));
+    net.backward(params, d_y, grads);
+    sgd.step(params, grads.params);
+  }
+  loss.push_back(static_cast<double>(mse_loss(net.forward(params, batch, BnMode::kEval), y)));
+}
+
+WindowBatch<float> single_state(WindowBatch<float> batch) {
+  std::fill(batch.state.begin(), batch.state.end(), 0);
+  return batch;
+}
+
+}  // namespace
+
+AdaptResult adapt_pb(const HadynetModel& model, const WindowDataset& data, std::span<const int> ids,
+                     const Eigen::VectorXf& start, const AdaptOptions& options) {
+  if (ids.empty()) throw std::invalid_argument("PB adaptation: no windows");
+  HadynetParams<float> params = single_pb_params(model, start);
+  MomentumSgd<float> sgd({options.lr, options.momentum}, GroupSet::only(ParamGroup::kPb));
+  WindowBatch<float> batch;
+  Matrix<float> y;
+  data.gather(ids, batch, y);
+  AdaptResult result;
+  fit(params, sgd, single_state(std::move(batch)), y, options.epochs, result.loss);
+  result.pb = params.pb.row(0).transpose();
+  return result;
+}
+
+OnlinePbAdapter::OnlinePbAdapter(const HadynetModel& model, Eigen::VectorXf start, Options options)
+    : model_(model),
+      options_(options),
+      pb_(std::move(start)),
+      params_(single_pb_params(model, pb_)),
+      sgd_({options.adapt.lr, options.adapt.momentum}, GroupSet::only(ParamGroup::kPb)),
+      last_loss_(std::numeric_limits<double>::quiet_NaN()) {
+  if (options.start_windows < 1 || options.max_windows < options.start_windows) {
+    throw std::invalid_argument("online PB: need 1 <= start_windows <= max_windows");
+  }
+}
+
+void OnlinePbAdapter::begin_segment() {
+  rows_y_.clear();
+  rows_u_.clear();
+  segment_steps_ = 0;
+}
+
+bool OnlinePbAdapter::push(const Eigen::VectorXd& y, const Eigen::VectorXd& u) {
+  const int N = model_.train_steps;
+  rows_y_.push_back(y);
+  rows_u_.push_back(u);
+  ++segment_steps_;
+  // Rows kept: x_i needs rows i-1 and i; the window then needs rows up to i+N.
+  while (static_cast<int>(rows_y_.size()) > N + 2) {
+    rows_y_.pop_front();
+    rows_u_.pop_front();
+  }
+  // The window completed by this row starts at i = (this step) - N; it needs i >= 1.
+  if (segment_steps_ - 1 - N < 1) return false;
+  LogSequence rows;
+  rows.y.resize(y.size(), N + 2);
+  rows.u.resize(u.size(), N + 2);
+  for (int t = 0; t < N + 2; ++t) {
+    rows.y.col(t) = rows_y_[static_cast<std::size_t>(t)];
+    rows.u.col(t) = rows_u_[static_cast<std::size_t>(t)];
+  }
+  // Row 1 of `rows` is x_i, rows 1..N are its commands, rows 2..N+1 its targets.
+  x_.push_back(model_.norm.x.standardize(initial_state(model_.layout, rows, 1)).cast<float>());
+  Matrix<float> wu(u.size(), N), wy(y.size(), N);
+  for (int k = 0; k < N; ++k) {
+    wu.col(k) = model_.norm.u.standardize(rows.u.col(1 + k)).cast<float>();
+    wy.col(k) = model_.norm.y.standardize(rows.y.col(2 + k)).cast<float>();
+  }
+  u_.push_back(std::move(wu));
+  y_.push_back(std::move(wy));
+  if (windows() > options_.max_windows) {
+    x_.pop_front();
+    u_.pop_front();
+    y_.pop_front();
+  }
+  if (windows() < options_.start_windows) return false;
+
+  const Eigen::Index B = windows();
+  WindowBatch<float> batch;
+  Matrix<float> target(y.size(), N * B);
+  batch.x0.resize(model_.params.dims.x, B);
+  batch.u.resize(u.size(), N * B);
+  batch.state.assign(static_cast<std::size_t>(B), 0);
+  for (Eigen::Index b = 0; b < B; ++b) {
+    const auto w = static_cast<std::size_t>(b);
+    batch.x0.col(b) = x_[w];
+    for (Eigen::Index k = 0; k < N; ++k) {
+      batch.u.col(k * B + b) = u_[w].col(k);
+      target.col(k * B + b) = y_[w].col(k);
+    }
+  }
+  std::vector<double> loss;
+  fit(params_, sgd_, batch, target, options_.adapt.epochs, loss);
+  pb_ = params_.pb.row(0).transpose();
+  last_loss_ = loss.back();
+  return true;
+}
+
+}  // namespace hadynet::trainer

@@ -1,0 +1,73 @@
+// PB-only adaptation (DESIGN.md section 4, seed paper section III-C): the
+// weights stay frozen, one PB vector is fitted to data of the current
+// dynamics state by MomentumSGD on the full batch (BN in eval mode).
+#pragma once
+
+#include <Eigen/Core>
+#include <deque>
+#include <span>
+#include <vector>
+
+#include "trainer/hadynet_model.h"
+#include "trainer/optim.h"
+#include "trainer/window_dataset.h"
+
+namespace hadynet::trainer {
+
+struct AdaptOptions {
+  int epochs = 20;        // paper: N_epoch^update = 20 (online: 3)
+  double lr = 1.0;        // MomentumSGD step; see docs/trainer.md for how it was chosen
+  double momentum = 0.9;  // MomentumSGD momentum (Chainer's default)
+};
+
+struct AdaptResult {
+  Eigen::VectorXf pb;
+  std::vector<double> loss;  // loss[0]: with the start PB; loss[e]: after epoch e
+};
+
+// Fits one PB to the windows `ids` of `data`, starting from `start`
+// (dims.pb values). Throws std::invalid_argument on size errors or no windows.
+AdaptResult adapt_pb(const HadynetModel& model, const WindowDataset& data, std::span<const int> ids,
+                     const Eigen::VectorXf& start, const AdaptOptions& options);
+
+// Online PB update over a stream of steps (paper: start once 100 windows are
+// available, keep the newest 200, 3 full-batch epochs per new step). The
+// stream may consist of several segments (e.g. one log per grasped object):
+// windows never span a segment boundary, but the window buffer, the PB and
+// the momentum buffer carry over, as they would on the robot.
+class OnlinePbAdapter {
+ public:
+  struct Options {
+    int start_windows = 100;  // N_thre^online
+    int max_windows = 200;    // N_max^online
+    AdaptOptions adapt{3, 1.0, 0.9};
+  };
+
+  OnlinePbAdapter(const HadynetModel& model, Eigen::VectorXf start, Options options);
+
+  // Appends the next step (physical units: observed y_t, command u_t) of the
+  // current segment. A window {x_i, u_[i,i+N), y_[i+1,i+N]} is complete once
+  // y_{i+N} has arrived (and i >= 1 within the segment). Returns true if the
+  // PB was updated at this step (enough windows, and a new one arrived).
+  bool push(const Eigen::VectorXd& y, const Eigen::VectorXd& u);
+  // Starts a new segment: the next push is step 0 of a new recording.
+  void begin_segment();
+
+  const Eigen::VectorXf& pb() const { return pb_; }
+  int windows() const { return static_cast<int>(x_.size()); }  // <= max_windows
+  double last_loss() const { return last_loss_; }  // after the last update; NaN before
+
+ private:
+  const HadynetModel& model_;
+  Options options_;
+  Eigen::VectorXf pb_;
+  HadynetParams<float> params_;  // model weights with a one-row PB table
+  MomentumSgd<float> sgd_;
+  std::deque<Eigen::VectorXd> rows_y_, rows_u_;  // last N+1 rows of the current segment
+  long segment_steps_ = 0;                       // steps pushed in the current segment
+  std::deque<Eigen::VectorXf> x_;                // standardised windows, oldest first
+  std::deque<Matrix<float>> u_, y_;              // u x N and y x N per window
+  double last_loss_;
+};
+
+}  // namespace hadynet::trainer
