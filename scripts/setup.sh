@@ -18,7 +18,8 @@ packages=(
   libusb-1.0-0-dev libhidapi-dev umockdev libumockdev-dev
 )
 if [[ "${1:-}" == "--bench" ]]; then
-  packages+=(python3-torch python3-numpy)
+  # OpenBLAS: without it Debian's torch falls back to the reference BLAS (an unfair baseline)
+  packages+=(python3-torch python3-numpy libopenblas0-pthread)
 fi
 
 missing=()

@@ -16,6 +16,13 @@ std::string shape_str(Eigen::Index rows, Eigen::Index cols) {
   return std::to_string(rows) + "x" + std::to_string(cols);
 }
 
+// Parts the windows are split into for the recurrence: one per Eigen thread,
+// at most one per 16 windows (smaller parts lose more in matrix-product
+// efficiency than a thread gains).
+int recurrence_parts(int windows) {
+  return std::max(1, std::min(Eigen::nbThreads(), windows / 16));
+}
+
 }  // namespace
 
 template <class S>
@@ -105,18 +112,37 @@ const Matrix<S>& HadynetNetwork<S>::forward(const HadynetParams<S>& params,
   h_.leftCols(B) = bn_out_.cwiseMax(S(0));
   c_.leftCols(B).setZero();
 
-  // ---- LSTM over N steps; the input projections of all steps in one product ----
-  const auto w_ih_u = params.lstm_weight_ih.leftCols(d.u);
+  // ---- LSTM over N steps (forward_recurrence), windows split over threads ----
   const auto w_ih_p = params.lstm_weight_ih.rightCols(d.pb);
   gates_.resize(4 * H, static_cast<Eigen::Index>(N) * B);
-  gates_.noalias() = w_ih_u * batch.u;
+  u_ = batch.u;
   gates_pb_.noalias() = w_ih_p * enc_in_.bottomRows(d.pb);
   gates_pb_.colwise() += params.lstm_bias_ih + params.lstm_bias_hh;
   tanh_c_.resize(H, static_cast<Eigen::Index>(N) * B);
-  for (int k = 0; k < N; ++k) {
-    auto g = gates_.middleCols(k * B, B);
-    g += gates_pb_;
-    g.noalias() += params.lstm_weight_hh * h_.middleCols(k * B, B);
+  // Windows are independent through the recurrence: split them over threads.
+  const int parts = recurrence_parts(B);
+#pragma omp parallel for schedule(static) num_threads(parts) if (parts > 1)
+  for (int part = 0; part < parts; ++part) {
+    forward_recurrence(params, part * B / parts, (part + 1) * B / parts - part * B / parts);
+  }
+
+  // ---- decoder, all steps in one product ----
+  y_hat_.noalias() = params.dec_weight * h_.rightCols(static_cast<Eigen::Index>(N) * B);
+  y_hat_.colwise() += params.dec_bias;
+  return y_hat_;
+}
+
+// LSTM steps 0..N-1 for windows [b0, b0 + nb).
+template <class S>
+void HadynetNetwork<S>::forward_recurrence(const HadynetParams<S>& params, int b0, int nb) {
+  const int H = dims_.hidden;
+  const int B = batch_;
+  const auto w_ih_u = params.lstm_weight_ih.leftCols(dims_.u);
+  for (int k = 0; k < steps_; ++k) {
+    auto g = gates_.middleCols(k * B + b0, nb);
+    g.noalias() = w_ih_u * u_.middleCols(k * B + b0, nb);
+    g += gates_pb_.middleCols(b0, nb);
+    g.noalias() += params.lstm_weight_hh * h_.middleCols(k * B + b0, nb);
     g.topRows(2 * H) = g.topRows(2 * H).array().logistic();          // i, f
     g.middleRows(2 * H, H) = g.middleRows(2 * H, H).array().tanh();  // g
     g.bottomRows(H) = g.bottomRows(H).array().logistic();            // o
@@ -124,18 +150,12 @@ const Matrix<S>& HadynetNetwork<S>::forward(const HadynetParams<S>& params,
     const auto f = g.middleRows(H, H).array();
     const auto gg = g.middleRows(2 * H, H).array();
     const auto o = g.bottomRows(H).array();
-    auto c_next = c_.middleCols((k + 1) * B, B).array();
-    c_next = f * c_.middleCols(k * B, B).array() + i * gg;
-    auto tc = tanh_c_.middleCols(k * B, B).array();
+    auto c_next = c_.middleCols((k + 1) * B + b0, nb).array();
+    c_next = f * c_.middleCols(k * B + b0, nb).array() + i * gg;
+    auto tc = tanh_c_.middleCols(k * B + b0, nb).array();
     tc = c_next.tanh();
-    h_.middleCols((k + 1) * B, B).array() = o * tc;
+    h_.middleCols((k + 1) * B + b0, nb).array() = o * tc;
   }
-
-  // ---- decoder, all steps in one product ----
-  y_hat_.noalias() = params.dec_weight * h_.rightCols(static_cast<Eigen::Index>(N) * B);
-  y_hat_.colwise() += params.dec_bias;
-  u_ = batch.u;
-  return y_hat_;
 }
 
 template <class S>
@@ -202,73 +222,89 @@ void HadynetNetwork<S>::backward_recurrence(const HadynetParams<S>& params, int 
   const int H = dims_.hidden;
   const int B = batch_;
   const int N = steps_;
-  const bool full = truncation >= N;
-  const int max_streams = full ? 1 : truncation;
+  const int max_streams = truncation >= N ? 1 : truncation;
   d_h_in_.resize(H, static_cast<Eigen::Index>(max_streams) * B);
   d_c_in_.resize(H, static_cast<Eigen::Index>(max_streams) * B);
   d_c_total_.resize(H, static_cast<Eigen::Index>(max_streams) * B);
   d_gates_streams_.resize(4 * H, static_cast<Eigen::Index>(max_streams) * B);
   d_gates_.resize(4 * H, static_cast<Eigen::Index>(N) * B);
+  d_h0_.resize(H, B);
+  // Windows are independent through the recurrence: split them over threads.
+  const int parts = recurrence_parts(B);
+#pragma omp parallel for schedule(static) num_threads(parts) if (parts > 1)
+  for (int part = 0; part < parts; ++part) {
+    backward_recurrence_columns(params, truncation, part * B / parts,
+                                (part + 1) * B / parts - part * B / parts);
+  }
+  d_gates_pb_sum_ = d_gates_.leftCols(B);
+  for (int k = 1; k < N; ++k) d_gates_pb_sum_ += d_gates_.middleCols(k * B, B);
+}
+
+// backward_recurrence for windows [b0, b0 + nb): block s of a stream matrix
+// holds the stream of age s of every window, so this part's columns of block s
+// are s*B + b0 .. s*B + b0 + nb - 1.
+template <class S>
+void HadynetNetwork<S>::backward_recurrence_columns(const HadynetParams<S>& params, int truncation,
+                                                    int b0, int nb) {
+  const int H = dims_.hidden;
+  const int B = batch_;
+  const int N = steps_;
+  const bool full = truncation >= N;
+  const auto block = [B, b0, nb](auto& m, int s) { return m.middleCols(s * B + b0, nb); };
 
   int carried = 0;  // streams propagated into this step from the later one
   for (int j = N - 1; j >= 0; --j) {
-    const auto fresh = d_h_out_.middleCols(j * B, B);
+    const auto fresh = d_h_out_.middleCols(j * B + b0, nb);
     int live = 0;
     if (full) {
       if (carried > 0) {
-        d_h_in_.leftCols(B) += fresh;
+        block(d_h_in_, 0) += fresh;
       } else {
-        d_h_in_.leftCols(B) = fresh;
-        d_c_in_.leftCols(B).setZero();
+        block(d_h_in_, 0) = fresh;
+        block(d_c_in_, 0).setZero();
       }
       live = 1;
     } else {
-      d_h_in_.leftCols(B) = fresh;
-      d_c_in_.leftCols(B).setZero();
+      block(d_h_in_, 0) = fresh;
+      block(d_c_in_, 0).setZero();
       live = 1 + carried;
     }
 
-    const auto gates = gates_.middleCols(j * B, B);
+    const auto gates = gates_.middleCols(j * B + b0, nb);
     const auto i = gates.topRows(H).array();
     const auto f = gates.middleRows(H, H).array();
     const auto gg = gates.middleRows(2 * H, H).array();
     const auto o = gates.bottomRows(H).array();
-    const auto tc = tanh_c_.middleCols(j * B, B).array();
-    const auto c_prev = c_.middleCols(j * B, B).array();
+    const auto tc = tanh_c_.middleCols(j * B + b0, nb).array();
+    const auto c_prev = c_.middleCols(j * B + b0, nb).array();
     for (int s = 0; s < live; ++s) {
-      const auto dh = d_h_in_.middleCols(s * B, B).array();
-      auto dc = d_c_total_.middleCols(s * B, B).array();
-      dc = d_c_in_.middleCols(s * B, B).array() + dh * o * (S(1) - tc.square());
-      auto da = d_gates_streams_.middleCols(s * B, B);
+      const auto dh = block(d_h_in_, s).array();
+      auto dc = block(d_c_total_, s).array();
+      dc = block(d_c_in_, s).array() + dh * o * (S(1) - tc.square());
+      auto da = block(d_gates_streams_, s);
       da.topRows(H).array() = dc * gg * i * (S(1) - i);
       da.middleRows(H, H).array() = dc * c_prev * f * (S(1) - f);
       da.middleRows(2 * H, H).array() = dc * i * (S(1) - gg.square());
       da.bottomRows(H).array() = dh * tc * o * (S(1) - o);
     }
-    auto d_gates_j = d_gates_.middleCols(j * B, B);
-    d_gates_j = d_gates_streams_.leftCols(B);
-    for (int s = 1; s < live; ++s) d_gates_j += d_gates_streams_.middleCols(s * B, B);
+    auto d_gates_j = d_gates_.middleCols(j * B + b0, nb);
+    d_gates_j = block(d_gates_streams_, 0);
+    for (int s = 1; s < live; ++s) d_gates_j += block(d_gates_streams_, s);
 
     if (j == 0) {
       // Every live stream has passed <= K steps: all reach the encoder output.
-      d_h0_.noalias() = params.lstm_weight_hh.transpose() * d_gates_j;
+      d_h0_.middleCols(b0, nb).noalias() = params.lstm_weight_hh.transpose() * d_gates_j;
       break;
     }
     const int propagate = full ? 1 : std::min(live, truncation - 1);
     const int dest = full ? 0 : 1;  // block of age a+1 for the stream of age a
-    if (propagate > 0) {
-      const Eigen::Index cols = static_cast<Eigen::Index>(propagate) * B;
-      d_h_in_.middleCols(dest * B, cols).noalias() =
-          params.lstm_weight_hh.transpose() * d_gates_streams_.leftCols(cols);
-      for (int s = 0; s < propagate; ++s) {
-        d_c_in_.middleCols((s + dest) * B, B).array() = d_c_total_.middleCols(s * B, B).array() * f;
-      }
+    for (int s = 0; s < propagate; ++s) {
+      block(d_h_in_, s + dest).noalias() =
+          params.lstm_weight_hh.transpose() * block(d_gates_streams_, s);
+      block(d_c_in_, s + dest).array() = block(d_c_total_, s).array() * f;
     }
     carried = propagate;
   }
-
-  d_gates_pb_sum_ = d_gates_.leftCols(B);
-  for (int k = 1; k < N; ++k) d_gates_pb_sum_ += d_gates_.middleCols(k * B, B);
 }
 
 template <class S>

@@ -62,6 +62,10 @@ S mse_loss(const Matrix<S>& y_hat, const Matrix<S>& y,
 
 // Holds the activations of the last forward pass that backward needs, and
 // scratch buffers reused between calls (no allocation once shapes settle).
+// Threads: with Eigen::nbThreads() > 1 (OpenMP) the recurrence of forward and
+// backward runs on one thread per part of the windows (windows are
+// independent there) and the large products use Eigen's own threads. Results
+// are deterministic for a given thread count.
 template <class S>
 class HadynetNetwork {
  public:
@@ -102,7 +106,9 @@ class HadynetNetwork {
   const Matrix<S>& hidden_states() const { return h_; }
 
  private:
+  void forward_recurrence(const HadynetParams<S>& params, int b0, int nb);
   void backward_recurrence(const HadynetParams<S>& params, int truncation);
+  void backward_recurrence_columns(const HadynetParams<S>& params, int truncation, int b0, int nb);
   void backward_encoder(const HadynetParams<S>& params, HadynetGrads<S>& grads);
 
   // Shape of the last forward.
