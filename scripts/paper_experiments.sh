@@ -49,14 +49,26 @@ record "$hadynet" recognize "$model" "$data/test" "$data/novel" --plot "$out/pb_
   --json "$out/recognize.json"
 end_section
 
+section "(3b) recognition on three more re-initialisations (inits 4, 5, 6, recorded here: 12 logs each)"
+for init in 4 5 6; do
+  for object in None Hammer Hammer-S Cylinder Gripper Ball; do
+    for motion in random1 random2; do
+      "$hadynet" collect --object "$object" --motion "$motion" --init "$init" --split "init$init" \
+        --out "$out/more_inits" --quiet >/dev/null
+    done
+  done
+  record "$hadynet" recognize "$model" "$out/more_inits/init$init" --json "$out/recognize_init$init.json"
+done
+end_section
+
 section "(5) online PB update streaming None, then Cylinder, then Cylinder-L (test/novel Random-2 logs)"
 "$hadynet" adapt "$model" "$data/test/None_random2_i3_w0.csv" "$data/test/Cylinder_random2_i3_w0.csv" \
   "$data/novel/Cylinder-L_random2_i3_w0.csv" --online --csv "$out/online_pb.csv" --plot "$out/online_pb.png"
 echo "trajectory: $out/online_pb.csv, plot: $out/online_pb.png" | tee -a "$summary"
 end_section
 
-section "contact detection: calibrated on the contact-free test logs (fresh PB)"
-record "$hadynet" calibrate-detect "$model" "$data"/test/None_*.csv --out "$out/hadynet_detect.safetensors"
+section "contact detection: calibrated on the contact-free test log None_random1 (fresh PB); None_random2 is held out"
+record "$hadynet" calibrate-detect "$model" "$data/test/None_random1_i3_w0.csv" --out "$out/hadynet_detect.safetensors"
 record "$hadynet" detect "$out/hadynet_detect.safetensors" "$data/test" --plot "$out/detect_fresh.png"
 end_section
 section "contact detection with the stale trained None PB (None/i0/w0) instead"
