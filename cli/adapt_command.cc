@@ -14,7 +14,6 @@
 #include "cli/pb_adapt_common.h"
 #include "cli/pb_map_plot.h"
 #include "cli/trainer_inputs.h"
-#include "datalog/log_error.h"
 #include "trainer/model_file.h"
 #include "trainer/pb_adaptation.h"
 
@@ -116,9 +115,6 @@ int run_adapt(int argc, char** argv) {
       write_adapt_json(opt.get("json"), results);
       std::fprintf(stderr, "wrote %s\n", opt.get("json").c_str());
     }
-  } catch (const datalog::LogError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hadynet adapt: %s\n", e.what());
     return 1;

@@ -12,7 +12,6 @@
 #include "cli/options.h"
 #include "cli/pb_adapt_common.h"
 #include "cli/trainer_inputs.h"
-#include "datalog/log_error.h"
 #include "trainer/detection.h"
 #include "trainer/model_file.h"
 
@@ -78,9 +77,6 @@ int run_calibrate_detect(int argc, char** argv) {
     model.detection = cal;
     trainer::save_model(opt.get("out"), model);
     std::printf("wrote %s\n", opt.get("out").c_str());
-  } catch (const datalog::LogError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hadynet calibrate-detect: %s\n", e.what());
     return 1;

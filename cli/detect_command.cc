@@ -11,7 +11,6 @@
 #include "cli/options.h"
 #include "cli/pb_adapt_common.h"
 #include "cli/trainer_inputs.h"
-#include "datalog/log_error.h"
 #include "trainer/detection.h"
 #include "trainer/model_file.h"
 
@@ -115,9 +114,6 @@ int run_detect(int argc, char** argv) {
       if (!err.empty()) throw std::runtime_error(err);
       std::fprintf(stderr, "wrote %s\n", opt.get("plot").c_str());
     }
-  } catch (const datalog::LogError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hadynet detect: %s\n", e.what());
     return 1;

@@ -14,7 +14,6 @@
 #include "cli/pb_adapt_common.h"
 #include "cli/pb_map_plot.h"
 #include "cli/trainer_inputs.h"
-#include "datalog/log_error.h"
 #include "trainer/model_file.h"
 #include "trainer/recognition.h"
 
@@ -120,9 +119,6 @@ int run_recognize(int argc, char** argv) {
       if (!err.empty()) throw std::runtime_error(err);
       std::fprintf(stderr, "wrote %s\n", opt.get("plot").c_str());
     }
-  } catch (const datalog::LogError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hadynet recognize: %s\n", e.what());
     return 1;

@@ -11,7 +11,6 @@
 #include "cli/options.h"
 #include "cli/pb_adapt_common.h"
 #include "cli/trainer_inputs.h"
-#include "datalog/log_error.h"
 #include "datalog/log_reader.h"
 #include "datalog/log_writer.h"
 #include "trainer/model_file.h"
@@ -21,19 +20,13 @@ namespace hadynet::cli {
 
 namespace {
 
-std::string group_of(const std::string& name) {
-  std::size_t end = name.size();
-  while (end > 0 && name[end - 1] >= '0' && name[end - 1] <= '9') --end;
-  return name.substr(0, end);
-}
-
 // Panels per observed group: measured (solid) and predicted (dashed).
 std::string comparison_plot(const trainer::FeatureLayout& layout, const Eigen::VectorXd& time,
                             const Eigen::MatrixXd& measured, const Eigen::MatrixXd& predicted,
                             const std::string& title, const std::string& png) {
   std::vector<std::pair<std::string, std::vector<int>>> groups;
   for (std::size_t i = 0; i < layout.y_names.size(); ++i) {
-    const std::string g = group_of(layout.y_names[i]);
+    const std::string g = trainer::channel_group(layout.y_names[i]);
     if (groups.empty() || groups.back().first != g) groups.push_back({g, {}});
     groups.back().second.push_back(static_cast<int>(i));
   }
@@ -155,10 +148,10 @@ int run_simulate(int argc, char** argv) {
     std::printf("predicted %d steps from t = %d with PB %s; RMS error per group (physical units):\n", n,
                 t0, format_pb(pb).c_str());
     for (std::size_t i = 0; i < model.layout.y_names.size();) {
-      const std::string g = group_of(model.layout.y_names[i]);
+      const std::string g = trainer::channel_group(model.layout.y_names[i]);
       double sq = 0.0;
       long count = 0;
-      for (; i < model.layout.y_names.size() && group_of(model.layout.y_names[i]) == g; ++i) {
+      for (; i < model.layout.y_names.size() && trainer::channel_group(model.layout.y_names[i]) == g; ++i) {
         sq += (predicted.row(static_cast<Eigen::Index>(i)) - measured.row(static_cast<Eigen::Index>(i))).squaredNorm();
         count += n;
       }
@@ -172,9 +165,6 @@ int run_simulate(int argc, char** argv) {
       if (!err.empty()) throw std::runtime_error(err);
       std::printf("wrote %s\n", opt.get("plot").c_str());
     }
-  } catch (const datalog::LogError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hadynet simulate: %s\n", e.what());
     return 1;

@@ -17,7 +17,6 @@
 #include "cli/gnuplot.h"
 #include "cli/options.h"
 #include "cli/trainer_inputs.h"
-#include "datalog/log_error.h"
 #include "datalog/log_reader.h"
 #include "hadynet_build_info.h"
 #include "trainer/checkpoint.h"
@@ -252,9 +251,6 @@ int run_train(int argc, char** argv) {
     const trainer::EpochStats& last = state.history.back();
     std::printf("wrote %s (train loss %.5f, held-out loss %.5f after %d epochs)\n", out.c_str(),
                 last.train_loss, last.held_out_loss, last.epoch);
-  } catch (const datalog::LogError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hadynet train: %s\n", e.what());
     return 1;

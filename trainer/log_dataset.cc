@@ -17,12 +17,6 @@ bool contains(const std::vector<std::string>& v, const std::string& s) {
   return std::find(v.begin(), v.end(), s) != v.end();
 }
 
-// Group prefix of a numbered channel name ("fc3" -> "fc").
-std::string prefix_of(const std::string& name) {
-  std::size_t end = name.size();
-  while (end > 0 && name[end - 1] >= '0' && name[end - 1] <= '9') --end;
-  return name.substr(0, end);
-}
 
 void add_x_channels(FeatureLayout& layout) {
   layout.x_names.clear();
@@ -30,9 +24,9 @@ void add_x_channels(FeatureLayout& layout) {
   layout.x_is_delta.clear();
   const auto& y = layout.y_names;
   for (std::size_t i = 0; i < y.size();) {
-    const std::string group = prefix_of(y[i]);
+    const std::string group = channel_group(y[i]);
     std::size_t end = i;
-    while (end < y.size() && prefix_of(y[end]) == group) ++end;
+    while (end < y.size() && channel_group(y[end]) == group) ++end;
     for (std::size_t j = i; j < end; ++j) {
       layout.x_names.push_back(y[j]);
       layout.x_source.push_back(static_cast<int>(j));
@@ -52,7 +46,7 @@ void add_x_channels(FeatureLayout& layout) {
 void check_delta_groups(const FeatureLayout& layout, const std::string& where) {
   for (const std::string& g : layout.delta_groups) {
     const bool found = std::any_of(layout.y_names.begin(), layout.y_names.end(),
-                                   [&](const std::string& n) { return prefix_of(n) == g; });
+                                   [&](const std::string& n) { return channel_group(n) == g; });
     if (!found) {
       throw std::runtime_error(where + ": delta group '" + g +
                                "' is not an observed channel group of this log");
@@ -61,6 +55,12 @@ void check_delta_groups(const FeatureLayout& layout, const std::string& where) {
 }
 
 }  // namespace
+
+std::string channel_group(const std::string& name) {
+  std::size_t end = name.size();
+  while (end > 0 && name[end - 1] >= '0' && name[end - 1] <= '9') --end;
+  return name.substr(0, end);
+}
 
 FeatureLayout feature_layout(const datalog::LogTable& table, const std::string& file,
                              const std::vector<std::string>& delta_groups) {

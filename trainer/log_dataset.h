@@ -34,6 +34,10 @@ struct FeatureLayout {
   bool operator==(const FeatureLayout&) const = default;
 };
 
+// Group of a numbered channel name: its prefix without the index ("fc3" ->
+// "fc", "dl0" -> "dl").
+std::string channel_group(const std::string& name);
+
 // Layout of a log's header. Throws std::runtime_error naming `file` if the
 // log has no "u" group, or a delta group is not an observed group.
 FeatureLayout feature_layout(const datalog::LogTable& table, const std::string& file,

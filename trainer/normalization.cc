@@ -9,12 +9,6 @@ namespace hadynet::trainer {
 
 namespace {
 
-std::string group_of(const std::string& name) {
-  std::size_t end = name.size();
-  while (end > 0 && name[end - 1] >= '0' && name[end - 1] <= '9') --end;
-  return name.substr(0, end);
-}
-
 // Accumulates columns; returns mean and floored std.
 class Moments {
  public:
@@ -35,7 +29,7 @@ class Moments {
     s.std = (sq_ / n - mean_d.cwiseProduct(mean_d)).cwiseMax(0.0).cwiseSqrt();
     std::map<std::string, std::vector<double>> by_group;
     for (std::size_t i = 0; i < names.size(); ++i)
-      by_group[group_of(names[i])].push_back(s.std(static_cast<Eigen::Index>(i)));
+      by_group[channel_group(names[i])].push_back(s.std(static_cast<Eigen::Index>(i)));
     std::map<std::string, double> median;
     for (auto& [g, v] : by_group) {
       std::sort(v.begin(), v.end());
@@ -43,7 +37,7 @@ class Moments {
     }
     for (std::size_t i = 0; i < names.size(); ++i) {
       const auto k = static_cast<Eigen::Index>(i);
-      s.std(k) = std::max(s.std(k), kStdFloorOfGroupMedian * median[group_of(names[i])]);
+      s.std(k) = std::max(s.std(k), kStdFloorOfGroupMedian * median[channel_group(names[i])]);
       if (!(s.std(k) > 1e-12)) s.std(k) = 1.0;
     }
     return s;
