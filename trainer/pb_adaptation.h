@@ -43,6 +43,7 @@ class OnlinePbAdapter {
     AdaptOptions adapt{3, 1.0, 0.9};
   };
 
+  // `model` is referenced, not copied: it must outlive the adapter.
   OnlinePbAdapter(const HadynetModel& model, Eigen::VectorXf start, Options options);
 
   // Appends the next step (physical units: observed y_t, command u_t) of the
