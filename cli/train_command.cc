@@ -95,7 +95,10 @@ void check_resumable(const trainer::Checkpoint& c, const trainer::HadynetModel& 
       c.options.variable_pb != o.variable_pb) {
     bad("--batch, --lr, --seed or --constant-pb");
   }
-  if (c.model.provenance.at("data_hash") != fresh.provenance.at("data_hash")) bad("the data");
+  const auto hash = c.model.provenance.find("data_hash");
+  if (hash == c.model.provenance.end() || hash->second != fresh.provenance.at("data_hash")) {
+    bad("the data");
+  }
 }
 
 }  // namespace
