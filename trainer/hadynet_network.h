@@ -104,6 +104,8 @@ class HadynetNetwork {
   const Matrix<S>& y_hat() const { return y_hat_; }
   // Encoder output h_0 and LSTM hidden states: hidden x ((N+1)*B), block k = h_k.
   const Matrix<S>& hidden_states() const { return h_; }
+  // Cell states c_0 (= 0) .. c_N: hidden x ((N+1)*B), block k = c_k.
+  const Matrix<S>& cell_states() const { return c_; }
 
  private:
   void forward_recurrence(const HadynetParams<S>& params, int b0, int nb);
