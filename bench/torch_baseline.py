@@ -28,7 +28,10 @@ Data (dataset folder from `hadynet collect`, default data/paper):
     states are sorted by name and indexed 0 .. S-1 (row of the PB table).
   * standardisation: x, u and y per channel, (v - mean) / max(std, 1e-6), with
     mean and population std (ddof 0) over the training windows (x: each
-    window's x_i; u, y: every step of every window).
+    window's x_i; u, y: every step of every window). The C++ trainer takes the
+    statistics over every row of the logs and floors a channel's std at 0.1 x
+    its group's median (trainer/normalization.h); the difference changes the
+    loss values, not the work per epoch that this baseline times.
 Network (PyTorch state_dict names = trainer/hadynet_params.h names):
   * pb = nn.Parameter(zeros(states, pb_dim)), pb_dim 8 (--pb); p = pb[state].
   * enc = nn.Linear(x + pb, hidden) on [x_i ; p]; enc_bn = nn.BatchNorm1d(hidden)
