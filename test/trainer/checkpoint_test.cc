@@ -4,6 +4,7 @@
 // No tolerances: checkpoints store the float tensors and Adam moments as
 // F32 and the losses as shortest round-trip JSON numbers, and training is
 // deterministic, so every comparison is exact (bits).
+#include "test_batches.h"
 #include "trainer/checkpoint.h"
 
 #include <gtest/gtest.h>
@@ -46,17 +47,6 @@ struct CheckpointData {
     });
   }
 };
-
-bool bit_identical(const HadynetParams<float>& a, const HadynetParams<float>& b) {
-  if (a.dims != b.dims) return false;
-  const auto ta = a.tensors();
-  const auto tb = b.tensors();
-  for (std::size_t i = 0; i < ta.size(); ++i) {
-    if (std::memcmp(ta[i].data, tb[i].data, sizeof(float) * static_cast<std::size_t>(ta[i].size())) != 0)
-      return false;
-  }
-  return true;
-}
 
 void expect_same_adam(const Adam<float>::State& got, const Adam<float>::State& want) {
   // A tensor never updated may be absent or empty: compare by content.

@@ -56,18 +56,6 @@ HadynetModel sample_model(bool with_detection) {
   return m;
 }
 
-bool bit_identical(const HadynetParams<float>& a, const HadynetParams<float>& b) {
-  if (a.dims != b.dims) return false;
-  const auto ta = a.tensors();
-  const auto tb = b.tensors();
-  for (std::size_t i = 0; i < ta.size(); ++i) {
-    if (ta[i].size() != tb[i].size() ||
-        std::memcmp(ta[i].data, tb[i].data, sizeof(float) * static_cast<std::size_t>(ta[i].size())) != 0)
-      return false;
-  }
-  return true;
-}
-
 WindowBatch<float> float_batch(const HadynetDims& dims, int B, int N) {
   const WindowBatch<double> b = random_batch(dims, B, N, 77, {0, 1});
   WindowBatch<float> f;

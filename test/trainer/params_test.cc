@@ -7,10 +7,13 @@
 #include <string>
 #include <vector>
 
+#include "test_batches.h"
 #include "trainer/hadynet_params.h"
 
 namespace hadynet::trainer {
 namespace {
+
+using testing::bit_identical;
 
 const HadynetDims kDims{37, 8, 27, 8, 128, 6};
 
@@ -85,17 +88,6 @@ TEST(HadynetParams, InitialisationFollowsPyTorch) {
   EXPECT_TRUE((p.enc_bn_running_mean.array() == 0.0).all());
   EXPECT_TRUE((p.enc_bn_running_var.array() == 1.0).all());
   EXPECT_TRUE((p.pb.array() == 0.0).all());
-}
-
-template <class S>
-bool bit_identical(const HadynetParams<S>& a, const HadynetParams<S>& b) {
-  const auto ta = a.tensors();
-  const auto tb = b.tensors();
-  for (std::size_t i = 0; i < ta.size(); ++i) {
-    if (ta[i].size() != tb[i].size()) return false;
-    if (std::memcmp(ta[i].data, tb[i].data, sizeof(S) * ta[i].size()) != 0) return false;
-  }
-  return true;
 }
 
 TEST(HadynetParams, SameSeedSameValuesOtherSeedOtherValues) {

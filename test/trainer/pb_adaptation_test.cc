@@ -1,6 +1,7 @@
 // PB-only adaptation (trainer/pb_adaptation.h) on the small trained spring
 // model: the batch fit lowers the loss with frozen weights, and the online
 // adapter starts, slides and moves as specified.
+#include "test_batches.h"
 #include "trainer/pb_adaptation.h"
 
 #include <gtest/gtest.h>
@@ -46,16 +47,6 @@ class PbAdaptation : public ::testing::Test {
   static SpringModel* spring_;
 };
 SpringModel* PbAdaptation::spring_ = nullptr;
-
-bool bit_identical(const HadynetParams<float>& a, const HadynetParams<float>& b) {
-  const auto ta = a.tensors();
-  const auto tb = b.tensors();
-  for (std::size_t i = 0; i < ta.size(); ++i) {
-    if (std::memcmp(ta[i].data, tb[i].data, sizeof(float) * static_cast<std::size_t>(ta[i].size())) != 0)
-      return false;
-  }
-  return true;
-}
 
 TEST_F(PbAdaptation, BatchFitFromAStalePbLowersTheLoss) {
   const Eigen::VectorXf start = pb_of(0);  // the soft state's PB on stiff data

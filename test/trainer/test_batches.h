@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 #include <random>
 #include <vector>
 
@@ -9,6 +10,21 @@
 #include "trainer/hadynet_params.h"
 
 namespace hadynet::trainer::testing {
+
+// True if both parameter sets have the same dims and every tensor has the
+// same bytes (no tolerance: for determinism and round-trip tests).
+template <class S>
+bool bit_identical(const HadynetParams<S>& a, const HadynetParams<S>& b) {
+  if (!(a.dims == b.dims)) return false;
+  const auto ta = a.tensors();
+  const auto tb = b.tensors();
+  for (std::size_t i = 0; i < ta.size(); ++i) {
+    if (ta[i].size() != tb[i].size() ||
+        std::memcmp(ta[i].data, tb[i].data, sizeof(S) * static_cast<std::size_t>(ta[i].size())) != 0)
+      return false;
+  }
+  return true;
+}
 
 // Uniform in [lo, hi) from the top 53 bits of the generator.
 inline double uniform(std::mt19937_64& rng, double lo, double hi) {

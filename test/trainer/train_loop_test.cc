@@ -2,6 +2,7 @@
 // per-epoch window order, evaluate_loss, loss falling, determinism and the
 // constant-PB ablation. Tolerances are stated per test; determinism and
 // the constant PB are checked bit for bit.
+#include "test_batches.h"
 #include "trainer/training.h"
 
 #include <gtest/gtest.h>
@@ -44,16 +45,6 @@ struct LoopData {
     return m;
   }
 };
-
-bool bit_identical(const HadynetParams<float>& a, const HadynetParams<float>& b) {
-  const auto ta = a.tensors();
-  const auto tb = b.tensors();
-  for (std::size_t i = 0; i < ta.size(); ++i) {
-    if (std::memcmp(ta[i].data, tb[i].data, sizeof(float) * static_cast<std::size_t>(ta[i].size())) != 0)
-      return false;
-  }
-  return true;
-}
 
 std::vector<int> all_ids(const WindowDataset& data) {
   std::vector<int> ids(static_cast<std::size_t>(data.size()));

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "test_batches.h"
 #include "synthetic_dynamics.h"
 #include "trainer/hadynet_network.h"
 #include "trainer/optim.h"
@@ -51,17 +52,10 @@ HadynetParams<float> train(const DynamicsWindows& data, std::uint64_t seed, int 
   return p;
 }
 
+using testing::bit_identical;  // the HadynetParams overload (test_batches.h)
+
 bool bit_identical(const NamedTensor<const float>& a, const NamedTensor<const float>& b) {
   return a.size() == b.size() && std::memcmp(a.data, b.data, sizeof(float) * a.size()) == 0;
-}
-
-bool bit_identical(const HadynetParams<float>& a, const HadynetParams<float>& b) {
-  const auto ta = a.tensors();
-  const auto tb = b.tensors();
-  for (std::size_t i = 0; i < ta.size(); ++i) {
-    if (!bit_identical(ta[i], tb[i])) return false;
-  }
-  return true;
 }
 
 class Training : public ::testing::Test {
