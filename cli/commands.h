@@ -13,5 +13,8 @@ int run_recognize(int argc, char** argv);
 int run_calibrate_detect(int argc, char** argv);
 int run_simulate(int argc, char** argv);
 int run_detect(int argc, char** argv);
+int run_replay(int argc, char** argv);
+int run_measure_ranges(int argc, char** argv);
+int run_codegen(int argc, char** argv);
 
 }  // namespace hadynet::cli

@@ -28,6 +28,12 @@ constexpr Command kCommands[] = {
     {"detect", "contact detection over logs: d per step, flags, traces plot", hadynet::cli::run_detect},
     {"simulate", "predict a log from a start state, commands and any PB (contact simulation)",
      hadynet::cli::run_simulate},
+    {"measure-ranges", "measure the value ranges codegen needs and store them in the model",
+     hadynet::cli::run_measure_ranges},
+    {"codegen", "generate the firmware's C++ model header (q15 fixed point or f32)",
+     hadynet::cli::run_codegen},
+    {"replay", "host-sim: replay a log through the firmware core (prediction, d, contact, command)",
+     hadynet::cli::run_replay},
 };
 
 void print_help() {

@@ -6,8 +6,15 @@
 
 namespace hadynet::cli {
 
-Options::Options(std::string command, std::string summary, std::string usage)
-    : command_(std::move(command)), summary_(std::move(summary)), usage_(std::move(usage)) {}
+Options::Options(std::string command, std::string summary, std::string usage, std::string program)
+    : command_(std::move(command)),
+      summary_(std::move(summary)),
+      usage_(std::move(usage)),
+      program_(std::move(program)) {}
+
+std::string Options::program_name() const {
+  return command_.empty() ? program_ : program_ + " " + command_;
+}
 
 void Options::value(const std::string& name, const std::string& metavar, const std::string& help,
                     std::optional<std::string> default_value) {
@@ -26,7 +33,7 @@ void Options::repeated(const std::string& name, const std::string& metavar, cons
 }
 
 std::string Options::help_text() const {
-  std::string out = "usage: hadynet " + command_ + " " + usage_ + "\n\n" + summary_ + "\n\noptions:\n";
+  std::string out = "usage: " + program_name() + " " + usage_ + "\n\n" + summary_ + "\n\noptions:\n";
   for (const auto& name : order_) {
     const Spec& s = specs_.at(name);
     std::string left = "  --" + name + (s.takes_value ? " " + s.metavar : "");
@@ -61,12 +68,12 @@ bool Options::parse(int argc, char** argv) {
     }
     const auto it = specs_.find(name);
     if (it == specs_.end()) {
-      std::fprintf(stderr, "hadynet %s: unknown option '--%s' (see --help)\n", command_.c_str(), name.c_str());
+      std::fprintf(stderr, "%s: unknown option '--%s' (see --help)\n", program_name().c_str(), name.c_str());
       return false;
     }
     if (!it->second.takes_value) {
       if (has_inline) {
-        std::fprintf(stderr, "hadynet %s: option '--%s' takes no value\n", command_.c_str(), name.c_str());
+        std::fprintf(stderr, "%s: option '--%s' takes no value\n", program_name().c_str(), name.c_str());
         return false;
       }
       values_[name].push_back("1");
@@ -74,14 +81,14 @@ bool Options::parse(int argc, char** argv) {
     }
     if (!has_inline) {
       if (i + 1 >= argc) {
-        std::fprintf(stderr, "hadynet %s: option '--%s' needs a value %s\n", command_.c_str(), name.c_str(),
+        std::fprintf(stderr, "%s: option '--%s' needs a value %s\n", program_name().c_str(), name.c_str(),
                      it->second.metavar.c_str());
         return false;
       }
       inline_value = argv[++i];
     }
     if (!it->second.repeatable && values_.count(name)) {
-      std::fprintf(stderr, "hadynet %s: option '--%s' given twice\n", command_.c_str(), name.c_str());
+      std::fprintf(stderr, "%s: option '--%s' given twice\n", program_name().c_str(), name.c_str());
       return false;
     }
     values_[name].push_back(inline_value);
@@ -108,7 +115,7 @@ std::optional<long long> Options::get_int(const std::string& name, long long min
   long long v = 0;
   auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
   if (ec != std::errc() || p != text.data() + text.size() || v < min || v > max) {
-    std::fprintf(stderr, "hadynet %s: --%s: expected a whole number in %lld..%lld, got '%s'\n", command_.c_str(),
+    std::fprintf(stderr, "%s: --%s: expected a whole number in %lld..%lld, got '%s'\n", program_name().c_str(),
                  name.c_str(), min, max, text.c_str());
     return std::nullopt;
   }
@@ -120,7 +127,7 @@ std::optional<double> Options::get_double(const std::string& name, double min, d
   double v = 0;
   auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
   if (ec != std::errc() || p != text.data() + text.size() || !std::isfinite(v) || v < min || v > max) {
-    std::fprintf(stderr, "hadynet %s: --%s: expected a number in %g..%g, got '%s'\n", command_.c_str(), name.c_str(),
+    std::fprintf(stderr, "%s: --%s: expected a number in %g..%g, got '%s'\n", program_name().c_str(), name.c_str(),
                  min, max, text.c_str());
     return std::nullopt;
   }

@@ -13,7 +13,10 @@ namespace hadynet::cli {
 
 class Options {
  public:
-  Options(std::string command, std::string summary, std::string usage);
+  // `program` names the executable in the usage line and messages; `command`
+  // may be empty for a program without subcommands (hadynet-codegen).
+  Options(std::string command, std::string summary, std::string usage,
+          std::string program = "hadynet");
 
   // Declares --name VALUE (or a flag with no value). `help` ends up in --help.
   void value(const std::string& name, const std::string& metavar, const std::string& help,
@@ -42,7 +45,9 @@ class Options {
     std::optional<std::string> default_value;
     bool takes_value = true, repeatable = false;
   };
-  std::string command_, summary_, usage_;
+  std::string program_name() const;  // "hadynet train", "hadynet-codegen"
+
+  std::string command_, summary_, usage_, program_;
   std::vector<std::string> order_;
   std::map<std::string, Spec> specs_;
   std::map<std::string, std::vector<std::string>> values_;

@@ -20,6 +20,7 @@
 #include "datalog/log_reader.h"
 #include "hadynet_build_info.h"
 #include "trainer/checkpoint.h"
+#include "trainer/deploy_prep.h"
 #include "trainer/model_file.h"
 #include "trainer/training.h"
 
@@ -110,7 +111,8 @@ int run_train(int argc, char** argv) {
               "time step, shuffled. The last --held-out fraction of each log's windows is kept out of training\n"
               "and reported as the held-out loss per epoch. A checkpoint OUT.ckpt is written atomically after\n"
               "every epoch; --resume continues an interrupted run exactly. Writes OUT (safetensors, PyTorch\n"
-              "names; docs/model-file.md), OUT.loss.csv and OUT.loss.png.",
+              "names; docs/model-file.md) with the value ranges measured on the training windows (for\n"
+              "codegen), OUT.loss.csv and OUT.loss.png.",
               "LOG|DIR... --out MODEL [options]");
   opt.value("out", "MODEL", "model file to write (.safetensors)");
   opt.value("epochs", "N", "epochs", "200");
@@ -244,6 +246,10 @@ int run_train(int argc, char** argv) {
                                   e.seconds, duration(per_epoch * (options.epochs - e.epoch)).c_str());
                    });
     model.hyper_parameters["epochs_done"] = std::to_string(state.epochs_done);
+    // Value ranges for codegen (docs/codegen.md), over the training windows.
+    model.ranges = trainer::measure_ranges(model, data, split.train);
+    model.ranges->source = "hadynet train: training windows of " + std::to_string(paths.size()) +
+                           " logs (data_hash " + model.provenance.at("data_hash") + ")";
     trainer::save_model(out, model);
     const std::string csv = out + ".loss.csv";
     const std::string png = out + ".loss.png";

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <stdexcept>
 
 namespace hadynet::trainer {
 
@@ -75,6 +77,36 @@ ValueRanges measure_ranges(const HadynetModel& model, const WindowDataset& data,
     r.c = std::max(r.c, max_abs(net.cell_states()));
     r.y = std::max(r.y, max_abs(y_hat));
   }
+  r.windows = static_cast<long>(ids.size());
+  return r;
+}
+
+ValueRanges measure_log_ranges(const HadynetModel& model, const std::vector<std::string>& log_args) {
+  const std::vector<std::string> paths = expand_log_paths(log_args);
+  std::vector<LogSequence> sequences;
+  std::vector<int> rows;
+  for (const std::string& path : paths) {
+    sequences.push_back(read_sequence(path, model.layout));
+    const int row = model.state_index(sequences.back().state);
+    if (row < 0) {
+      throw std::runtime_error(path + ": state '" + sequences.back().state +
+                               "' is not in the model's PB table");
+    }
+    rows.push_back(row);
+  }
+  const WindowDataset data(sequences, rows, model.layout, model.norm, model.train_steps);
+  if (data.size() == 0) {
+    throw std::runtime_error("the logs hold no window of " + std::to_string(model.train_steps) +
+                             " steps");
+  }
+  std::vector<int> ids(static_cast<std::size_t>(data.size()));
+  std::iota(ids.begin(), ids.end(), 0);
+  ValueRanges r = measure_ranges(model, data, ids);
+  std::string args;
+  for (const std::string& a : log_args) args += (args.empty() ? "" : " ") + a;
+  r.source = args + ": " + std::to_string(paths.size()) + " logs (data_hash " +
+             content_hash(paths) + "), all windows of " + std::to_string(model.train_steps) +
+             " steps";
   return r;
 }
 

@@ -5,6 +5,8 @@
 
 #include <Eigen/Core>
 #include <span>
+#include <string>
+#include <vector>
 
 #include "trainer/hadynet_model.h"
 #include "trainer/window_dataset.h"
@@ -24,18 +26,18 @@ FoldedEncoder fold_batch_norm(const HadynetParams<float>& params);
 
 // Largest absolute value of each quantity the firmware's forward computes,
 // over the windows `ids` of `data` with their states' PBs (BN eval), in
-// standardised units. Weights' ranges are read from the parameters.
-struct ValueRanges {
-  double x = 0, u = 0, pb = 0;          // inputs
-  double enc_pre = 0;                   // folded encoder pre-activation (before ReLU)
-  double h = 0;                         // h_0 .. h_N
-  double gate_pre = 0;                  // LSTM gate pre-activations (all four gates)
-  double c = 0;                         // cell states
-  double y = 0;                         // decoder outputs
-  double enc_weight = 0, lstm_weight = 0, dec_weight = 0;  // folded / raw weights
-  double enc_bias = 0, lstm_bias = 0, dec_bias = 0;
-};
+// standardised units (ValueRanges, trainer/hadynet_model.h). Weights' ranges
+// are read from the parameters. Sets `windows` to ids.size(); `source` is
+// left for the caller.
 ValueRanges measure_ranges(const HadynetModel& model, const WindowDataset& data,
                            std::span<const int> ids);
+
+// measure_ranges over every window (N_train steps) of the logs under
+// `log_args` (files or folders, see expand_log_paths). Each log's state
+// (metadata "state") must be a row of the model's PB table; its windows run
+// with that PB. `source` names the logs and their content hash. Throws
+// std::runtime_error naming the file (unreadable log, other channels, a state
+// not in the PB table) or when the logs hold no window.
+ValueRanges measure_log_ranges(const HadynetModel& model, const std::vector<std::string>& log_args);
 
 }  // namespace hadynet::trainer

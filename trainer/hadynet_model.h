@@ -34,6 +34,46 @@ struct DetectionCalibration {
   std::string source;         // logs the calibration used
 };
 
+// Largest absolute value of each quantity the firmware's forward computes, in
+// standardised units (measure_ranges in trainer/deploy_prep.h). Codegen picks
+// the fixed-point formats from them (docs/codegen.md).
+struct ValueRanges {
+  double x = 0, u = 0, pb = 0;          // inputs
+  double enc_pre = 0;                   // folded encoder pre-activation (before ReLU)
+  double h = 0;                         // h_0 .. h_N
+  double gate_pre = 0;                  // LSTM gate pre-activations (all four gates)
+  double c = 0;                         // cell states
+  double y = 0;                         // decoder outputs
+  double enc_weight = 0, lstm_weight = 0, dec_weight = 0;  // folded / raw weights
+  double enc_bias = 0, lstm_bias = 0, dec_bias = 0;
+  long windows = 0;    // windows the activations were measured on
+  std::string source;  // what they came from, e.g. "36 logs (data_hash ...), all windows"
+
+  bool operator==(const ValueRanges&) const = default;
+};
+
+// The numeric fields of ValueRanges by their model-file key (docs/model-file.md).
+struct ValueRangeField {
+  const char* name;
+  double ValueRanges::*member;
+};
+inline constexpr ValueRangeField kValueRangeFields[] = {
+    {"x", &ValueRanges::x},
+    {"u", &ValueRanges::u},
+    {"pb", &ValueRanges::pb},
+    {"enc_pre", &ValueRanges::enc_pre},
+    {"h", &ValueRanges::h},
+    {"gate_pre", &ValueRanges::gate_pre},
+    {"c", &ValueRanges::c},
+    {"y", &ValueRanges::y},
+    {"enc_weight", &ValueRanges::enc_weight},
+    {"lstm_weight", &ValueRanges::lstm_weight},
+    {"dec_weight", &ValueRanges::dec_weight},
+    {"enc_bias", &ValueRanges::enc_bias},
+    {"lstm_bias", &ValueRanges::lstm_bias},
+    {"dec_bias", &ValueRanges::dec_bias},
+};
+
 struct HadynetModel {
   FeatureLayout layout;
   Normalization norm;
@@ -42,13 +82,14 @@ struct HadynetModel {
   int train_steps = 10;         // N_train of the windows it was trained on
   long bn_batches_tracked = 0;  // enc_bn.num_batches_tracked (PyTorch buffer)
   std::optional<DetectionCalibration> detection;
+  std::optional<ValueRanges> ranges;  // measured value ranges (needed by codegen)
   std::map<std::string, std::string> hyper_parameters;  // e.g. "lr" -> "0.001"
   std::map<std::string, std::string> provenance;        // data_hash, git_commit, logs, ...
 
   // Row of the PB table for a state name; -1 if absent.
   int state_index(const std::string& name) const;
   // Throws std::invalid_argument if the parts disagree (dims vs channels vs
-  // normalisation vs PB table vs detection sizes).
+  // normalisation vs PB table vs detection sizes; ranges negative or not finite).
   void check_consistent() const;
 };
 

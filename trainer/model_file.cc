@@ -102,6 +102,14 @@ void HadynetModel::check_consistent() const {
          "detection statistics sizes");
     need(std::isfinite(c.threshold) && c.threshold > 0, "detection threshold not positive");
   }
+  if (ranges) {
+    for (const ValueRangeField& f : kValueRangeFields) {
+      const double v = (*ranges).*f.member;
+      need(std::isfinite(v) && v >= 0,
+           std::string("range '") + f.name + "' is negative or not finite");
+    }
+    need(ranges->windows >= 0, "ranges windows < 0");
+  }
 }
 
 st::File model_to_safetensors(const HadynetModel& model) {
@@ -149,6 +157,13 @@ st::File model_to_safetensors(const HadynetModel& model) {
     file.tensors["detect.mean"] = f64_vector(c.mean);
     file.tensors["detect.covariance"] = f64_matrix(c.covariance);
     file.tensors["detect.inverse"] = f64_matrix(c.inverse);
+  }
+  if (model.ranges) {
+    json r = json::object();
+    for (const ValueRangeField& f : kValueRangeFields) r[f.name] = (*model.ranges).*f.member;
+    r["windows"] = model.ranges->windows;
+    r["source"] = model.ranges->source;
+    file.metadata["ranges"] = r.dump();
   }
   return file;
 }
@@ -259,6 +274,16 @@ HadynetModel model_from_safetensors(const st::File& file, const std::string& ori
       for (const char* n : {"detect.pb", "detect.mean", "detect.covariance", "detect.inverse"})
         expected.insert(n);
       model.detection = std::move(c);
+    }
+
+    if (file.metadata.count("ranges") != 0) {
+      const json r = parse_metadata_json(file, "ranges", origin);
+      ValueRanges ranges;
+      for (const ValueRangeField& f : kValueRangeFields)
+        ranges.*f.member = json_get<double>(r, f.name, "ranges", origin);
+      ranges.windows = json_get<long>(r, "windows", "ranges", origin);
+      ranges.source = json_get<std::string>(r, "source", "ranges", origin);
+      model.ranges = std::move(ranges);
     }
 
     for (const auto& [name, tensor] : file.tensors) {

@@ -4,9 +4,7 @@
 #include <cstdio>
 
 #include "host-sim/plant/hand_geometry.h"
-#include "host-sim/plant/hand_plant.h"
 #include "host-sim/plant/rng.h"
-#include "host-sim/plant/sensor_model.h"
 
 namespace hadynet::plant {
 namespace g = geometry;
@@ -25,12 +23,14 @@ std::uint64_t experiment_seed(const ExperimentSpec& spec, SeedSalt salt) {
   const auto motion_and_init = static_cast<std::uint64_t>(spec.motion) * 1000 + static_cast<std::uint64_t>(spec.init_id);
   return derive_seed(spec.seed, salt, static_cast<std::uint64_t>(spec.object), motion_and_init, wear_key(spec.wear_level));
 }
+}  // namespace
 
-// Rounds a length (mm) to the command resolution, printing as e.g. -2.991.
 double to_command_resolution(double mm) {
   return std::round(mm / kCommandResolution_mm) / (1.0 / kCommandResolution_mm);
 }
-}  // namespace
+
+std::uint64_t motion_seed(const ExperimentSpec& spec) { return experiment_seed(spec, kSaltMotion); }
+std::uint64_t sensor_noise_seed(const ExperimentSpec& spec) { return experiment_seed(spec, kSaltNoise); }
 
 std::string state_id(const ExperimentSpec& spec) {
   return std::string(object_name(spec.object)) + "/i" + std::to_string(spec.init_id) + "/w" + wear_text(spec.wear_level);
@@ -54,11 +54,36 @@ HandSpec hand_spec_for(const ExperimentSpec& spec) {
   return hand;
 }
 
+ExperimentLoop::ExperimentLoop(const ExperimentSpec& spec)
+    : plant_(hand_spec_for(spec)), sensors_(spec.effects, spec.sensor_realism, sensor_noise_seed(spec)) {
+  // Start from the open hand, held for 1 s so that the row at t = 0 is at rest.
+  target_mm_ = nominal_muscle_lengths_mm(start_pose());
+  for (auto& v : target_mm_) v = to_command_resolution(v);
+  plant_.settle(target_mm_, 1.0);
+  measured_ = sensors_.measure(plant_.state());
+}
+
+std::array<double, kMuscles> ExperimentLoop::command_to(const std::array<double, kMuscles>& wanted_mm) const {
+  std::array<double, kMuscles> u{};
+  for (int m = 0; m < kMuscles; ++m) u[m] = to_command_resolution(wanted_mm[m] - target_mm_[m]);
+  return u;
+}
+
+std::array<double, kMuscles> ExperimentLoop::apply(const std::array<double, kMuscles>& u_mm) {
+  std::array<double, kMuscles> applied{};
+  for (int m = 0; m < kMuscles; ++m) {
+    applied[m] = to_command_resolution(u_mm[m]);  // unchanged if already at the resolution
+    target_mm_[m] += applied[m];
+  }
+  plant_.step(target_mm_);
+  measured_ = sensors_.measure(plant_.state());
+  return applied;
+}
+
 ExperimentResult run_experiment(const ExperimentSpec& spec) {
   const HandSpec hand = hand_spec_for(spec);
-  HandPlant plant(hand);
-  MotionGenerator motion(spec.motion, spec.object, experiment_seed(spec, kSaltMotion));
-  SensorModel sensors(hand.effects, hand.sensor_realism, experiment_seed(spec, kSaltNoise));
+  ExperimentLoop loop(spec);
+  MotionGenerator motion(spec.motion, spec.object, motion_seed(spec));
 
   datalog::LogTable log;
   auto& meta = log.metadata;
@@ -76,39 +101,46 @@ ExperimentResult run_experiment(const ExperimentSpec& spec) {
   if (spec.declare_effects) meta.set("effects", hand.effects.describe());
 
   log.columns.push_back("t");
-  for (int m = 0; m < kMuscles; ++m) log.columns.push_back("l" + std::to_string(m));
-  for (int m = 0; m < kMuscles; ++m) log.columns.push_back("f" + std::to_string(m));
-  for (int i = 0; i < kLoadcells; ++i) log.columns.push_back("fc" + std::to_string(i));
-  for (int j = 0; j < kWristJoints; ++j) log.columns.push_back("th" + std::to_string(j));
-  for (int m = 0; m < kMuscles; ++m) log.columns.push_back("u" + std::to_string(m));
+  const auto y_names = observed_channel_names();
+  const auto u_names = command_channel_names();
+  log.columns.insert(log.columns.end(), y_names.begin(), y_names.end());
+  log.columns.insert(log.columns.end(), u_names.begin(), u_names.end());
 
-  // Start from the open hand, held for 1 s so that the row at t = 0 is at rest.
-  std::array<double, kMuscles> target = nominal_muscle_lengths_mm(start_pose());
-  for (auto& v : target) v = to_command_resolution(v);
-  plant.settle(target, 1.0);
-  SensorFrame y = sensors.measure(plant.state());
   std::vector<double> row;
   row.reserve(log.columns.size());
   for (int k = 0; k < spec.steps; ++k) {
     // u_k: change of target applied between t_k and t_k+1, at command resolution.
-    const auto wanted = motion.next_target();
-    std::array<double, kMuscles> u{};
-    for (int m = 0; m < kMuscles; ++m) {
-      u[m] = to_command_resolution(wanted[m] - target[m]);
-      target[m] += u[m];
-    }
+    const auto u = loop.command_to(motion.next_target());
     row.clear();
     row.push_back(static_cast<double>(k) / (1.0 / g::kControlStep_s));  // 0.6, not 0.6000000000000001
-    row.insert(row.end(), y.muscle_length_mm.begin(), y.muscle_length_mm.end());
-    row.insert(row.end(), y.tension_N.begin(), y.tension_N.end());
-    row.insert(row.end(), y.loadcell_N.begin(), y.loadcell_N.end());
-    row.insert(row.end(), y.wrist_rad.begin(), y.wrist_rad.end());
+    append_observed(loop.measured(), row);
     row.insert(row.end(), u.begin(), u.end());
     log.append_row(row);
-    plant.step(target);
-    y = sensors.measure(plant.state());
+    loop.apply(u);
   }
-  return {std::move(log), plant.physics_steps()};
+  return {std::move(log), loop.plant().physics_steps()};
+}
+
+std::vector<std::string> observed_channel_names() {
+  std::vector<std::string> names;
+  for (int m = 0; m < kMuscles; ++m) names.push_back("l" + std::to_string(m));
+  for (int m = 0; m < kMuscles; ++m) names.push_back("f" + std::to_string(m));
+  for (int i = 0; i < kLoadcells; ++i) names.push_back("fc" + std::to_string(i));
+  for (int j = 0; j < kWristJoints; ++j) names.push_back("th" + std::to_string(j));
+  return names;
+}
+
+std::vector<std::string> command_channel_names() {
+  std::vector<std::string> names;
+  for (int m = 0; m < kMuscles; ++m) names.push_back("u" + std::to_string(m));
+  return names;
+}
+
+void append_observed(const SensorFrame& y, std::vector<double>& out) {
+  out.insert(out.end(), y.muscle_length_mm.begin(), y.muscle_length_mm.end());
+  out.insert(out.end(), y.tension_N.begin(), y.tension_N.end());
+  out.insert(out.end(), y.loadcell_N.begin(), y.loadcell_N.end());
+  out.insert(out.end(), y.wrist_rad.begin(), y.wrist_rad.end());
 }
 
 }  // namespace hadynet::plant

@@ -2,12 +2,16 @@
 // run on the plant and returned as a log table (docs/log-format.md).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "datalog/log_table.h"
+#include "host-sim/plant/hand_plant.h"
 #include "host-sim/plant/hand_spec.h"
 #include "host-sim/plant/motions.h"
+#include "host-sim/plant/sensor_model.h"
 
 namespace hadynet::plant {
 
@@ -38,7 +42,49 @@ struct ExperimentResult {
 // Runs the experiment. Deterministic: the same spec gives the same log.
 ExperimentResult run_experiment(const ExperimentSpec& spec);
 
+// The log's channel names in column order: y = l0..l7, f0..f7, fc0..fc8,
+// th0, th1 and u = u0..u7 (docs/log-format.md, docs/plant.md).
+std::vector<std::string> observed_channel_names();
+std::vector<std::string> command_channel_names();
+// Appends one frame's y values in observed_channel_names() order.
+void append_observed(const SensorFrame& y, std::vector<double>& out);
+
 // Command resolution (mm) of the target muscle lengths.
 inline constexpr double kCommandResolution_mm = 0.001;
+// Rounds a length (mm) to the command resolution (prints as e.g. -2.991).
+double to_command_resolution(double mm);
+
+// Seeds of an experiment's two random streams (motion, sensor noise), derived
+// from (seed, object, motion, init, wear) as run_experiment uses them.
+std::uint64_t motion_seed(const ExperimentSpec& spec);
+std::uint64_t sensor_noise_seed(const ExperimentSpec& spec);
+
+// The plant in the loop exactly as run_experiment drives it: the hand of
+// hand_spec_for(spec), settled for 1 s at the open start pose, the sensor
+// model seeded from sensor_noise_seed(spec), and the current target muscle
+// lengths. GraspSession runs on it too, so that a session and a log agree.
+class ExperimentLoop {
+ public:
+  explicit ExperimentLoop(const ExperimentSpec& spec);
+
+  // The measured y after the last step (log units), i.e. this row's y.
+  const SensorFrame& measured() const { return measured_; }
+  const std::array<double, kMuscles>& target_mm() const { return target_mm_; }
+  // The command that moves the target to `wanted_mm`, at command resolution.
+  std::array<double, kMuscles> command_to(const std::array<double, kMuscles>& wanted_mm) const;
+  // One 0.2 s step: rounds each u to the command resolution, adds it to the
+  // target (no clamping: the servos' 0..200 N force range is the only limit),
+  // steps the plant and measures. Returns the u actually applied.
+  std::array<double, kMuscles> apply(const std::array<double, kMuscles>& u_mm);
+
+  HandPlant& plant() { return plant_; }
+  const HandPlant& plant() const { return plant_; }
+
+ private:
+  HandPlant plant_;
+  SensorModel sensors_;
+  std::array<double, kMuscles> target_mm_{};
+  SensorFrame measured_;
+};
 
 }  // namespace hadynet::plant

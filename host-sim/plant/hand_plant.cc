@@ -3,6 +3,7 @@
 #include <mujoco/mujoco.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -71,9 +72,11 @@ HandPlant::HandPlant(const HandSpec& spec) : spec_(spec) {
   }
   for (int i = 0; i < kLoadcells; ++i)
     sensor_adr_[i] = model_->sensor_adr[require_id(model_, mjOBJ_SENSOR, "lc" + std::to_string(i))];
-  wrist_qpos_adr_[0] = model_->jnt_qposadr[require_id(model_, mjOBJ_JOINT, "wrist_pitch")];
+  wrist_joint_ = require_id(model_, mjOBJ_JOINT, "wrist_pitch");
+  wrist_qpos_adr_[0] = model_->jnt_qposadr[wrist_joint_];
   wrist_qpos_adr_[1] = model_->jnt_qposadr[require_id(model_, mjOBJ_JOINT, "wrist_yaw")];
   press_qpos_adr_ = model_->jnt_qposadr[require_id(model_, mjOBJ_JOINT, "press")];
+  if (spec.object != ObjectKind::kNone) object_body_ = require_id(model_, mjOBJ_BODY, "object");
   for (const auto& joint : finger_spring_joints(spec))
     springs_.push_back({require_id(model_, mjOBJ_JOINT, joint.name), joint.stiffness_Nm_per_rad});
   mj_forward(model_, data_);
@@ -91,6 +94,41 @@ HandPlant::~HandPlant() {
 
 double HandPlant::joint_position(const std::string& joint) const {
   return data_->qpos[model_->jnt_qposadr[require_id(model_, mjOBJ_JOINT, joint)]];
+}
+
+void HandPlant::set_object_wrench(const std::array<double, 3>& force_N, const std::array<double, 3>& torque_Nm) {
+  bool zero = true;
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(force_N[i]) || !std::isfinite(torque_Nm[i]))
+      throw std::invalid_argument("object wrench: every component must be finite");
+    zero = zero && force_N[i] == 0.0 && torque_Nm[i] == 0.0;
+  }
+  if (object_body_ < 0) {
+    if (!zero) throw std::logic_error("object wrench: the hand holds no object");
+    return;
+  }
+  object_force_N_ = force_N;
+  object_torque_Nm_ = torque_Nm;
+  // xfrc_applied row of a body: force (3) then torque (3), world frame, at the
+  // body's centre of mass. MuJoCo never clears it, so it holds until reset.
+  mjtNum* w = data_->xfrc_applied + 6 * object_body_;
+  for (int i = 0; i < 3; ++i) {
+    w[i] = force_N[i];
+    w[3 + i] = torque_Nm[i];
+  }
+}
+
+std::array<double, 3> HandPlant::object_position_m() const {
+  std::array<double, 3> p{};
+  if (object_body_ >= 0)
+    for (int i = 0; i < 3; ++i) p[i] = data_->xipos[3 * object_body_ + i];
+  return p;
+}
+
+std::array<double, 3> HandPlant::wrist_centre_m() const {
+  std::array<double, 3> p{};
+  for (int i = 0; i < 3; ++i) p[i] = data_->xanchor[3 * wrist_joint_ + i];
+  return p;
 }
 
 void HandPlant::apply_spring_gain() {

@@ -45,6 +45,25 @@ class HandPlant {
   // the step's last 20 ms).
   const SensorFrame& state() const { return state_; }
   const std::array<double, kMuscles>& target_mm() const { return target_mm_; }
+
+  // External wrench on the grasped object's body (MuJoCo mjData::xfrc_applied):
+  // force (N) and torque (N m), both in the world frame, acting at the
+  // object's centre of mass. World frame: z up (gravity -z); at zero wrist
+  // angles x points from the wrist towards the fingers and the palm faces +z,
+  // so -z pushes the object into the palm and +z pulls it out of the fingers.
+  // The wrench acts on every physics substep until it is set again; it is
+  // zero by default. Throws std::logic_error for a nonzero wrench when the
+  // hand holds no object (ObjectKind::kNone), std::invalid_argument for a
+  // non-finite component.
+  void set_object_wrench(const std::array<double, 3>& force_N, const std::array<double, 3>& torque_Nm = {});
+  const std::array<double, 3>& object_force_N() const { return object_force_N_; }
+  const std::array<double, 3>& object_torque_Nm() const { return object_torque_Nm_; }
+  bool has_object() const { return object_body_ >= 0; }
+  // Centre of mass of the object (world frame, m); zeros without an object.
+  std::array<double, 3> object_position_m() const;
+  // The wrist's centre of rotation (the pitch and yaw axes meet there; world
+  // frame, m).
+  std::array<double, 3> wrist_centre_m() const;
   // Physics steps taken so far (for benchmarks).
   long physics_steps() const { return physics_steps_; }
 
@@ -66,6 +85,10 @@ class HandPlant {
   std::array<int, kLoadcells> sensor_adr_{};
   std::array<int, kWristJoints> wrist_qpos_adr_{};
   int press_qpos_adr_ = -1;
+  int object_body_ = -1;  // -1: no object
+  int wrist_joint_ = -1;
+  std::array<double, 3> object_force_N_{};
+  std::array<double, 3> object_torque_Nm_{};
   struct SpringDof {
     int joint_id;
     double stiffness_Nm_per_rad;

@@ -39,7 +39,7 @@ void MotionGenerator::plan_segment() {
     segment_steps_ = rng_.uniform_int(3, 15);  // 0.6 .. 3.0 s
   } else if (segments_done_ == 0) {
     // Grasp: close the hand around the object (or bend the fingers a
-    // moderate amount when there is none) over 1.6 s.
+    // moderate amount when there is none) over kGraspSteps (1.6 s).
     JointTargets q;
     q.wrist_pitch_rad = rng_.uniform(-0.2, 0.2);
     q.wrist_yaw_rad = rng_.uniform(-0.1, 0.1);
@@ -49,7 +49,7 @@ void MotionGenerator::plan_segment() {
     q.thumb_oppose = rng_.uniform(0.4, 0.7);
     q.stiffness = rng_.uniform(0.0, 1.0);
     to_mm_ = grasp_mm_ = nominal_muscle_lengths_mm(q);
-    segment_steps_ = 8;
+    segment_steps_ = kGraspSteps;
   } else {
     // Random changes of the finger muscles #1-#4 around the grasp.
     to_mm_ = current_mm_;

@@ -23,6 +23,10 @@ std::optional<Motion> parse_motion(std::string_view name);
 // The open-hand pose every experiment starts from.
 JointTargets start_pose();
 
+// Random-2 closes the hand around the object over this many 0.2 s steps
+// before its random finger changes begin.
+inline constexpr int kGraspSteps = 8;
+
 class MotionGenerator {
  public:
   MotionGenerator(Motion motion, ObjectKind object, std::uint64_t seed);

@@ -1,7 +1,7 @@
 # Script test of the trainer subcommands end to end on the smoke preset (4 short
 # logs, states None/i0/w0 and Cylinder/i0/w0) with a tiny network:
 # train -> resume -> adapt (offline and online) -> recognize -> calibrate-detect
-# -> simulate, each producing its files; then malformed inputs must fail with
+# -> codegen and measure-ranges -> simulate, each producing its files; then malformed inputs must fail with
 # messages that name the file. Behaviour on the paper preset is measured in
 # docs/trainer.md; this test checks the plumbing, not accuracy.
 file(REMOVE_RECURSE "${WORK}")
@@ -95,6 +95,53 @@ endif()
 run("${HADYNET}" calibrate-detect "${model}" "${WORK}/data/train" --detect-steps 30 --out "${WORK}/x.safetensors")
 if(rc EQUAL 0 OR NOT err MATCHES "exceeds the model's N_train")
   message(FATAL_ERROR "N_detect > N_train accepted:\n${err}")
+endif()
+
+# Codegen (docs/codegen.md): train stored the value ranges; the headers of the
+# model without detection (m) and with it (md) compile with the project's
+# warnings as errors; measure-ranges re-measures; unsupported options write nothing.
+set(gen_checks)
+foreach(case "m;q15" "m;f32" "md;q15" "md;f32")
+  list(GET case 0 name)
+  list(GET case 1 numeric)
+  run("${HADYNET}" codegen "${WORK}/${name}.safetensors" --numeric ${numeric} --out "${WORK}/gen_${name}")
+  must_succeed("codegen ${name} ${numeric}")
+  if(NOT out MATCHES "hadynet_model_${numeric}.h: ${numeric} model hadynet::model_${numeric} \\(written\\)")
+    message(FATAL_ERROR "codegen ${name} ${numeric} output:\n${out}")
+  endif()
+  file(WRITE "${WORK}/gen_${name}/check_${numeric}.cc"
+       "#include \"hadynet_model_${numeric}.h\"\n"
+       "static_assert(hadynet::model_${numeric}::Model::kHasDetection == ${name}_has_detection);\n")
+endforeach()
+foreach(name m md)
+  if(name STREQUAL "md")
+    set(has true)
+  else()
+    set(has false)
+  endif()
+  foreach(numeric q15 f32)
+    execute_process(COMMAND "${CXX}" -std=c++20 -fsyntax-only -Wall -Wextra -Wpedantic -Wshadow
+                            -Wconversion -Werror -D${name}_has_detection=${has}
+                            "-I${SOURCE_DIR}" "-I${WORK}/gen_${name}" "${WORK}/gen_${name}/check_${numeric}.cc"
+                    RESULT_VARIABLE rc ERROR_VARIABLE err)
+    if(NOT rc EQUAL 0)
+      message(FATAL_ERROR "generated ${name} ${numeric} header does not compile:\n${err}")
+    endif()
+  endforeach()
+endforeach()
+run("${HADYNET}" measure-ranges "${WORK}/md.safetensors" "${WORK}/data/train" --out "${WORK}/mr.safetensors")
+must_succeed("measure-ranges")
+if(NOT out MATCHES "gate_pre +[0-9.]+" OR NOT out MATCHES "4 logs \\(data_hash [0-9a-f]+\\).* [0-9]+ windows")
+  message(FATAL_ERROR "measure-ranges output:\n${out}")
+endif()
+run("${HADYNET}" codegen "${WORK}/mr.safetensors" --numeric q15 --out "${WORK}/gen_mr" --headroom 2
+    --control-horizon 5 --control-alphas 0.5,0.25 --beta 2 --namespace hand::mr)
+must_succeed("codegen of the re-measured model with options")
+run("${HADYNET}" codegen "${WORK}/md.safetensors" --numeric q15 --out "${WORK}/gen_logs" --logs "${WORK}/data/train")
+must_succeed("codegen --logs")
+run("${HADYNET}" codegen "${WORK}/md.safetensors" --numeric q15 --out "${WORK}/gen_bad" --control-horizon 30)
+if(rc EQUAL 0 OR NOT err MATCHES "control horizon 30" OR EXISTS "${WORK}/gen_bad")
+  message(FATAL_ERROR "codegen with a horizon beyond N_train accepted or wrote files (${rc}):\n${err}")
 endif()
 
 run("${HADYNET}" simulate "${WORK}/md.safetensors" --log "${WORK}/data/train/Cylinder_random1_i0_w0.csv"

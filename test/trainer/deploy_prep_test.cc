@@ -96,5 +96,36 @@ TEST(MeasureRanges, MatchesAnIndependentComputation) {
   EXPECT_FLOAT_EQ(static_cast<float>(r.dec_weight), m.params.dec_weight.cwiseAbs().maxCoeff());
 }
 
+TEST(MeasureLogRanges, EveryWindowOfTheLogsWithTheirStatesPb) {
+  const SpringModel spring = trained_spring_model(3);
+  const HadynetModel& m = spring.model;
+  TempDir dir;
+  const std::string soft = dir.write_log("logs/a.csv", spring_log(kSoftStiffness, 40, 21, "soft"));
+  const std::string stiff = dir.write_log("logs/b.csv", spring_log(kStiffStiffness, 30, 22, "stiff"));
+  const ValueRanges r = measure_log_ranges(m, {(dir.path() / "logs").string()});
+
+  // Independent: the same windows through measure_ranges (stiff is PB row 1).
+  const std::vector<LogSequence> seqs = {read_sequence(soft, m.layout), read_sequence(stiff, m.layout)};
+  const WindowDataset data(seqs, {0, 1}, m.layout, m.norm, m.train_steps);
+  ValueRanges want = measure_ranges(m, data, all_ids(data));
+  EXPECT_EQ(r.windows, data.size());
+  EXPECT_EQ(r.windows, (40 - 1 - kSpringTrainSteps) + (30 - 1 - kSpringTrainSteps));
+  EXPECT_TRUE(contains(r.source, "2 logs (data_hash " + content_hash({soft, stiff}) + ")")) << r.source;
+  want.source = r.source;
+  EXPECT_EQ(r, want);  // same windows, same order of computation: exact
+
+  // A log of a state the PB table does not have is an error naming the file.
+  const std::string other = dir.write_log("other/c.csv", spring_log(2.0, 30, 23, "medium"));
+  try {
+    measure_log_ranges(m, {other});
+    ADD_FAILURE() << "a state outside the PB table was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_TRUE(contains(e.what(), other + ": state 'medium'")) << e.what();
+  }
+  // Logs too short for one window.
+  const std::string tiny = dir.write_log("tiny/d.csv", spring_log(1.0, 4, 24, "soft"));
+  EXPECT_THROW(measure_log_ranges(m, {tiny}), std::runtime_error);
+}
+
 }  // namespace
 }  // namespace hadynet::trainer::testing

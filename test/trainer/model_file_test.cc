@@ -52,6 +52,14 @@ HadynetModel sample_model(bool with_detection) {
     c.samples = 123;
     c.source = "calib/none.csv";
     m.detection = c;
+    // Ranges go with the detection variant; the other one is a model
+    // without them (as files written before they existed).
+    ValueRanges r;
+    double v = 0.125;
+    for (const ValueRangeField& field : kValueRangeFields) r.*field.member = (v *= 1.7);
+    r.windows = 321;
+    r.source = "spring logs \"a\" (data_hash 0123)";
+    m.ranges = r;
   }
   return m;
 }
@@ -96,6 +104,10 @@ void expect_same_model(const HadynetModel& got, const HadynetModel& want) {
     EXPECT_EQ(g.samples, w.samples);
     EXPECT_EQ(g.source, w.source);
   }
+  ASSERT_EQ(got.ranges.has_value(), want.ranges.has_value());
+  if (want.ranges) {
+    EXPECT_EQ(*got.ranges, *want.ranges);  // doubles exactly (JSON round trip)
+  }
 }
 
 TEST(ModelFile, RoundTripKeepsEveryPartAndTheForwardBits) {
@@ -129,6 +141,8 @@ TEST(ModelFile, RoundTripWithoutDetection) {
   save_model(path, model);
   const HadynetModel loaded = load_model(path);
   EXPECT_FALSE(loaded.detection.has_value());
+  EXPECT_FALSE(loaded.ranges.has_value());
+  EXPECT_EQ(model_to_safetensors(loaded).metadata.count("ranges"), 0u);
   expect_same_model(loaded, model);
 }
 
@@ -353,6 +367,29 @@ TEST_F(ModelFileRejects, InconsistentOrMalformedMetadata) {
   const double zero = 0.0;
   std::memcpy(f.tensors.at("norm.x_std").bytes.data(), &zero, sizeof zero);
   expect_rejected(f, "std is not positive");
+}
+
+TEST_F(ModelFileRejects, MalformedRanges) {
+  ASSERT_EQ(good_.metadata.count("ranges"), 1u);
+  st::File f = good_;
+  f.metadata["ranges"] = "[1, 2]";
+  expect_rejected(f, "ranges has no 'x'");
+
+  f = good_;
+  edit_metadata(f, "ranges", R"("h":)", R"("h":-)");
+  expect_rejected(f, "range 'h' is negative or not finite");
+
+  f = good_;
+  edit_metadata(f, "ranges", R"("windows":321)", R"("windows":"many")");
+  expect_rejected(f, "ranges 'windows' has the wrong type");
+
+  f = good_;
+  edit_metadata(f, "ranges", R"("c":)", R"("c_old":)");
+  expect_rejected(f, "ranges has no 'c'");
+
+  HadynetModel m = model_;
+  m.ranges->y = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(model_to_safetensors(m), std::invalid_argument);
 }
 
 TEST_F(ModelFileRejects, TruncatedFile) {

@@ -1,0 +1,206 @@
+// hadynet replay: host-sim — the firmware core compiled for the PC with the
+// build's generated model (codegen of HADYNET_MODEL), fed a recorded log
+// frame by frame. Writes per step the estimate of y_t, d, the contact flag
+// and the stabiliser's command as CSV; prints a summary; --plot draws d and
+// the commands.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+#include "cli/commands.h"
+#include "cli/gnuplot.h"
+#include "cli/options.h"
+#include "datalog/log_error.h"
+#include "datalog/log_reader.h"
+#include "host-sim/replay/replay.h"
+#include <fstream>
+
+namespace hadynet::cli {
+
+namespace {
+
+std::string replay_plot(const hostsim::ReplayResult& r, const hostsim::CompiledModelInfo& info,
+                        const std::string& title, const std::string& png) {
+  std::string s = "$d << EOD\n";
+  char buf[64];
+  for (const auto& st : r.steps) {
+    if (!st.distance_valid) continue;
+    std::snprintf(buf, sizeof buf, "%.4f %.6g\n", st.time, static_cast<double>(st.d));
+    s += buf;
+  }
+  s += "EOD\n$u << EOD\n";
+  bool any_command = false;
+  for (const auto& st : r.steps) {
+    if (!st.command_valid) continue;
+    any_command = true;
+    std::snprintf(buf, sizeof buf, "%.4f", st.time);
+    s += buf;
+    for (float v : st.command) {
+      std::snprintf(buf, sizeof buf, " %.6g", static_cast<double>(v));
+      s += buf;
+    }
+    s += "\n";
+  }
+  s += "EOD\n";
+  s += "set terminal pngcairo size 1200,700 font 'sans,9' noenhanced\n";
+  s += "set output " + gnuplot_quote(png) + "\n";
+  s += "set multiplot layout 2,1 title " + gnuplot_quote(title) + "\nset grid\nset xlabel 't [s]'\n";
+  s += "set ylabel 'd'\nset logscale y\n";
+  std::snprintf(buf, sizeof buf, "%.6g", static_cast<double>(info.detect_threshold));
+  s += "plot $d using 1:2 with lines title 'd', " + std::string(buf) +
+       " with lines dt 2 lw 2 lc rgb 'red' title 'C_detect'\n";
+  s += "unset logscale y\nset ylabel 'stabiliser command u_t'\n";
+  if (any_command) {
+    s += "plot ";
+    for (std::size_t i = 0; i < r.u_names.size(); ++i) {
+      if (i) s += ", ";
+      s += "$u using 1:" + std::to_string(i + 2) + " with lines title " + gnuplot_quote(r.u_names[i]);
+    }
+    s += "\n";
+  } else {
+    s += "set label 1 'no control (see --control-from)' at graph 0.4,0.5\nplot 0 notitle\n";
+  }
+  s += "unset multiplot\n";
+  return run_gnuplot(s, png);
+}
+
+}  // namespace
+
+int run_replay(int argc, char** argv) {
+  Options opt("replay",
+              "Host-sim: replays a recorded log through the firmware core built for the PC with the\n"
+              "model compiled into this build (codegen of the CMake variable HADYNET_MODEL). Frame t\n"
+              "carries y_t and the command u_{t-1}; the firmware returns its estimate of y_t from\n"
+              "x_{t-N} and u_[t-N,t) (N = N_detect), the Mahalanobis distance d, the contact flag\n"
+              "d > C_detect and, in control mode, the grasp stabiliser's command u_t (advisory: the\n"
+              "log's own commands keep driving the replay). Bit-identical across runs.",
+              "hadynet replay LOG --out CSV [options]");
+  opt.value("out", "CSV", "per-step results (required)");
+  opt.value("numeric", "q15|f32", "which generated build of the core", "q15");
+  opt.value("mode", "observe|detect|control", "firmware mode from the first row", "detect");
+  opt.value("control-from", "ROW", "switch to control mode at this row (y_ref = its y)");
+  opt.value("pb", "STATE|v1,..,vP", "PB: a state name of the PB table or standardised values "
+            "(default: the detection PB)");
+  opt.value("control-epochs", "N", "stabiliser epochs (default: the model's)");
+  opt.value("control-truncation", "K", "stabiliser truncation depth K (default: the model's)");
+  opt.value("plot", "PNG", "draw d and the commands");
+  opt.flag("info", "print the compiled model's identity and sizes and exit");
+  if (!opt.parse(argc, argv)) return 2;
+  if (opt.help_requested()) return 0;
+
+  hostsim::ReplayOptions ro;
+  const std::string numeric = opt.get("numeric");
+  if (numeric == "q15") {
+    ro.numeric = hostsim::ReplayNumeric::kQ15;
+  } else if (numeric == "f32") {
+    ro.numeric = hostsim::ReplayNumeric::kF32;
+  } else {
+    std::fprintf(stderr, "hadynet replay: --numeric must be q15 or f32, not '%s'\n", numeric.c_str());
+    return 2;
+  }
+  const hostsim::CompiledModelInfo info = hostsim::compiled_model_info(ro.numeric);
+  if (opt.has("info")) {
+    std::printf("compiled model (%s): %s, hash %016llx\n", numeric.c_str(), info.generator.c_str(),
+                static_cast<unsigned long long>(info.hash));
+    std::printf("dims: x %d, u %d, y %d, pb %d, hidden %d, states %d\n", info.x, info.u, info.y, info.pb,
+                info.hidden, info.states);
+    std::printf("detection: %s (N_detect %d, C_detect %g)\n", info.has_detection ? "yes" : "no",
+                info.detect_steps, static_cast<double>(info.detect_threshold));
+    std::printf("stabiliser: horizon %d, epochs %d, truncation %d\n", info.control_horizon, info.control_epochs,
+                info.control_truncation);
+    return 0;
+  }
+  if (opt.positional().size() != 1 || !opt.has("out")) {
+    std::fprintf(stderr, "hadynet replay: need exactly one LOG and --out CSV (see --help)\n");
+    return 2;
+  }
+  const std::string mode = opt.get("mode");
+  if (mode == "observe") {
+    ro.mode = firmware::Mode::kObserve;
+  } else if (mode == "detect") {
+    ro.mode = firmware::Mode::kDetect;
+  } else if (mode == "control") {
+    ro.mode = firmware::Mode::kDetect;
+    ro.control_from = 0;
+  } else {
+    std::fprintf(stderr, "hadynet replay: --mode must be observe, detect or control\n");
+    return 2;
+  }
+  if (opt.has("control-from")) {
+    const auto v = opt.get_int("control-from", 0, 1 << 30);
+    if (!v) return 2;
+    ro.control_from = static_cast<int>(*v);
+  }
+  if (opt.has("control-epochs")) {
+    const auto v = opt.get_int("control-epochs", 0, 100);
+    if (!v) return 2;
+    ro.control_epochs = static_cast<int>(*v);
+  }
+  if (opt.has("control-truncation")) {
+    const auto v = opt.get_int("control-truncation", 1, 1000);
+    if (!v) return 2;
+    ro.control_truncation = static_cast<int>(*v);
+  }
+  if (opt.has("pb")) {
+    const std::string pb = opt.get("pb");
+    for (std::size_t k = 0; k < info.state_names.size(); ++k)
+      if (info.state_names[k] == pb) ro.pb_state = static_cast<int>(k);
+    if (ro.pb_state < 0) {
+      std::size_t pos = 0;
+      try {
+        while (pos <= pb.size()) {
+          const std::size_t comma = pb.find(',', pos);
+          const std::string field = pb.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+          std::size_t used = 0;
+          ro.pb.push_back(std::stof(field, &used));
+          if (used != field.size()) throw std::invalid_argument(field);
+          if (comma == std::string::npos) break;
+          pos = comma + 1;
+        }
+      } catch (const std::exception&) {
+        std::fprintf(stderr, "hadynet replay: --pb '%s' is neither a state of the model nor %d numbers\n",
+                     pb.c_str(), info.pb);
+        return 2;
+      }
+    }
+  }
+
+  const std::string log_path = opt.positional()[0];
+  try {
+    const datalog::LogTable log = datalog::read_log(log_path);
+    const hostsim::ReplayResult r = hostsim::replay_log(log, log_path, ro);
+    {
+      std::ofstream out(opt.get("out"), std::ios::binary);
+      out << hostsim::format_replay_csv(r);
+      if (!out.flush()) throw std::runtime_error(opt.get("out") + ": cannot write");
+    }
+    int distances = 0, flagged = 0, commands = 0;
+    double d_max = 0.0;
+    for (const auto& st : r.steps) {
+      if (st.distance_valid) {
+        ++distances;
+        flagged += st.contact ? 1 : 0;
+        d_max = std::max(d_max, static_cast<double>(st.d));
+      }
+      commands += st.command_valid ? 1 : 0;
+    }
+    std::printf("%s: %zu rows (%s), d on %d rows, contact on %d (%.1f%%), max d %.3g, %d commands -> %s\n",
+                log_path.c_str(), r.steps.size(), numeric.c_str(), distances, flagged,
+                distances ? 100.0 * flagged / distances : 0.0, d_max, commands, opt.get("out").c_str());
+    if (opt.has("plot")) {
+      const std::string err = replay_plot(r, info, std::filesystem::path(log_path).filename().string() + " (" +
+                                                       numeric + ")", opt.get("plot"));
+      if (!err.empty()) {
+        std::fprintf(stderr, "hadynet replay: %s\n", err.c_str());
+        return 1;
+      }
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hadynet replay: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace hadynet::cli

@@ -1,0 +1,174 @@
+#include "codegen/codegen_command.h"
+
+#include <charconv>
+#include <cstdio>
+#include <stdexcept>
+#include <vector>
+
+#include "cli/options.h"
+#include "codegen/codegen.h"
+#include "trainer/deploy_prep.h"
+
+namespace hadynet::codegen {
+
+namespace {
+
+// "1,0.5,0.25" -> numbers; nullopt (after a message) on a malformed list.
+std::optional<std::vector<double>> parse_alphas(const std::string& text, const std::string& who) {
+  std::vector<double> out;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, end - start);
+    double v = 0;
+    const auto [p, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
+    if (item.empty() || ec != std::errc() || p != item.data() + item.size()) {
+      std::fprintf(stderr, "%s: --control-alphas: '%s' is not a comma-separated list of numbers\n",
+                   who.c_str(), text.c_str());
+      return std::nullopt;
+    }
+    out.push_back(v);
+    if (end == text.size()) break;
+    start = end + 1;
+  }
+  return out;
+}
+
+void print_formats(const Formats& f) {
+  const std::pair<const char*, const FormatChoice*> rows[] = {
+      {"kFracIn", &f.in},         {"kFracH", &f.h},           {"kFracC", &f.c},
+      {"kFracY", &f.y},           {"kFracGate", &f.gate},     {"kFracEncW", &f.enc_w},
+      {"kFracLstmW", &f.lstm_w},  {"kFracLstmAcc", &f.lstm_acc}, {"kFracDecW", &f.dec_w},
+      {"kFracWhiten", &f.whiten}, {"kFracZ", &f.z},           {"kFracLossW", &f.loss_w}};
+  for (const auto& [name, c] : rows) std::printf("  %-13s Q%-2d  %s\n", name, c->frac, c->from.c_str());
+}
+
+}  // namespace
+
+int run_codegen_command(const std::string& program, const std::string& command, int argc,
+                        char** argv) {
+  cli::Options opt(
+      command,
+      "Generates one allocation-free C++ header from a trained model file: every constant and\n"
+      "array of the firmware contract (firmware/core/model_contract.h) as static constexpr members\n"
+      "of `struct Model`, in fixed point (q15: int16 values in per-tensor Q formats chosen from the\n"
+      "model's measured value ranges, int32 biases) or float32 (f32). Writes\n"
+      "DIR/hadynet_model_<numeric>.h atomically; an unsupported model is rejected before anything\n"
+      "is written (docs/codegen.md). --logs: measure the value ranges on the logs given after MODEL\n"
+      "instead of using those stored in the model.",
+      "MODEL --numeric q15|f32 --out DIR [options] [--logs LOG|DIR...]", program);
+  opt.value("numeric", "q15|f32", "number format of the generated model");
+  opt.value("out", "DIR", "directory to write hadynet_model_<numeric>.h into (created if needed)");
+  opt.value("namespace", "NS", "C++ namespace (default: hadynet::model_q15 / hadynet::model_f32)");
+  opt.value("headroom", "H", "factor on the measured activation ranges before choosing formats", "1.5");
+  opt.value("control-horizon", "N", "grasp stabiliser horizon N_control (<= the model's N_train)", "8");
+  opt.value("control-epochs", "N", "gradient steps per control period (N_epoch)", "3");
+  opt.value("control-alphas", "LIST", "step sizes tried per gradient step (N_batch of them)",
+            "1,0.5,0.25,0.125");
+  opt.value("control-truncation", "K", "BPTT truncation depth (>= horizon: full; default: the horizon)");
+  opt.value("beta", "B", "force loss weight where the estimate is below the reference", "3");
+  opt.value("w2", "W", "wrist angle loss weight", "1");
+  opt.value("w3", "W", "muscle length loss weight", "1");
+  opt.value("loss-units", "physical|standardised",
+            "units of the stabiliser's loss: physical (the paper's raw values; weights x std^2) or "
+            "standardised", "physical");
+  opt.value("control-commands", "NAMES|all",
+            "u channels the stabiliser may change, comma-separated (others stay at 'no change')", "all");
+  opt.flag("logs", "measure the value ranges on the logs/folders given after MODEL");
+  if (!opt.parse(argc, argv)) return 2;
+  if (opt.help_requested()) return 0;
+  const std::string who = command.empty() ? program : program + " " + command;
+  const bool with_logs = opt.has("logs");
+  if (opt.positional().empty() || !opt.has("numeric") || !opt.has("out")) {
+    std::fprintf(stderr, "%s: give MODEL, --numeric and --out (see --help)\n", who.c_str());
+    return 2;
+  }
+  if (with_logs != (opt.positional().size() > 1)) {
+    std::fprintf(stderr, "%s: %s\n", who.c_str(),
+                 with_logs ? "--logs needs logs or folders after MODEL"
+                           : "give one MODEL (logs after it only with --logs)");
+    return 2;
+  }
+  CodegenOptions options;
+  if (opt.get("numeric") == "q15") {
+    options.numeric = Numeric::kQ15;
+  } else if (opt.get("numeric") == "f32") {
+    options.numeric = Numeric::kF32;
+  } else {
+    std::fprintf(stderr, "%s: --numeric must be q15 or f32, got '%s'\n", who.c_str(),
+                 opt.get("numeric").c_str());
+    return 2;
+  }
+  options.ns = opt.get("namespace");
+  const auto headroom = opt.get_double("headroom", 1.0, 1e6);
+  const auto horizon = opt.get_int("control-horizon", 1, 100000);
+  const auto epochs = opt.get_int("control-epochs", 1, 100000);
+  const auto alphas = parse_alphas(opt.get("control-alphas"), who);
+  std::optional<long long> truncation;
+  if (opt.has("control-truncation")) {
+    truncation = opt.get_int("control-truncation", 1, 100000);
+    if (!truncation) return 2;
+  }
+  const auto beta = opt.get_double("beta", 0.0, 1e6);
+  const auto w2 = opt.get_double("w2", 0.0, 1e6);
+  const auto w3 = opt.get_double("w3", 0.0, 1e6);
+  if (!headroom || !horizon || !epochs || !alphas || !beta || !w2 || !w3) return 2;
+  options.headroom = *headroom;
+  options.control.horizon = static_cast<int>(*horizon);
+  options.control.epochs = static_cast<int>(*epochs);
+  options.control.alphas = *alphas;
+  if (truncation) options.control.truncation = static_cast<int>(*truncation);
+  options.control.beta = *beta;
+  options.control.w2 = *w2;
+  options.control.w3 = *w3;
+  if (opt.get("loss-units") == "physical") {
+    options.control.physical_units = true;
+  } else if (opt.get("loss-units") == "standardised") {
+    options.control.physical_units = false;
+  } else {
+    std::fprintf(stderr, "%s: --loss-units must be physical or standardised, got '%s'\n", who.c_str(),
+                 opt.get("loss-units").c_str());
+    return 2;
+  }
+  if (opt.get("control-commands") != "all") {
+    const std::string list = opt.get("control-commands");
+    std::size_t pos = 0;
+    while (true) {
+      const std::size_t comma = list.find(',', pos);
+      const std::string name = list.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+      if (name.empty()) {
+        std::fprintf(stderr, "%s: --control-commands: empty name in '%s'\n", who.c_str(), list.c_str());
+        return 2;
+      }
+      options.control.commands.push_back(name);
+      if (comma == std::string::npos) break;
+      pos = comma + 1;
+    }
+  }
+
+  const std::string model_path = opt.positional().front();
+  try {
+    LoadedModel loaded = load_model_file(model_path);
+    if (with_logs) {
+      const std::vector<std::string> logs(opt.positional().begin() + 1, opt.positional().end());
+      loaded.model.ranges = trainer::measure_log_ranges(loaded.model, logs);
+      std::printf("value ranges measured on %s\n", loaded.model.ranges->source.c_str());
+    }
+    GeneratedHeader header;
+    try {
+      header = generate(loaded.model, loaded.identity, options);
+    } catch (const UnsupportedModel& e) {
+      throw std::runtime_error(model_path + ": unsupported model: " + e.what());
+    }
+    const WriteResult written = write_header(opt.get("out"), header);
+    std::printf("%s: %s model %s (%s)\n", written.path.c_str(), numeric_name(options.numeric),
+                namespace_of(options).c_str(), written.changed ? "written" : "unchanged");
+    if (options.numeric == Numeric::kQ15) print_formats(header.formats);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", who.c_str(), e.what());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace hadynet::codegen

@@ -1,0 +1,184 @@
+// Stateful, step-by-step HADYNET forward pass of a generated model
+// (DESIGN.md §3), in the model's numerics (q15 or f32), plus the input
+// gradient (back-propagation through time) the grasp stabiliser needs.
+//
+//   encode:  h_0 = ReLU(W_enc' [x ; p] + b_enc')   (batch norm folded by codegen), c_0 = 0
+//   step:    [i f g o] = act(W_ih [u ; p] + W_hh h + b),  c' = f c + i g,  h' = o tanh(c')
+//            y = W_dec h' + b_dec
+//
+// Every value is in standardised units (model_contract.h); the q15 formats
+// are the model's kFrac* constants. Allocation-free: all state is in the
+// object, sized by the model at compile time; no call allocates or throws.
+#ifndef HADYNET_FIRMWARE_CORE_HADYNET_NET_H_
+#define HADYNET_FIRMWARE_CORE_HADYNET_NET_H_
+
+#include <cstdint>
+
+#include "firmware/core/model_contract.h"
+#include "firmware/core/numerics.h"
+
+namespace hadynet::firmware {
+
+// What the backward pass needs from one LSTM step.
+template <GeneratedModel M>
+struct StepTrace {
+  using Value = typename M::Value;
+  Value gates[4 * M::kHidden];  // activated i, f, g, o (Q15)
+  Value c_prev[M::kHidden];     // c before the step (Q(kFracC))
+  Value tanh_c[M::kHidden];     // tanh(c after the step) (Q15)
+};
+
+template <GeneratedModel M>
+class HadynetNet {
+ public:
+  static_assert(M::kContractVersion == kModelContractVersion,
+                "generated model was written for another contract version: re-run codegen");
+  using N = Numerics<M>;
+  using Value = typename M::Value;
+  using Grad = typename N::Grad;
+  static constexpr int kX = M::kX, kU = M::kU, kY = M::kY, kPb = M::kPb, kH = M::kHidden;
+  static constexpr int kGates = 4 * kH;
+  static constexpr int kFracOut = N::kFixed ? 15 : 0;  // activation outputs
+
+  // h_0 from the standardised initial state x (Q(kFracIn)) and PB p
+  // (Q(kFracIn)); c_0 = 0. p is kept for the following steps.
+  void encode(const Value (&x)[kX], const Value (&pb)[kPb]) noexcept {
+    for (int i = 0; i < kPb; ++i) pb_[i] = pb[i];
+    for (int r = 0; r < kH; ++r) {
+      const auto acc = typename N::Acc{M::kEncBias[r]} + N::dot(M::kEncWeight[r], x, kX) +
+                       N::dot(M::kEncWeight[r] + kX, pb_, kPb);
+      const Value v = N::template narrow<M::kFracEncW + M::kFracIn, M::kFracH>(acc);
+      h_[r] = v > 0 ? v : Value{0};
+      c_[r] = 0;
+    }
+  }
+
+  // One LSTM step with command u (Q(kFracIn)); writes y (Q(kFracY)). If
+  // `trace` is not null it receives what backward() needs for this step.
+  void step(const Value (&u)[kU], Value (&y)[kY], StepTrace<M>* trace = nullptr) noexcept {
+    Value gates[kGates];
+    constexpr int kAccFrac = M::kFracLstmAcc;
+    constexpr int kInShift = kAccFrac - (M::kFracLstmW + M::kFracIn);
+    constexpr int kHShift = kAccFrac - (M::kFracLstmW + M::kFracH);
+    static_assert(!N::kFixed || (kInShift >= 0 && kHShift >= 0), "kFracLstmAcc too small");
+    for (int r = 0; r < kGates; ++r) {
+      auto in = N::dot(M::kLstmWeightIh[r], u, kU) + N::dot(M::kLstmWeightIh[r] + kU, pb_, kPb);
+      auto rec = N::dot(M::kLstmWeightHh[r], h_, kH);
+      typename N::Acc acc;
+      if constexpr (N::kFixed) {
+        // Exact: both products are brought to Q(kFracLstmAcc) by left shifts
+        // (|acc| < 2^46 before the shift of at most 15 bits).
+        acc = std::int64_t{M::kLstmBias[r]} + in * (std::int64_t{1} << kInShift) +
+              rec * (std::int64_t{1} << kHShift);
+      } else {
+        acc = M::kLstmBias[r] + in + rec;
+      }
+      const Value pre = N::template narrow<kAccFrac, M::kFracGate>(acc);
+      gates[r] = (r >= 2 * kH && r < 3 * kH) ? N::tanh(pre) : N::sigmoid(pre);
+    }
+    for (int j = 0; j < kH; ++j) {
+      const Value i = gates[j], f = gates[kH + j], g = gates[2 * kH + j], o = gates[3 * kH + j];
+      if (trace != nullptr) trace->c_prev[j] = c_[j];
+      Value c_new;
+      if constexpr (N::kFixed) {
+        // f c + i g with one rounding: f c is Q(15 + C), i g is Q30; both
+        // exact in int64 at Q(30 + C), then narrowed to Q(C).
+        constexpr int C = M::kFracC;
+        const std::int64_t fc = std::int64_t{f} * c_[j] * (std::int64_t{1} << 15);
+        const std::int64_t ig = std::int64_t{i} * g * (std::int64_t{1} << C);
+        c_new = fixed::requantize_i16<30 + C, C>(fc + ig);
+      } else {
+        c_new = f * c_[j] + i * g;
+      }
+      c_[j] = c_new;
+      const Value tc = N::tanh(N::template narrow<M::kFracC, M::kFracGate>(c_new));
+      h_[j] = N::template mul<kFracOut, kFracOut, M::kFracH>(o, tc);
+      if (trace != nullptr) trace->tanh_c[j] = tc;
+    }
+    if (trace != nullptr) {
+      for (int r = 0; r < kGates; ++r) trace->gates[r] = gates[r];
+    }
+    decode(y);
+  }
+
+  // y = W_dec h + b_dec of the current hidden state.
+  void decode(Value (&y)[kY]) const noexcept {
+    for (int r = 0; r < kY; ++r) {
+      const auto acc = typename N::Acc{M::kDecBias[r]} + N::dot(M::kDecWeight[r], h_, kH);
+      y[r] = N::template narrow<M::kFracDecW + M::kFracH, M::kFracY>(acc);
+    }
+  }
+
+  // One step of back-propagation through the LSTM, for input gradients only
+  // (weights are constant). Given dL/dh' (dh) and dL/dc' (dc) after step
+  // `trace`, adds dL/du of that step to du (kU entries) and, if dh_prev is
+  // not null, writes dL/dh and dL/dc before the step into dh_prev / dc
+  // (dc is updated in place). Gradients share one scale (numerics.h).
+  void backward_step(const StepTrace<M>& trace, const Grad (&dh)[kH], Grad (&dc)[kH],
+                     Grad (&du)[kU], Grad* dh_prev) noexcept {
+    Grad dgates[kGates];
+    for (int j = 0; j < kH; ++j) {
+      const Value i = trace.gates[j], f = trace.gates[kH + j], g = trace.gates[2 * kH + j],
+                  o = trace.gates[3 * kH + j], tc = trace.tanh_c[j];
+      // h' = o tanh(c'): do = dh tanh(c'), dc' += dh o tanh'(c').
+      const Grad d_o = N::template grad_mul<kFracOut>(dh[j], tc);
+      const Grad dcj = N::grad_add(
+          dc[j], N::grad_mul_q15(N::template grad_mul<kFracOut>(dh[j], o), N::tanh_slope(tc)));
+      // c' = f c + i g.
+      dgates[j] = N::grad_mul_q15(N::template grad_mul<kFracOut>(dcj, g), N::sigmoid_slope(i));
+      dgates[kH + j] =
+          N::grad_mul_q15(N::template grad_mul<M::kFracC>(dcj, trace.c_prev[j]), N::sigmoid_slope(f));
+      dgates[2 * kH + j] = N::grad_mul_q15(N::template grad_mul<kFracOut>(dcj, i), N::tanh_slope(g));
+      dgates[3 * kH + j] = N::grad_mul_q15(d_o, N::sigmoid_slope(o));
+      dc[j] = N::template grad_mul<kFracOut>(dcj, f);
+    }
+    // The chain rule runs on real values: a gradient's raw value is its real
+    // value times one constant; products with a Q(F) operand divide by 2^F
+    // (grad_mul<F>, transposed_matvec<F>), so the constant never changes.
+    // Requantising a pre-activation is the identity on reals (saturation is
+    // not differentiated).
+    Grad du_step[kU];
+    N::template transposed_matvec<M::kFracLstmW>(M::kLstmWeightIh, dgates, kU, du_step, scratch_);
+    for (int k = 0; k < kU; ++k) du[k] = N::grad_add(du[k], du_step[k]);
+    if (dh_prev != nullptr) {
+      N::template transposed_matvec<M::kFracLstmW>(M::kLstmWeightHh, dgates, kH, dh_prev, scratch_);
+    }
+  }
+
+  // dh += W_dec^T dy (dy: dL/dy of the current output, kY entries).
+  void backward_decoder(const Grad (&dy)[kY], Grad (&dh)[kH]) noexcept {
+    Grad d[kH];
+    N::template transposed_matvec<M::kFracDecW>(M::kDecWeight, dy, kH, d, scratch_);
+    for (int j = 0; j < kH; ++j) dh[j] = N::grad_add(dh[j], d[j]);
+  }
+
+  // State access (for rollouts that restart from h_0 and for tests).
+  struct State {
+    Value h[kH];
+    Value c[kH];
+  };
+  void save(State& s) const noexcept {
+    for (int j = 0; j < kH; ++j) {
+      s.h[j] = h_[j];
+      s.c[j] = c_[j];
+    }
+  }
+  void restore(const State& s) noexcept {
+    for (int j = 0; j < kH; ++j) {
+      h_[j] = s.h[j];
+      c_[j] = s.c[j];
+    }
+  }
+  const Value (&hidden() const noexcept)[kH] { return h_; }
+  const Value (&cell() const noexcept)[kH] { return c_; }
+
+ private:
+  Value pb_[kPb] = {};
+  Value h_[kH] = {};
+  Value c_[kH] = {};
+  typename N::GradAcc scratch_[kH > kU ? kH : kU] = {};
+};
+
+}  // namespace hadynet::firmware
+
+#endif  // HADYNET_FIRMWARE_CORE_HADYNET_NET_H_

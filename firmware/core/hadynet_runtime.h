@@ -1,0 +1,152 @@
+// The firmware's periodic job (every 0.2 s): one sensor frame in, one result
+// out — HADYNET's estimate of the current y, the contact distance d and flag,
+// and (in control mode) the grasp stabiliser's command. The active PB and the
+// mode are set at run time (e.g. from the link). Same sources on host and MCU.
+//
+// Timing of one period t (log row t; docs/log-format.md):
+//   in : y_t (measured now) and u_{t-1} (the command applied since t-1);
+//   out: prediction = y_est_t from x_{t-N} and u_[t-N, t) under the active PB
+//        (N = N_detect; valid from the (N+2)-th frame on), d and contact
+//        (modes detect and control, if the model has detection statistics),
+//        command = u_t from the stabiliser (mode control; needs 2 frames).
+// Entering control mode takes the next frame's y as the reference y_ref.
+#ifndef HADYNET_FIRMWARE_CORE_HADYNET_RUNTIME_H_
+#define HADYNET_FIRMWARE_CORE_HADYNET_RUNTIME_H_
+
+#include <cstdint>
+
+#include "firmware/core/boundary.h"
+#include "firmware/core/detector.h"
+#include "firmware/core/grasp_stabilizer.h"
+#include "firmware/core/hadynet_net.h"
+
+namespace hadynet::firmware {
+
+enum class Mode : std::uint8_t {
+  kObserve = 0,  // prediction only
+  kDetect = 1,   // prediction, d, contact
+  kControl = 2,  // as detect, plus the stabiliser's command
+};
+
+template <GeneratedModel M>
+struct SensorFrame {
+  float y[M::kY];       // y_t, physical (log units)
+  float u_prev[M::kU];  // u_{t-1}, physical
+};
+
+template <GeneratedModel M>
+struct StepResult {
+  bool prediction_valid = false;
+  float prediction[M::kY] = {};  // y_est_t, physical
+  bool distance_valid = false;
+  float d = 0.0f;  // Mahalanobis distance (standardised units)
+  bool contact = false;
+  bool command_valid = false;
+  float command[M::kU] = {};  // u_t, physical
+};
+
+template <GeneratedModel M>
+class HadynetRuntime {
+ public:
+  using N = Numerics<M>;
+  using Value = typename M::Value;
+  using B = Boundary<M>;
+  using Det = Detector<M>;
+
+  HadynetRuntime() noexcept {
+    init_pb();
+    reset();
+  }
+
+  // Clears the history and the plan; keeps the mode and the PB. The PB
+  // starts as the detection PB (or PB table row 0, or zero).
+  void reset() noexcept {
+    history_.clear();
+    reference_pending_ = true;
+    const float zero_u[M::kU] = {};
+    B::u_to_model(zero_u, hold_);
+    stabilizer_.reset(hold_);
+  }
+
+  Mode mode() const noexcept { return mode_; }
+  void set_mode(Mode mode) noexcept {
+    if (mode == Mode::kControl && mode_ != Mode::kControl) {
+      reference_pending_ = true;
+      stabilizer_.reset(hold_);
+    }
+    mode_ = mode;
+  }
+
+  // Active PB from the PB table; false (and unchanged) if out of range.
+  bool set_pb_state(int state) noexcept {
+    if (state < 0 || state >= M::kStates) return false;
+    for (int i = 0; i < M::kPb; ++i) pb_[i] = M::kPbTable[state][i];
+    return true;
+  }
+  // Active PB from standardised real values (saturated into the format).
+  void set_pb(const float (&pb)[M::kPb]) noexcept { B::real_to_in(pb, pb_); }
+  const Value (&pb() const noexcept)[M::kPb] { return pb_; }
+
+  typename GraspStabilizer<M>::Settings& control_settings() noexcept {
+    return stabilizer_.settings();
+  }
+  const GraspStabilizer<M>& stabilizer() const noexcept { return stabilizer_; }
+
+  // One period. Never fails: results not yet computable are marked invalid.
+  StepResult<M> step(const SensorFrame<M>& frame) noexcept {
+    StepResult<M> out;
+    history_.push(frame.y, frame.u_prev);
+    Value y_now[M::kY];
+    B::y_to_model(frame.y, y_now);
+
+    if (Det::ready(history_)) {
+      Value y_est[M::kY];
+      Det::estimate(history_, pb_, net_, y_est);
+      B::y_to_physical(y_est, out.prediction);
+      out.prediction_valid = true;
+      if (M::kHasDetection && mode_ != Mode::kObserve) {
+        const auto d2 = Det::distance2(y_est, y_now);
+        out.d = Det::distance(d2);
+        out.contact = Det::is_contact(d2);
+        out.distance_valid = true;
+      }
+    }
+
+    if (mode_ == Mode::kControl) {
+      if (reference_pending_) {
+        stabilizer_.set_reference(y_now);
+        reference_pending_ = false;
+      }
+      if (history_.count() >= 2) {
+        Value x[M::kX];
+        B::x_from_frames(history_.y(0), history_.y(1), x);
+        Value u[M::kU];
+        stabilizer_.plan(net_, x, y_now, pb_, u);
+        B::u_to_physical(u, out.command);
+        out.command_valid = true;
+      }
+    }
+    return out;
+  }
+
+ private:
+  void init_pb() noexcept {
+    if constexpr (M::kHasDetection) {
+      for (int i = 0; i < M::kPb; ++i) pb_[i] = M::kDetectPb[i];
+    } else if constexpr (M::kStates > 0) {
+      for (int i = 0; i < M::kPb; ++i) pb_[i] = M::kPbTable[0][i];
+    }
+  }
+
+  Mode mode_ = Mode::kDetect;
+  Value pb_[M::kPb] = {};
+  Value hold_[M::kU] = {};
+  bool reference_pending_ = true;
+  typename Det::History history_{};
+  HadynetNet<M> net_{};
+  GraspStabilizer<M> stabilizer_{};
+};
+
+}  // namespace hadynet::firmware
+
+#endif  // HADYNET_FIRMWARE_CORE_HADYNET_RUNTIME_H_

@@ -1,0 +1,146 @@
+// What a generated model provides to the firmware core (DESIGN.md §3, §6).
+//
+// `hadynet codegen MODEL --numeric q15|f32` writes one header holding one
+// struct (default `hadynet::model_q15::Model` / `hadynet::model_f32::Model`)
+// whose static constexpr members are listed below. The core's templates take
+// that struct as their parameter; every buffer of the core is sized from its
+// dimensions at compile time. The arrays are static constexpr members, so
+// they live once in read-only data (flash on the MCU), never on the stack.
+//
+// Units. The network works in standardised units (physical minus mean,
+// divided by std, per channel, as the trainer). The core converts at its
+// boundary: physical float32 in, physical float32 out (kXMean/kXInvStd etc.).
+//
+// Numerics. kNumeric selects how `Value` and `Bias` are read:
+//  * kQ15: Value = int16 in a per-tensor Q format (frac-bit counts below),
+//    Bias = int32 already in its accumulator's format, so adding it is exact.
+//    All arithmetic is integer (firmware/core/fixed_point.h), saturating.
+//  * kF32: Value = Bias = float; the kFrac* constants are 0 and unused.
+//
+// Fixed-point formats (frac bits; a Q(F) raw v means v / 2^F):
+//   kFracIn      x, u and p (the encoder input [x;p] and the LSTM input [u;p])
+//   kFracH       h_0 .. h_N (encoder output and LSTM hidden state)
+//   kFracC       LSTM cell state c
+//   kFracY       decoder output y (and the detection mean / error e)
+//   kFracGate    gate pre-activations: 12, the activation tables' input Q3.12
+//   kFracEncW    folded encoder weight;  encoder bias is Q(kFracEncW + kFracIn)
+//   kFracLstmW   both LSTM weight matrices; bias (b_ih + b_hh) is
+//                Q(kFracLstmAcc), kFracLstmAcc = kFracLstmW + max(kFracIn, kFracH)
+//   kFracDecW    decoder weight; decoder bias is Q(kFracDecW + kFracH)
+//   kFracWhiten  detection whitening matrix
+//   kFracZ       whitened detection error z (d = |z|)
+//   kFracLossW   controller loss weights
+#ifndef HADYNET_FIRMWARE_CORE_MODEL_CONTRACT_H_
+#define HADYNET_FIRMWARE_CORE_MODEL_CONTRACT_H_
+
+#include <concepts>
+#include <cstdint>
+#include <type_traits>
+
+namespace hadynet::firmware {
+
+enum class Numeric { kQ15, kF32 };
+
+// The generator version the core was written against; codegen writes the
+// same number into kGeneratorVersion and the core rejects other versions at
+// compile time (a stale generated header fails the build, not the robot).
+inline constexpr int kModelContractVersion = 1;
+
+// Loss class of each observed channel for the grasp stabiliser.
+enum class LossClass : std::uint8_t {
+  kNone = 0,    // not in the loss
+  kForce = 1,   // F = (f, f_contact): weight 1 if est >= ref, else beta
+  kAngle = 2,   // theta: weight w2
+  kLength = 3,  // l: weight w3
+};
+
+// clang-format off
+template <class M>
+concept GeneratedModel = requires {
+  // ---- identity
+  { M::kContractVersion } -> std::convertible_to<int>;        // == kModelContractVersion
+  { M::kGeneratorVersion } -> std::convertible_to<const char*>; // e.g. "hadynet-codegen 0.1.0"
+  { M::kModelHash } -> std::convertible_to<std::uint64_t>;     // FNV-1a 64 of the model file bytes
+  { M::kNumeric } -> std::convertible_to<Numeric>;
+  typename M::Value;                                           // int16_t (q15) or float (f32)
+  typename M::Bias;                                            // int32_t (q15) or float (f32)
+
+  // ---- dimensions (all >= 1 except kStates >= 0)
+  { M::kX } -> std::convertible_to<int>;          // initial-state features (paper: 37)
+  { M::kU } -> std::convertible_to<int>;          // commands (8)
+  { M::kY } -> std::convertible_to<int>;          // observed channels (27)
+  { M::kPb } -> std::convertible_to<int>;         // parametric bias size (8)
+  { M::kHidden } -> std::convertible_to<int>;     // LSTM units (128)
+  { M::kStates } -> std::convertible_to<int>;     // rows of the PB table
+  { M::kTrainSteps } -> std::convertible_to<int>; // N_train
+
+  // ---- formats (see above; 0 in an f32 model)
+  { M::kFracIn } -> std::convertible_to<int>;
+  { M::kFracH } -> std::convertible_to<int>;
+  { M::kFracC } -> std::convertible_to<int>;
+  { M::kFracY } -> std::convertible_to<int>;
+  { M::kFracGate } -> std::convertible_to<int>;
+  { M::kFracEncW } -> std::convertible_to<int>;
+  { M::kFracLstmW } -> std::convertible_to<int>;
+  { M::kFracLstmAcc } -> std::convertible_to<int>;
+  { M::kFracDecW } -> std::convertible_to<int>;
+  { M::kFracWhiten } -> std::convertible_to<int>;
+  { M::kFracZ } -> std::convertible_to<int>;
+  { M::kFracLossW } -> std::convertible_to<int>;
+
+  // ---- channels and standardisation (float32, physical units)
+  // x channel i is y channel kXSource[i] at t (kXIsDelta[i] false) or
+  // y[t] - y[t-1] of that channel (true).
+  M::kXSource;    // const int[kX]
+  M::kXIsDelta;   // const bool[kX]
+  M::kXMean;      // const float[kX]
+  M::kXInvStd;    // const float[kX]   1 / std
+  M::kUMean;      // const float[kU]
+  M::kUStd;       // const float[kU]
+  M::kUInvStd;    // const float[kU]
+  M::kYMean;      // const float[kY]
+  M::kYStd;       // const float[kY]
+  M::kYInvStd;    // const float[kY]
+  M::kYNames;     // const char* const[kY]
+  M::kUNames;     // const char* const[kU]
+
+  // ---- network (standardised units)
+  M::kEncWeight;     // Value[kHidden][kX + kPb]   BN folded; input [x ; p]
+  M::kEncBias;       // Bias[kHidden]
+  M::kLstmWeightIh;  // Value[4*kHidden][kU + kPb] gate order i, f, g, o; input [u ; p]
+  M::kLstmWeightHh;  // Value[4*kHidden][kHidden]
+  M::kLstmBias;      // Bias[4*kHidden]            b_ih + b_hh
+  M::kDecWeight;     // Value[kY][kHidden]
+  M::kDecBias;       // Bias[kY]
+
+  // ---- PB table (Q(kFracIn) or float), with labels
+  M::kPbTable;       // Value[max(kStates,1)][kPb]
+  M::kStateNames;    // const char* const[max(kStates,1)]
+  M::kStateObjects;  // const char* const[max(kStates,1)]
+
+  // ---- contact detection (kHasDetection false: zeros, never used)
+  { M::kHasDetection } -> std::convertible_to<bool>;
+  { M::kDetectSteps } -> std::convertible_to<int>;  // N_detect (>= 1)
+  M::kDetectPb;           // Value[kPb]           PB the detector runs with
+  M::kDetectMean;         // Value[kY]            mu_e, Q(kFracY)
+  M::kDetectWhiten;       // Value[kY][kY]        W with W^T W = Sigma_e^-1 (regularised)
+  M::kDetectThreshold;    // float                C_detect on d
+  M::kDetectThresholdSq;  // q15: int64 C_detect^2 in Q(2*kFracZ); f32: float C_detect^2
+
+  // ---- grasp stabiliser (seed paper III-F; defaults of the generator)
+  { M::kControlHorizon } -> std::convertible_to<int>;     // N_control (8)
+  { M::kControlEpochs } -> std::convertible_to<int>;      // N_epoch (3)
+  { M::kControlAlphaCount } -> std::convertible_to<int>;  // N_batch (4)
+  { M::kControlTruncation } -> std::convertible_to<int>;  // K; >= kControlHorizon = full BPTT
+  M::kControlAlpha;       // Value[kControlAlphaCount] step sizes, Q(kFracIn): L2 norm of
+                          // the step of the whole standardised command sequence
+  M::kLossClass;          // LossClass[kY]
+  M::kLossWeightUp;       // Value[kY] weight where est >= ref, Q(kFracLossW)
+  M::kLossWeightDown;     // Value[kY] weight where est <  ref, Q(kFracLossW)
+  M::kControlActive;      // bool[kU]  commands the stabiliser may change (others: "no change")
+};
+// clang-format on
+
+}  // namespace hadynet::firmware
+
+#endif  // HADYNET_FIRMWARE_CORE_MODEL_CONTRACT_H_

@@ -1,0 +1,183 @@
+// The two numerics of a generated model (model_contract.h), behind one set of
+// names so that the network, detector and controller are written once:
+//   q15: Value int16 in a Q format, accumulators int64 (exact), gradients
+//        int32 at one common scale, every narrowing rounded and saturated
+//        (fixed_point.h);
+//   f32: Value, accumulators and gradients float.
+// Frac-bit template arguments are ignored by the f32 versions.
+#ifndef HADYNET_FIRMWARE_CORE_NUMERICS_H_
+#define HADYNET_FIRMWARE_CORE_NUMERICS_H_
+
+#include <cmath>
+#include <cstdint>
+#include <type_traits>
+
+#include "firmware/core/activation.h"
+#include "firmware/core/fixed_point.h"
+#include "firmware/core/model_contract.h"
+
+namespace hadynet::firmware {
+
+template <class M>
+inline constexpr bool kIsFixed = M::kNumeric == Numeric::kQ15;
+
+// Gradient scale of the q15 controller: gradients are int32 with this many
+// fractional bits after the loss gradient has been scaled so that its
+// largest entry is 1.0 (see grasp_stabilizer.h). 2^20 leaves 11 bits of
+// headroom for growth through the network before saturation.
+inline constexpr int kGradFracBits = 20;
+
+template <GeneratedModel M>
+struct Numerics {
+  using Value = typename M::Value;
+  static constexpr bool kFixed = kIsFixed<M>;
+  using Acc = std::conditional_t<kFixed, std::int64_t, float>;   // dot products
+  using Grad = std::conditional_t<kFixed, std::int32_t, float>;  // controller gradients
+  static_assert(std::is_same_v<Value, std::conditional_t<kFixed, std::int16_t, float>>,
+                "Value must be int16_t (q15) or float (f32)");
+  static_assert(std::is_same_v<typename M::Bias, std::conditional_t<kFixed, std::int32_t, float>>,
+                "Bias must be int32_t (q15) or float (f32)");
+
+  // sum_i a[i] * b[i] (q15: exact, in Q(fa + fb)).
+  static constexpr Acc dot(const Value* a, const Value* b, int n) noexcept {
+    if constexpr (kFixed) {
+      return fixed::dot(a, b, n);
+    } else {
+      float acc = 0.0f;
+      for (int i = 0; i < n; ++i) acc += a[i] * b[i];
+      return acc;
+    }
+  }
+
+  // Standardised real value -> Value in Q(Frac) (rounded, saturated).
+  template <int Frac>
+  static constexpr Value from_real(float v) noexcept {
+    if constexpr (kFixed) {
+      return fixed::to_q<Frac>(v);
+    } else {
+      return v;
+    }
+  }
+
+  // Value in Q(Frac) -> real.
+  template <int Frac>
+  static constexpr float to_real(Value v) noexcept {
+    if constexpr (kFixed) {
+      return fixed::to_real<Frac, float>(v);
+    } else {
+      return v;
+    }
+  }
+
+  // Accumulator in Q(FromFrac) -> Value in Q(ToFrac).
+  template <int FromFrac, int ToFrac>
+  static constexpr Value narrow(Acc acc) noexcept {
+    if constexpr (kFixed) {
+      return fixed::requantize_i16<FromFrac, ToFrac>(acc);
+    } else {
+      return acc;
+    }
+  }
+
+  // Activations: input Q(kFracGate) = Q3.12, output Q15 (or float).
+  static Value sigmoid(Value x) noexcept {
+    if constexpr (kFixed) {
+      return fixed::sigmoid_q15(x);
+    } else {
+      return 1.0f / (1.0f + std::exp(-x));
+    }
+  }
+  static Value tanh(Value x) noexcept {
+    if constexpr (kFixed) {
+      return fixed::tanh_q15(x);
+    } else {
+      return std::tanh(x);
+    }
+  }
+
+  // a * b with a in Q(AFrac), b in Q(BFrac) -> Q(YFrac).
+  template <int AFrac, int BFrac, int YFrac>
+  static constexpr Value mul(Value a, Value b) noexcept {
+    if constexpr (kFixed) {
+      return fixed::mul<AFrac, BFrac, YFrac>(a, b);
+    } else {
+      return a * b;
+    }
+  }
+
+  // ---- gradients (controller backward pass)
+
+  // g * a, g a gradient (common scale), a a Value in Q(AFrac): result at the
+  // gradient scale, rounded and saturated to int32.
+  template <int AFrac>
+  static constexpr Grad grad_mul(Grad g, Value a) noexcept {
+    if constexpr (kFixed) {
+      return fixed::requantize_i32<AFrac, 0>(std::int64_t{g} * a);
+    } else {
+      return g * a;
+    }
+  }
+  // g * s with s a Q15 factor held in int32 (may be 1.0 = 32768).
+  static constexpr Grad grad_mul_q15(Grad g, std::conditional_t<kFixed, std::int32_t, float> s) noexcept {
+    if constexpr (kFixed) {
+      return fixed::requantize_i32<15, 0>(std::int64_t{g} * s);
+    } else {
+      return g * s;
+    }
+  }
+  static constexpr Grad grad_add(Grad a, Grad b) noexcept {
+    if constexpr (kFixed) {
+      return fixed::add_sat32(a, b);
+    } else {
+      return a + b;
+    }
+  }
+  // sigma'(z) from the activated value s = sigma(z): s (1 - s), Q15 in int32.
+  static constexpr auto sigmoid_slope(Value s) noexcept {
+    if constexpr (kFixed) {
+      const std::int32_t one = 1 << 15;
+      return static_cast<std::int32_t>(fixed::rounding_shift_right(std::int64_t{s} * (one - s), 15));
+    } else {
+      return s * (1.0f - s);
+    }
+  }
+  // tanh'(z) from t = tanh(z): 1 - t^2, Q15 in int32.
+  static constexpr auto tanh_slope(Value t) noexcept {
+    if constexpr (kFixed) {
+      const std::int32_t one = 1 << 15;
+      return one - static_cast<std::int32_t>(fixed::rounding_shift_right(std::int64_t{t} * t, 15));
+    } else {
+      return 1.0f - t * t;
+    }
+  }
+  // Wide accumulator of gradient products (int64 / float).
+  using GradAcc = std::conditional_t<kFixed, std::int64_t, float>;
+
+  // out[c] = sum_r w[r][c] * g[r] for c < n_cols (first columns of W^T g),
+  // w in Q(WFrac), g and out at the gradient scale. Row-wise (axpy) order so
+  // both w and g are read contiguously; `scratch` holds n_cols accumulators.
+  // q15: exact int64 sums (|w g| < 2^46, Rows < 2^17), one rounding per
+  // output, saturated to int32.
+  template <int WFrac, int Rows, int Cols>
+  static constexpr void transposed_matvec(const Value (&w)[Rows][Cols], const Grad* g, int n_cols,
+                                          Grad* out, GradAcc* scratch) noexcept {
+    for (int c = 0; c < n_cols; ++c) scratch[c] = 0;
+    for (int r = 0; r < Rows; ++r) {
+      const Grad gr = g[r];
+      if (gr == 0) continue;  // same result, skips dead gates
+      const Value* row = w[r];
+      for (int c = 0; c < n_cols; ++c) scratch[c] += static_cast<GradAcc>(row[c]) * gr;
+    }
+    for (int c = 0; c < n_cols; ++c) {
+      if constexpr (kFixed) {
+        out[c] = fixed::requantize_i32<WFrac, 0>(scratch[c]);
+      } else {
+        out[c] = scratch[c];
+      }
+    }
+  }
+};
+
+}  // namespace hadynet::firmware
+
+#endif  // HADYNET_FIRMWARE_CORE_NUMERICS_H_

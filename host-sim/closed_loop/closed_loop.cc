@@ -1,0 +1,104 @@
+#include "host-sim/closed_loop/closed_loop.h"
+
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+#include "firmware/core/hadynet_runtime.h"
+#include "hadynet_model_f32.h"
+#include "hadynet_model_q15.h"
+#include "host-sim/plant/grasp_session.h"
+
+namespace hadynet::hostsim {
+
+namespace {
+
+template <class M>
+double loss_to_real(typename firmware::GraspStabilizer<M>::Loss l) {
+  if constexpr (firmware::kIsFixed<M>) {
+    return static_cast<double>(l) / static_cast<double>(std::int64_t{1} << (2 * M::kFracY + M::kFracLossW));
+  } else {
+    return static_cast<double>(l);
+  }
+}
+
+template <class M>
+ClosedLoopRun run_with(const ClosedLoopOptions& opt) {
+  plant::GraspSession session(opt.object, opt.init_id, opt.wear_level, opt.seed, opt.disturbance);
+  // The model's channels in the plant's order.
+  std::vector<std::size_t> y_index(M::kY), u_index(M::kU);
+  for (int i = 0; i < M::kY; ++i) {
+    std::size_t k = 0;
+    while (k < session.y_names().size() && session.y_names()[k] != M::kYNames[i]) ++k;
+    if (k == session.y_names().size())
+      throw std::invalid_argument(std::string("the plant has no channel '") + M::kYNames[i] + "'");
+    y_index[static_cast<std::size_t>(i)] = k;
+  }
+  for (int i = 0; i < M::kU; ++i) {
+    std::size_t k = 0;
+    while (k < session.u_names().size() && session.u_names()[k] != M::kUNames[i]) ++k;
+    if (k == session.u_names().size())
+      throw std::invalid_argument(std::string("the plant has no command '") + M::kUNames[i] + "'");
+    u_index[static_cast<std::size_t>(i)] = k;
+  }
+
+  auto rt = std::make_unique<firmware::HadynetRuntime<M>>();
+  if (!opt.pb_state.empty()) {
+    int state = -1;
+    for (int k = 0; k < M::kStates; ++k)
+      if (opt.pb_state == M::kStateNames[k]) state = k;
+    if (state < 0) throw std::invalid_argument("PB state '" + opt.pb_state + "' is not in the compiled model");
+    rt->set_pb_state(state);
+  }
+  if (opt.control_epochs >= 0) rt->control_settings().epochs = opt.control_epochs;
+  if (opt.control_truncation >= 1) rt->control_settings().truncation = opt.control_truncation;
+  rt->set_mode(opt.control ? firmware::Mode::kControl : firmware::Mode::kDetect);
+
+  ClosedLoopRun run;
+  for (int i = 0; i < M::kU; ++i) run.u_names.emplace_back(M::kUNames[i]);
+  const std::vector<double> y_ref = session.y_grasp();
+  firmware::SensorFrame<M> frame{};
+  std::vector<double> u(session.u_names().size(), 0.0);
+  for (int t = 0; t <= opt.steps; ++t) {
+    const std::vector<double>& y = session.y();
+    for (int i = 0; i < M::kY; ++i) frame.y[i] = static_cast<float>(y[y_index[static_cast<std::size_t>(i)]]);
+    for (int i = 0; i < M::kU; ++i)
+      frame.u_prev[i] = static_cast<float>(session.last_u()[u_index[static_cast<std::size_t>(i)]]);
+    const firmware::StepResult<M> r = rt->step(frame);
+    ClosedLoopStep s;
+    s.step = t;
+    s.grasp_error = plant::grasp_error(y, y_ref, session.y_names());
+    const auto& f = session.last_wrench().force_N;
+    s.force_N = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    s.contact = r.contact;
+    s.d = r.d;
+    std::fill(u.begin(), u.end(), 0.0);
+    if (opt.control && r.command_valid)
+      for (int i = 0; i < M::kU; ++i) u[u_index[static_cast<std::size_t>(i)]] = r.command[i];
+    s.command.assign(M::kU, 0.0);
+    for (int i = 0; i < M::kU; ++i) s.command[static_cast<std::size_t>(i)] = u[u_index[static_cast<std::size_t>(i)]];
+    if (opt.control && r.command_valid) {
+      s.loss_initial = loss_to_real<M>(rt->stabilizer().loss_initial());
+      s.loss_final = loss_to_real<M>(rt->stabilizer().loss_final());
+    }
+    run.steps.push_back(std::move(s));
+    if (t < opt.steps) session.step(u);
+  }
+  return run;
+}
+
+}  // namespace
+
+double ClosedLoopRun::mean_error(std::size_t begin, std::size_t end) const {
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = begin; i < end && i < steps.size(); ++i, ++n) sum += steps[i].grasp_error;
+  return n ? sum / static_cast<double>(n) : 0.0;
+}
+
+ClosedLoopRun run_closed_loop(const ClosedLoopOptions& options) {
+  return options.numeric == ReplayNumeric::kQ15 ? run_with<model_q15::Model>(options)
+                                                : run_with<model_f32::Model>(options);
+}
+
+}  // namespace hadynet::hostsim

@@ -1,0 +1,54 @@
+// Host-sim in closed loop with the MuJoCo hand: the firmware core (build's
+// generated model, q15 or f32) runs the grasp stabiliser every 0.2 s on a
+// grasp that a scripted disturbance works loose (GraspSession). The seed
+// paper's grasp-stabiliser experiment (section IV-E): the evaluation value
+// E = h_loss,1 stays flat with the stabiliser and grows without it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "host-sim/plant/disturbance.h"
+#include "host-sim/plant/hand_spec.h"
+#include "host-sim/replay/replay.h"
+
+namespace hadynet::hostsim {
+
+struct ClosedLoopOptions {
+  plant::ObjectKind object = plant::ObjectKind::kCylinder;
+  int init_id = 3;           // dynamics state of the grasp (3: not in the paper training set)
+  double wear_level = 0.0;
+  std::uint64_t seed = 1;    // dataset seed (grasp motion and sensor noise derive from it)
+  plant::Disturbance disturbance = plant::default_strike();
+  int steps = 100;           // control periods after the grasp
+  bool control = true;       // false: hold (u = 0), the firmware only observes
+  ReplayNumeric numeric = ReplayNumeric::kQ15;
+  std::string pb_state;      // PB table state the stabiliser predicts with ("": the default PB)
+  int control_epochs = -1;   // -1: the model's default
+  int control_truncation = -1;
+};
+
+struct ClosedLoopStep {
+  int step = 0;                 // periods since the grasp
+  double grasp_error = 0.0;     // E of y_step against y_ref (N^2, beta = 3; plant::grasp_error)
+  double force_N = 0.0;         // |disturbance force| during the step that led here
+  bool contact = false;         // the firmware's contact flag
+  float d = 0.0f;
+  std::vector<double> command;  // u applied after this period (physical)
+  double loss_initial = 0.0;    // stabiliser's predicted L of its warm start (standardised)
+  double loss_final = 0.0;      // predicted L of the adopted sequence
+};
+
+struct ClosedLoopRun {
+  std::vector<std::string> u_names;
+  std::vector<ClosedLoopStep> steps;  // steps + 1 rows: the grasp (y_ref) and every period
+  // Mean E over a row range [begin, end).
+  double mean_error(std::size_t begin, std::size_t end) const;
+};
+
+// Runs one closed loop. Throws std::invalid_argument for an unknown PB state
+// or a plant whose channels the compiled model does not read.
+ClosedLoopRun run_closed_loop(const ClosedLoopOptions& options);
+
+}  // namespace hadynet::hostsim

@@ -1,0 +1,154 @@
+#include "host-sim/replay/replay.h"
+
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+
+#include "hadynet_model_f32.h"
+#include "hadynet_model_q15.h"
+
+namespace hadynet::hostsim {
+
+namespace {
+
+template <class M>
+CompiledModelInfo info_of() {
+  CompiledModelInfo info;
+  info.generator = M::kGeneratorVersion;
+  info.hash = M::kModelHash;
+  info.x = M::kX;
+  info.u = M::kU;
+  info.y = M::kY;
+  info.pb = M::kPb;
+  info.hidden = M::kHidden;
+  info.states = M::kStates;
+  info.detect_steps = M::kDetectSteps;
+  info.has_detection = M::kHasDetection;
+  info.detect_threshold = M::kDetectThreshold;
+  info.control_horizon = M::kControlHorizon;
+  info.control_epochs = M::kControlEpochs;
+  info.control_truncation = M::kControlTruncation;
+  for (int i = 0; i < M::kY; ++i) info.y_names.emplace_back(M::kYNames[i]);
+  for (int i = 0; i < M::kU; ++i) info.u_names.emplace_back(M::kUNames[i]);
+  for (int i = 0; i < M::kStates; ++i) info.state_names.emplace_back(M::kStateNames[i]);
+  return info;
+}
+
+// Column index of every model channel in the log, in model order.
+std::vector<std::size_t> map_columns(const datalog::LogTable& log, const std::string& file,
+                                     const std::vector<std::string>& names) {
+  std::vector<std::size_t> cols;
+  for (const auto& name : names) {
+    const auto c = log.column_index(name);
+    if (!c) throw std::runtime_error(file + ": no column '" + name + "', which the compiled model reads");
+    cols.push_back(*c);
+  }
+  return cols;
+}
+
+template <class M>
+double loss_to_real(typename firmware::GraspStabilizer<M>::Loss l) {
+  if constexpr (firmware::kIsFixed<M>) {
+    return static_cast<double>(l) / static_cast<double>(std::int64_t{1} << (2 * M::kFracY + M::kFracLossW));
+  } else {
+    return static_cast<double>(l);
+  }
+}
+
+template <class M>
+ReplayResult replay_with(const datalog::LogTable& log, const std::string& file, const ReplayOptions& opt) {
+  const CompiledModelInfo info = info_of<M>();
+  const auto y_cols = map_columns(log, file, info.y_names);
+  const auto u_cols = map_columns(log, file, info.u_names);
+  const auto t_col = log.column_index("t");
+
+  // The runtime holds the network, traces and history (~tens of KiB): on
+  // the heap here, a static object on the MCU.
+  auto rt = std::make_unique<firmware::HadynetRuntime<M>>();
+  if (!opt.pb.empty()) {
+    if (static_cast<int>(opt.pb.size()) != M::kPb)
+      throw std::invalid_argument("PB has " + std::to_string(opt.pb.size()) + " values, the model " +
+                                  std::to_string(M::kPb));
+    float pb[M::kPb];
+    for (int i = 0; i < M::kPb; ++i) pb[i] = opt.pb[static_cast<std::size_t>(i)];
+    rt->set_pb(pb);
+  } else if (opt.pb_state >= 0 && !rt->set_pb_state(opt.pb_state)) {
+    throw std::invalid_argument("PB state " + std::to_string(opt.pb_state) + " is not in the model's table (" +
+                                std::to_string(M::kStates) + " states)");
+  }
+  if (opt.control_epochs >= 0) rt->control_settings().epochs = opt.control_epochs;
+  if (opt.control_truncation >= 1) rt->control_settings().truncation = opt.control_truncation;
+  rt->set_mode(opt.mode);
+
+  ReplayResult result;
+  result.y_names = info.y_names;
+  result.u_names = info.u_names;
+  result.steps.reserve(log.rows());
+  firmware::SensorFrame<M> frame{};
+  for (std::size_t row = 0; row < log.rows(); ++row) {
+    if (opt.control_from >= 0 && row == static_cast<std::size_t>(opt.control_from))
+      rt->set_mode(firmware::Mode::kControl);
+    for (int i = 0; i < M::kY; ++i) frame.y[i] = static_cast<float>(log.at(row, y_cols[static_cast<std::size_t>(i)]));
+    for (int i = 0; i < M::kU; ++i)
+      frame.u_prev[i] = row == 0 ? 0.0f : static_cast<float>(log.at(row - 1, u_cols[static_cast<std::size_t>(i)]));
+    const firmware::StepResult<M> r = rt->step(frame);
+    ReplayStep s;
+    s.time = t_col ? log.at(row, *t_col) : static_cast<double>(row);
+    s.prediction_valid = r.prediction_valid;
+    s.prediction.assign(r.prediction, r.prediction + M::kY);
+    s.distance_valid = r.distance_valid;
+    s.d = r.d;
+    s.contact = r.contact;
+    s.command_valid = r.command_valid;
+    s.command.assign(r.command, r.command + M::kU);
+    if (r.command_valid) {
+      s.loss_initial = loss_to_real<M>(rt->stabilizer().loss_initial());
+      s.loss_final = loss_to_real<M>(rt->stabilizer().loss_final());
+    }
+    result.steps.push_back(std::move(s));
+  }
+  return result;
+}
+
+void append_float(std::string& s, double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, ",%.9g", v);
+  s += buf;
+}
+
+}  // namespace
+
+CompiledModelInfo compiled_model_info(ReplayNumeric numeric) {
+  return numeric == ReplayNumeric::kQ15 ? info_of<model_q15::Model>() : info_of<model_f32::Model>();
+}
+
+ReplayResult replay_log(const datalog::LogTable& log, const std::string& file, const ReplayOptions& options) {
+  return options.numeric == ReplayNumeric::kQ15 ? replay_with<model_q15::Model>(log, file, options)
+                                                : replay_with<model_f32::Model>(log, file, options);
+}
+
+std::string format_replay_csv(const ReplayResult& result) {
+  std::string s = "t,prediction_valid";
+  for (const auto& n : result.y_names) s += ",est_" + n;
+  s += ",distance_valid,d,contact,command_valid";
+  for (const auto& n : result.u_names) s += ",cmd_" + n;
+  s += ",loss_initial,loss_final\n";
+  for (const auto& st : result.steps) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.9g", st.time);
+    s += buf;
+    s += st.prediction_valid ? ",1" : ",0";
+    for (float v : st.prediction) append_float(s, v);
+    s += st.distance_valid ? ",1" : ",0";
+    append_float(s, st.d);
+    s += st.contact ? ",1" : ",0";
+    s += st.command_valid ? ",1" : ",0";
+    for (float v : st.command) append_float(s, v);
+    append_float(s, st.loss_initial);
+    append_float(s, st.loss_final);
+    s += '\n';
+  }
+  return s;
+}
+
+}  // namespace hadynet::hostsim

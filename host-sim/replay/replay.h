@@ -1,0 +1,71 @@
+// Host-sim replay: the firmware core, built for the PC from the same sources,
+// fed a recorded log frame by frame (hadynet replay). Per step it records
+// what the firmware would report: HADYNET's estimate of y_t, the contact
+// distance d and flag, and the grasp stabiliser's command. Deterministic:
+// the same log and options give bit-identical results (q15 and f32 alike).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "datalog/log_table.h"
+#include "firmware/core/hadynet_runtime.h"
+
+namespace hadynet::hostsim {
+
+enum class ReplayNumeric { kQ15, kF32 };
+
+struct ReplayOptions {
+  ReplayNumeric numeric = ReplayNumeric::kQ15;
+  firmware::Mode mode = firmware::Mode::kDetect;  // mode before control_from
+  int control_from = -1;       // row at which control mode starts (y_ref = y of that row); -1 never
+  int pb_state = -1;           // PB table row; -1: the model's default (detection PB)
+  std::vector<float> pb;       // explicit standardised PB; overrides pb_state if non-empty
+  int control_epochs = -1;     // -1: the model's default
+  int control_truncation = -1; // -1: the model's default
+};
+
+// One replayed step (log row t). Physical units except d and the losses
+// (standardised, as the firmware computes them).
+struct ReplayStep {
+  double time = 0.0;
+  bool prediction_valid = false;
+  std::vector<float> prediction;  // y_est_t
+  bool distance_valid = false;
+  float d = 0.0f;
+  bool contact = false;
+  bool command_valid = false;
+  std::vector<float> command;  // u_t from the stabiliser
+  double loss_initial = 0.0;   // stabiliser: L of the warm start
+  double loss_final = 0.0;     // stabiliser: L of the adopted sequence
+};
+
+struct ReplayResult {
+  std::vector<std::string> y_names, u_names;
+  std::vector<ReplayStep> steps;
+};
+
+// What the compiled-in generated model is (for --help, info and checks).
+struct CompiledModelInfo {
+  std::string generator;
+  std::uint64_t hash = 0;
+  int x = 0, u = 0, y = 0, pb = 0, hidden = 0, states = 0, detect_steps = 0;
+  bool has_detection = false;
+  float detect_threshold = 0.0f;  // C_detect
+  int control_horizon = 0, control_epochs = 0, control_truncation = 0;
+  std::vector<std::string> y_names, u_names, state_names;
+};
+CompiledModelInfo compiled_model_info(ReplayNumeric numeric);
+
+// Replays `log` (read from `file`, named in errors). Throws
+// std::runtime_error naming the file if the log lacks a channel of the
+// compiled model, std::invalid_argument for bad options (PB size or state).
+ReplayResult replay_log(const datalog::LogTable& log, const std::string& file,
+                        const ReplayOptions& options);
+
+// CSV: t, valid flags, y_est_<y>..., d, contact, u_<u>..., losses; floats
+// with 9 significant digits (float round trip).
+std::string format_replay_csv(const ReplayResult& result);
+
+}  // namespace hadynet::hostsim
