@@ -3,8 +3,10 @@
 # install dependencies, build, record the seed paper's dataset from the plant,
 # validate it and plot it, then the seed paper's experiments with the trainer
 # (scripts/paper_experiments.sh: train, adapt, recognise, online PB, detection,
-# simulation; summary in out/paper/summary.md). Later stages (codegen, replay)
-# join here as they land.
+# simulation; summary in out/paper/summary.md), then codegen of the trained
+# model and the firmware core on it (scripts/firmware_experiments.sh: replay
+# of held-out logs, the grasp stabiliser in closed loop with the plant;
+# summary in out/firmware/summary.md).
 # Usage: scripts/main.sh [DATA_DIR] [RESULTS_DIR]   (defaults: data/paper, out/paper)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -26,3 +28,5 @@ for log in "$out"/train/*_random2_i0_w0.csv "$out"/novel/*_random2_*.csv; do
 done
 echo "== the seed paper's experiments -> $results"
 scripts/paper_experiments.sh "$out" "$results"
+echo "== codegen and the firmware core on the trained model -> out/firmware"
+scripts/firmware_experiments.sh "$results/hadynet_detect.safetensors" "$out" out/firmware

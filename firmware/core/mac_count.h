@@ -43,10 +43,12 @@ struct MacCount {
     return total;
   }
   // One control period in the worst case (no early stop): encode x_t, the
+  // hold rollout of the relative reference (GraspStabilizer::Reference), the
   // warm start's rollout, then per epoch one gradient and N_batch rollouts.
-  static constexpr long control(int epochs, int truncation) {
+  static constexpr long control(int epochs, int truncation, bool relative_reference = true) {
     const long rollout = M::kControlHorizon * step;
-    return encode + rollout + epochs * (gradient(truncation) + M::kControlAlphaCount * rollout);
+    return encode + (relative_reference ? rollout : 0) + rollout +
+           epochs * (gradient(truncation) + M::kControlAlphaCount * rollout);
   }
   static constexpr long control_default = control(M::kControlEpochs, M::kControlTruncation);
   // The firmware's period in control mode: detection plus the stabiliser.

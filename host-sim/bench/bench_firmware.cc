@@ -113,8 +113,11 @@ int main(int argc, char** argv) {
   std::printf("      detection (N_detect %d) %ld; stabiliser (horizon %d, %d epochs x %d step sizes, K %d) %ld;\n",
               Q::kDetectSteps, MC::detect, Q::kControlHorizon, Q::kControlEpochs, Q::kControlAlphaCount,
               Q::kControlTruncation, MC::control_default);
-  std::printf("      control period (detection + stabiliser) %ld; stabiliser with K = 1: %ld\n\n",
+  std::printf("      control period (detection + stabiliser) %ld; stabiliser with K = 1: %ld\n",
               MC::period_control, MC::control(Q::kControlEpochs, 1));
+  std::printf("RAM: the whole runtime object (network state, history, stabiliser traces): q15 %zu bytes, "
+              "f32 %zu bytes\n\n",
+              sizeof(hadynet::firmware::HadynetRuntime<Q>), sizeof(hadynet::firmware::HadynetRuntime<F>));
 
   // Baseline: the trainer's Eigen float forward of one detection window.
   const hadynet::trainer::HadynetModel model = hadynet::trainer::load_model(HADYNET_MODEL_PATH);

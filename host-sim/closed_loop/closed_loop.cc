@@ -52,6 +52,11 @@ ClosedLoopRun run_with(const ClosedLoopOptions& opt) {
   }
   if (opt.control_epochs >= 0) rt->control_settings().epochs = opt.control_epochs;
   if (opt.control_truncation >= 1) rt->control_settings().truncation = opt.control_truncation;
+  auto& settings = rt->control_settings();
+  if (opt.absolute_reference) settings.reference = firmware::GraspStabilizer<M>::Reference::kAbsolute;
+  if (opt.adopt_best_always) settings.keep_if_no_descent = false;
+  if (opt.all_commands)
+    for (bool& a : settings.active) a = true;
   rt->set_mode(opt.control ? firmware::Mode::kControl : firmware::Mode::kDetect);
 
   ClosedLoopRun run;

@@ -27,6 +27,10 @@ struct ClosedLoopOptions {
   std::string pb_state;      // PB table state the stabiliser predicts with ("": the default PB)
   int control_epochs = -1;   // -1: the model's default
   int control_truncation = -1;
+  // Ablations of the stabiliser's design choices (grasp_stabilizer.h):
+  bool absolute_reference = false;  // the paper's r_k = y_ref instead of relative to holding still
+  bool adopt_best_always = false;   // the paper's rule: adopt the best step size even if L rises
+  bool all_commands = false;        // let it move every command, not only the model's active ones
 };
 
 struct ClosedLoopStep {
