@@ -34,6 +34,9 @@ constexpr Command kCommands[] = {
      hadynet::cli::run_codegen},
     {"replay", "host-sim: replay a log through the firmware core (prediction, d, contact, command)",
      hadynet::cli::run_replay},
+    {"stabilize",
+     "host-sim: the grasp stabiliser in closed loop with the MuJoCo hand under a scripted disturbance (E with/without)",
+     hadynet::cli::run_stabilize},
 };
 
 void print_help() {

@@ -75,7 +75,7 @@ int run_replay(int argc, char** argv) {
               "x_{t-N} and u_[t-N,t) (N = N_detect), the Mahalanobis distance d, the contact flag\n"
               "d > C_detect and, in control mode, the grasp stabiliser's command u_t (advisory: the\n"
               "log's own commands keep driving the replay). Bit-identical across runs.",
-              "hadynet replay LOG --out CSV [options]");
+              "LOG --out CSV [options]");
   opt.value("out", "CSV", "per-step results (required)");
   opt.value("numeric", "q15|f32", "which generated build of the core", "q15");
   opt.value("mode", "observe|detect|control", "firmware mode from the first row", "detect");
@@ -166,6 +166,11 @@ int run_replay(int argc, char** argv) {
     }
   }
 
+  if (!ro.pb.empty() && static_cast<int>(ro.pb.size()) != info.pb) {
+    std::fprintf(stderr, "hadynet replay: --pb has %zu values, the compiled model's PB has %d\n", ro.pb.size(),
+                 info.pb);
+    return 2;
+  }
   const std::string log_path = opt.positional()[0];
   try {
     const datalog::LogTable log = datalog::read_log(log_path);

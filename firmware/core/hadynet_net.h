@@ -101,6 +101,13 @@ class HadynetNet {
     decode(y);
   }
 
+  // Contact simulation: N steps from the current state with commands
+  // u[0..N) (Q(kFracIn)), predictions y[k] of step k (Q(kFracY)).
+  template <int Steps>
+  void rollout(const Value (&u)[Steps][kU], Value (&y)[Steps][kY]) noexcept {
+    for (int k = 0; k < Steps; ++k) step(u[k], y[k]);
+  }
+
   // y = W_dec h + b_dec of the current hidden state.
   void decode(Value (&y)[kY]) const noexcept {
     for (int r = 0; r < kY; ++r) {

@@ -104,6 +104,23 @@ TEST(FirmwareEdgeCases, NetworkSaturatesInsteadOfOverflowing) {
   }
 }
 
+// rollout() is step() repeated: same outputs, same final state.
+TEST(FirmwareNet, RolloutEqualsRepeatedSteps) {
+  HadynetNet<Q> a, b;
+  Q::Value x[Q::kX] = {}, u[4][Q::kU] = {}, ya[4][Q::kY], yb[Q::kY];
+  for (int i = 0; i < Q::kX; ++i) x[i] = static_cast<Q::Value>(100 * (i % 7) - 300);
+  for (int k = 0; k < 4; ++k)
+    for (int i = 0; i < Q::kU; ++i) u[k][i] = static_cast<Q::Value>(50 * (k + i) - 200);
+  a.encode(x, Q::kPbTable[0]);
+  b.encode(x, Q::kPbTable[0]);
+  a.rollout(u, ya);
+  for (int k = 0; k < 4; ++k) {
+    b.step(u[k], yb);
+    EXPECT_EQ(std::memcmp(ya[k], yb, sizeof yb), 0) << k;
+  }
+  EXPECT_EQ(std::memcmp(a.hidden(), b.hidden(), sizeof(Q::Value) * Q::kHidden), 0);
+}
+
 // Malformed sensor values reach no undefined behaviour and produce finite,
 // flagged results; the runtime keeps working on good frames afterwards.
 TEST(FirmwareEdgeCases, RuntimeSurvivesGarbageFrames) {
