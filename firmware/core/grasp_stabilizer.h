@@ -146,6 +146,15 @@ class GraspStabilizer {
       for (int i = 0; i < kU; ++i) seq_[k][i] = seq_[k + 1][i];
   }
 
+  // A loss as a real number (q15: Q(2 kFracY + kFracLossW) -> real).
+  static float loss_value(Loss l) noexcept {
+    if constexpr (N::kFixed) {
+      return static_cast<float>(l) / static_cast<float>(std::int64_t{1} << (2 * M::kFracY + M::kFracLossW));
+    } else {
+      return l;
+    }
+  }
+
   // Diagnostics of the last plan().
   Loss loss_initial() const noexcept { return loss_initial_; }  // warm start's L
   Loss loss_final() const noexcept { return loss_final_; }      // adopted sequence's L

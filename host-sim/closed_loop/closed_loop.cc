@@ -13,34 +13,20 @@ namespace hadynet::hostsim {
 
 namespace {
 
-template <class M>
-double loss_to_real(typename firmware::GraspStabilizer<M>::Loss l) {
-  if constexpr (firmware::kIsFixed<M>) {
-    return static_cast<double>(l) / static_cast<double>(std::int64_t{1} << (2 * M::kFracY + M::kFracLossW));
-  } else {
-    return static_cast<double>(l);
-  }
+// Position of `name` in `names`; throws std::invalid_argument naming it.
+std::size_t index_of(const std::vector<std::string>& names, const char* name, const char* what) {
+  for (std::size_t k = 0; k < names.size(); ++k)
+    if (names[k] == name) return k;
+  throw std::invalid_argument(std::string("the plant has no ") + what + " '" + name + "'");
 }
 
 template <class M>
 ClosedLoopRun run_with(const ClosedLoopOptions& opt) {
   plant::GraspSession session(opt.object, opt.init_id, opt.wear_level, opt.seed, opt.disturbance);
   // The model's channels in the plant's order.
-  std::vector<std::size_t> y_index(M::kY), u_index(M::kU);
-  for (int i = 0; i < M::kY; ++i) {
-    std::size_t k = 0;
-    while (k < session.y_names().size() && session.y_names()[k] != M::kYNames[i]) ++k;
-    if (k == session.y_names().size())
-      throw std::invalid_argument(std::string("the plant has no channel '") + M::kYNames[i] + "'");
-    y_index[static_cast<std::size_t>(i)] = k;
-  }
-  for (int i = 0; i < M::kU; ++i) {
-    std::size_t k = 0;
-    while (k < session.u_names().size() && session.u_names()[k] != M::kUNames[i]) ++k;
-    if (k == session.u_names().size())
-      throw std::invalid_argument(std::string("the plant has no command '") + M::kUNames[i] + "'");
-    u_index[static_cast<std::size_t>(i)] = k;
-  }
+  std::vector<std::size_t> y_index, u_index;
+  for (int i = 0; i < M::kY; ++i) y_index.push_back(index_of(session.y_names(), M::kYNames[i], "channel"));
+  for (int i = 0; i < M::kU; ++i) u_index.push_back(index_of(session.u_names(), M::kUNames[i], "command"));
 
   auto rt = std::make_unique<firmware::HadynetRuntime<M>>();
   if (!opt.pb_state.empty()) {
@@ -83,8 +69,8 @@ ClosedLoopRun run_with(const ClosedLoopOptions& opt) {
     s.command.assign(M::kU, 0.0);
     for (int i = 0; i < M::kU; ++i) s.command[static_cast<std::size_t>(i)] = u[u_index[static_cast<std::size_t>(i)]];
     if (opt.control && r.command_valid) {
-      s.loss_initial = loss_to_real<M>(rt->stabilizer().loss_initial());
-      s.loss_final = loss_to_real<M>(rt->stabilizer().loss_final());
+      s.loss_initial = firmware::GraspStabilizer<M>::loss_value(rt->stabilizer().loss_initial());
+      s.loss_final = firmware::GraspStabilizer<M>::loss_value(rt->stabilizer().loss_final());
     }
     run.steps.push_back(std::move(s));
     if (t < opt.steps) session.step(u);

@@ -47,15 +47,6 @@ std::vector<std::size_t> map_columns(const datalog::LogTable& log, const std::st
 }
 
 template <class M>
-double loss_to_real(typename firmware::GraspStabilizer<M>::Loss l) {
-  if constexpr (firmware::kIsFixed<M>) {
-    return static_cast<double>(l) / static_cast<double>(std::int64_t{1} << (2 * M::kFracY + M::kFracLossW));
-  } else {
-    return static_cast<double>(l);
-  }
-}
-
-template <class M>
 ReplayResult replay_with(const datalog::LogTable& log, const std::string& file, const ReplayOptions& opt) {
   const CompiledModelInfo info = info_of<M>();
   const auto y_cols = map_columns(log, file, info.y_names);
@@ -102,8 +93,8 @@ ReplayResult replay_with(const datalog::LogTable& log, const std::string& file, 
     s.command_valid = r.command_valid;
     s.command.assign(r.command, r.command + M::kU);
     if (r.command_valid) {
-      s.loss_initial = loss_to_real<M>(rt->stabilizer().loss_initial());
-      s.loss_final = loss_to_real<M>(rt->stabilizer().loss_final());
+      s.loss_initial = firmware::GraspStabilizer<M>::loss_value(rt->stabilizer().loss_initial());
+      s.loss_final = firmware::GraspStabilizer<M>::loss_value(rt->stabilizer().loss_final());
     }
     result.steps.push_back(std::move(s));
   }
