@@ -34,6 +34,8 @@ constexpr Command kCommands[] = {
      hadynet::cli::run_codegen},
     {"replay", "host-sim: replay a log through the firmware core (prediction, d, contact, command)",
      hadynet::cli::run_replay},
+    {"link", "talk to a device running the firmware over its serial link (info, reset, mode, pb)",
+     hadynet::cli::run_link},
     {"stabilize",
      "host-sim: the grasp stabiliser in closed loop with the MuJoCo hand under a scripted disturbance (E with/without)",
      hadynet::cli::run_stabilize},

@@ -5,7 +5,10 @@
 // the commands.
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <memory>
 #include <stdexcept>
 
 #include "cli/commands.h"
@@ -14,7 +17,7 @@
 #include "datalog/log_error.h"
 #include "datalog/log_reader.h"
 #include "host-sim/replay/replay.h"
-#include <fstream>
+#include "tools/link/fd_stream.h"
 
 namespace hadynet::cli {
 
@@ -74,8 +77,18 @@ int run_replay(int argc, char** argv) {
               "carries y_t and the command u_{t-1}; the firmware returns its estimate of y_t from\n"
               "x_{t-N} and u_[t-N,t) (N = N_detect), the Mahalanobis distance d, the contact flag\n"
               "d > C_detect and, in control mode, the grasp stabiliser's command u_t (advisory: the\n"
-              "log's own commands keep driving the replay). Bit-identical across runs.",
+              "log's own commands keep driving the replay). Bit-identical across runs.\n"
+              "--target qemu runs the same log through a firmware image in QEMU instead, and\n"
+              "--target serial/tcp through a device on a serial port or socket, frame by frame over\n"
+              "the link protocol (docs/protocol.md); the device must run this build's model.",
               "LOG --out CSV [options]");
+  opt.value("target", "hostsim|qemu|serial|tcp", "where the firmware runs", "hostsim");
+  opt.value("image", "ELF", "firmware image for --target qemu", HADYNET_DEFAULT_QEMU_IMAGE);
+  opt.value("machine", "NAME", "QEMU machine for --target qemu (mps2-an386, netduinoplus2)", "mps2-an386");
+  opt.value("qemu-log", "FILE", "QEMU's own output (--target qemu)");
+  opt.value("device", "PATH", "serial device for --target serial (e.g. /dev/ttyACM0, a pty)");
+  opt.value("baud", "N", "baud rate for --target serial", "115200");
+  opt.value("tcp", "HOST:PORT", "socket for --target tcp (e.g. QEMU's -serial tcp:...)");
   opt.value("out", "CSV", "per-step results (required)");
   opt.value("numeric", "q15|f32", "which generated build of the core", "q15");
   opt.value("mode", "observe|detect|control", "firmware mode from the first row", "detect");
@@ -172,7 +185,39 @@ int run_replay(int argc, char** argv) {
     return 2;
   }
   const std::string log_path = opt.positional()[0];
+  const std::string target = opt.get("target");
+  std::unique_ptr<tools::FdStream> stream;
   try {
+    if (target == "qemu") {
+      ro.target = hostsim::ReplayTarget::kQemu;
+      ro.qemu_image = opt.get("image");
+      ro.qemu_machine = opt.get("machine");
+      ro.qemu_log = opt.get("qemu-log");
+    } else if (target == "serial" || target == "tcp") {
+      if (target == "serial") {
+        const auto baud = opt.get_int("baud", 1, 10000000);
+        if (!baud || !opt.has("device")) {
+          std::fprintf(stderr, "hadynet replay: --target serial needs --device PATH (and a valid --baud)\n");
+          return 2;
+        }
+        stream = std::make_unique<tools::FdStream>(tools::FdStream::open_serial(opt.get("device"), static_cast<int>(*baud)));
+      } else {
+        const std::string hp = opt.get("tcp");
+        const auto colon = hp.rfind(':');
+        if (colon == std::string::npos || colon == 0) {
+          std::fprintf(stderr, "hadynet replay: --tcp needs HOST:PORT, not '%s'\n", hp.c_str());
+          return 2;
+        }
+        stream = std::make_unique<tools::FdStream>(
+            tools::FdStream::connect_tcp(hp.substr(0, colon), std::atoi(hp.c_str() + colon + 1), 5000));
+      }
+      ro.target = hostsim::ReplayTarget::kStream;
+      ro.stream = stream.get();
+    } else if (target != "hostsim") {
+      std::fprintf(stderr, "hadynet replay: --target must be hostsim, qemu, serial or tcp, not '%s'\n",
+                   target.c_str());
+      return 2;
+    }
     const datalog::LogTable log = datalog::read_log(log_path);
     const hostsim::ReplayResult r = hostsim::replay_log(log, log_path, ro);
     {

@@ -12,10 +12,12 @@ packages=(
   cmake ninja-build g++ make pkg-config git
   # trainer, plant, tests, plots (libmujoco-dev's CMake config needs libqhull-dev's headers)
   libeigen3-dev libmujoco-dev libqhull-dev libgtest-dev libgmock-dev nlohmann-json3-dev gnuplot-nox
-  # firmware cross build and emulation
-  gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm
+  # firmware cross build and emulation (python3: the QEMU test runner, test/boards/qemu_run.py)
+  gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm python3
   # host USB tools and their tests
   libusb-1.0-0-dev libhidapi-dev umockdev libumockdev-dev
+  # link fuzzer (fuzz/): clang with libFuzzer and the sanitizer runtimes
+  clang libclang-rt-dev
 )
 if [[ "${1:-}" == "--bench" ]]; then
   # OpenBLAS: without it Debian's torch falls back to the reference BLAS (an unfair baseline)

@@ -14,6 +14,7 @@
 
 #include <cstdint>
 
+#include "firmware/core/kernels/dot_q15.h"
 #include "firmware/core/model_contract.h"
 #include "firmware/core/numerics.h"
 
@@ -27,6 +28,39 @@ struct StepTrace {
   Value c_prev[M::kHidden];     // c before the step (Q(kFracC))
   Value tanh_c[M::kHidden];     // tanh(c after the step) (Q15)
 };
+
+// q15: the network's matrices in the orders the build's kernels read
+// (kernels/dot_q15.h), built at compile time into read-only memory (flash
+// on the MCU); of the generated row-major arrays the q15 code then reads only
+// W_dec (W_dec^T dy, backward_decoder). Forward: packed (rows in pairs,
+// columns in chunks of eight). Backward: W^T of the u columns of W_ih and of
+// W_hh, so dL/du and dL/dh are dot products along contiguous rows. Only q15
+// code refers to them.
+template <GeneratedModel M>
+struct KernelWeights {
+  static constexpr int kGates = 4 * M::kHidden;
+  kernels::PackedMatrix<M::kHidden, M::kX + M::kPb> enc;  // [W_enc | x ; p]
+  kernels::PackedMatrix<kGates, M::kU + M::kPb> ih;       // W_ih, input [u ; p]
+  kernels::PackedMatrix<kGates, M::kHidden> hh;           // W_hh
+  kernels::PackedMatrix<M::kY, M::kHidden> dec;           // W_dec
+  typename M::Value ih_u_t[M::kU][kGates];                // W_ih[:, :kU]^T
+  typename M::Value hh_t[M::kHidden][kGates];             // W_hh^T
+};
+template <GeneratedModel M>
+constexpr KernelWeights<M> make_kernel_weights() noexcept {
+  KernelWeights<M> k{};
+  k.enc = kernels::pack_matrix(M::kEncWeight);
+  k.ih = kernels::pack_matrix(M::kLstmWeightIh);
+  k.hh = kernels::pack_matrix(M::kLstmWeightHh);
+  k.dec = kernels::pack_matrix(M::kDecWeight);
+  for (int r = 0; r < KernelWeights<M>::kGates; ++r) {
+    for (int c = 0; c < M::kU; ++c) k.ih_u_t[c][r] = M::kLstmWeightIh[r][c];
+    for (int c = 0; c < M::kHidden; ++c) k.hh_t[c][r] = M::kLstmWeightHh[r][c];
+  }
+  return k;
+}
+template <GeneratedModel M>
+inline constexpr KernelWeights<M> kKernelWeights = make_kernel_weights<M>();
 
 template <GeneratedModel M>
 class HadynetNet {
@@ -44,12 +78,28 @@ class HadynetNet {
   // (Q(kFracIn)); c_0 = 0. p is kept for the following steps.
   void encode(const Value (&x)[kX], const Value (&pb)[kPb]) noexcept {
     for (int i = 0; i < kPb; ++i) pb_[i] = pb[i];
-    for (int r = 0; r < kH; ++r) {
-      const auto acc = typename N::Acc{M::kEncBias[r]} + N::dot(M::kEncWeight[r], x, kX) +
-                       N::dot(M::kEncWeight[r] + kX, pb_, kPb);
-      const Value v = N::template narrow<M::kFracEncW + M::kFracIn, M::kFracH>(acc);
-      h_[r] = v > 0 ? v : Value{0};
-      c_[r] = 0;
+    if constexpr (N::kFixed) {
+      // [x ; p] as one vector (zero-padded to the packed matrix's columns):
+      // one exact dot product per row, requantised by the build's kernel.
+      const auto& enc = kKernelWeights<M>.enc;
+      alignas(8) Value xp[enc.kCols] = {};
+      for (int i = 0; i < kX; ++i) xp[i] = x[i];
+      for (int i = 0; i < kPb; ++i) xp[kX + i] = pb_[i];
+      constexpr int kFrom = M::kFracEncW + M::kFracIn;
+      static_assert(kFrom >= M::kFracH, "the encoder output has more fractional bits than its sum");
+      kernels::matvec_requantize_q15({enc.data, enc.kCols, xp, 0}, {}, M::kEncBias, kH, kFrom - M::kFracH, h_);
+      for (int r = 0; r < kH; ++r) {
+        h_[r] = h_[r] > 0 ? h_[r] : Value{0};
+        c_[r] = 0;
+      }
+    } else {
+      for (int r = 0; r < kH; ++r) {
+        const auto acc = typename N::Acc{M::kEncBias[r]} + N::dot(M::kEncWeight[r], x, kX) +
+                         N::dot(M::kEncWeight[r] + kX, pb_, kPb);
+        const Value v = N::template narrow<M::kFracEncW + M::kFracIn, M::kFracH>(acc);
+        h_[r] = v > 0 ? v : Value{0};
+        c_[r] = 0;
+      }
     }
   }
 
@@ -61,20 +111,30 @@ class HadynetNet {
     constexpr int kInShift = kAccFrac - (M::kFracLstmW + M::kFracIn);
     constexpr int kHShift = kAccFrac - (M::kFracLstmW + M::kFracH);
     static_assert(!N::kFixed || (kInShift >= 0 && kHShift >= 0), "kFracLstmAcc too small");
-    for (int r = 0; r < kGates; ++r) {
-      auto in = N::dot(M::kLstmWeightIh[r], u, kU) + N::dot(M::kLstmWeightIh[r] + kU, pb_, kPb);
-      auto rec = N::dot(M::kLstmWeightHh[r], h_, kH);
-      typename N::Acc acc;
-      if constexpr (N::kFixed) {
-        // Exact: both products are brought to Q(kFracLstmAcc) by left shifts
-        // (|acc| < 2^46 before the shift of at most 15 bits).
-        acc = std::int64_t{M::kLstmBias[r]} + in * (std::int64_t{1} << kInShift) +
-              rec * (std::int64_t{1} << kHShift);
-      } else {
-        acc = M::kLstmBias[r] + in + rec;
+    if constexpr (N::kFixed) {
+      // gates = requantise(b + W_ih [u;p] 2^kInShift + W_hh h 2^kHShift) by
+      // the build's kernel. Exact: both products are brought to
+      // Q(kFracLstmAcc) by left shifts (|sum| < 2^46 before the shift of at
+      // most 15 bits), then one rounding to Q(kFracGate).
+      static_assert(kAccFrac >= M::kFracGate, "gate sums have fewer fractional bits than the gates");
+      const KernelWeights<M>& kw = kKernelWeights<M>;
+      alignas(8) Value up[kw.ih.kCols] = {};  // [u ; p]: one dot product per row of W_ih
+      for (int i = 0; i < kU; ++i) up[i] = u[i];
+      for (int i = 0; i < kPb; ++i) up[kU + i] = pb_[i];
+      alignas(8) Value h_buffer[kHPadded];
+      kernels::matvec_requantize_q15({kw.ih.data, kw.ih.kCols, up, kInShift},
+                                     {kw.hh.data, kw.hh.kCols, hidden_padded(h_buffer), kHShift}, M::kLstmBias,
+                                     kGates, kAccFrac - M::kFracGate, gates);
+      kernels::sigmoid_q15_block(gates, 2 * kH);       // i, f
+      kernels::tanh_q15_block(gates + 2 * kH, kH);     // g
+      kernels::sigmoid_q15_block(gates + 3 * kH, kH);  // o
+    } else {
+      for (int r = 0; r < kGates; ++r) {
+        const auto in = N::dot(M::kLstmWeightIh[r], u, kU) + N::dot(M::kLstmWeightIh[r] + kU, pb_, kPb);
+        const auto rec = N::dot(M::kLstmWeightHh[r], h_, kH);
+        const Value pre = N::template narrow<kAccFrac, M::kFracGate>(M::kLstmBias[r] + in + rec);
+        gates[r] = (r >= 2 * kH && r < 3 * kH) ? N::tanh(pre) : N::sigmoid(pre);
       }
-      const Value pre = N::template narrow<kAccFrac, M::kFracGate>(acc);
-      gates[r] = (r >= 2 * kH && r < 3 * kH) ? N::tanh(pre) : N::sigmoid(pre);
     }
     for (int j = 0; j < kH; ++j) {
       const Value i = gates[j], f = gates[kH + j], g = gates[2 * kH + j], o = gates[3 * kH + j];
@@ -110,9 +170,18 @@ class HadynetNet {
 
   // y = W_dec h + b_dec of the current hidden state.
   void decode(Value (&y)[kY]) const noexcept {
-    for (int r = 0; r < kY; ++r) {
-      const auto acc = typename N::Acc{M::kDecBias[r]} + N::dot(M::kDecWeight[r], h_, kH);
-      y[r] = N::template narrow<M::kFracDecW + M::kFracH, M::kFracY>(acc);
+    if constexpr (N::kFixed) {
+      constexpr int kFrom = M::kFracDecW + M::kFracH;
+      static_assert(kFrom >= M::kFracY, "the decoder output has more fractional bits than its sum");
+      const auto& dec = kKernelWeights<M>.dec;
+      alignas(8) Value h_buffer[kHPadded];
+      kernels::matvec_requantize_q15({dec.data, dec.kCols, hidden_padded(h_buffer), 0}, {}, M::kDecBias, kY,
+                                     kFrom - M::kFracY, y);
+    } else {
+      for (int r = 0; r < kY; ++r) {
+        const auto acc = typename N::Acc{M::kDecBias[r]} + N::dot(M::kDecWeight[r], h_, kH);
+        y[r] = N::template narrow<M::kFracDecW + M::kFracH, M::kFracY>(acc);
+      }
     }
   }
 
@@ -144,11 +213,23 @@ class HadynetNet {
     // (grad_mul<F>, transposed_matvec<F>), so the constant never changes.
     // Requantising a pre-activation is the identity on reals (saturation is
     // not differentiated).
-    Grad du_step[kU];
-    N::template transposed_matvec<M::kFracLstmW>(M::kLstmWeightIh, dgates, kU, du_step, scratch_);
-    for (int k = 0; k < kU; ++k) du[k] = N::grad_add(du[k], du_step[k]);
-    if (dh_prev != nullptr) {
-      N::template transposed_matvec<M::kFracLstmW>(M::kLstmWeightHh, dgates, kH, dh_prev, scratch_);
+    if constexpr (N::kFixed) {
+      // W^T dgates along the rows of the transposed copies (exact int64 sums,
+      // one rounding per output, as transposed_matvec).
+      const KernelWeights<M>& kw = kKernelWeights<M>;
+      kernels::dot_rows_q15_i32(kw.ih_u_t[0], kGates, kU, dgates, kGates, scratch_);
+      for (int k = 0; k < kU; ++k) du[k] = N::grad_add(du[k], fixed::requantize_i32<M::kFracLstmW, 0>(scratch_[k]));
+      if (dh_prev != nullptr) {
+        kernels::dot_rows_q15_i32(kw.hh_t[0], kGates, kH, dgates, kGates, scratch_);
+        for (int j = 0; j < kH; ++j) dh_prev[j] = fixed::requantize_i32<M::kFracLstmW, 0>(scratch_[j]);
+      }
+    } else {
+      Grad du_step[kU];
+      N::template transposed_matvec<M::kFracLstmW>(M::kLstmWeightIh, dgates, kU, du_step, scratch_);
+      for (int k = 0; k < kU; ++k) du[k] = N::grad_add(du[k], du_step[k]);
+      if (dh_prev != nullptr) {
+        N::template transposed_matvec<M::kFracLstmW>(M::kLstmWeightHh, dgates, kH, dh_prev, scratch_);
+      }
     }
   }
 
@@ -180,6 +261,19 @@ class HadynetNet {
   const Value (&cell() const noexcept)[kH] { return c_; }
 
  private:
+  // q15: h as the packed kernels read it, kH values then zeros up to a
+  // multiple of 8 (they meet the packed matrices' zero columns): h_ itself,
+  // or a copy in `buffer` if kH is not a multiple of 8.
+  static constexpr int kHPadded = (kH + 7) / 8 * 8;
+  const Value* hidden_padded(Value (&buffer)[kHPadded]) const noexcept {
+    if constexpr (kH == kHPadded) {
+      return h_;
+    } else {
+      for (int j = 0; j < kHPadded; ++j) buffer[j] = j < kH ? h_[j] : Value{0};
+      return buffer;
+    }
+  }
+
   Value pb_[kPb] = {};
   Value h_[kH] = {};
   Value c_[kH] = {};

@@ -14,6 +14,7 @@
 
 #include "firmware/core/activation.h"
 #include "firmware/core/fixed_point.h"
+#include "firmware/core/kernels/dot_q15.h"
 #include "firmware/core/model_contract.h"
 
 namespace hadynet::firmware {
@@ -158,22 +159,22 @@ struct Numerics {
   // both w and g are read contiguously; `scratch` holds n_cols accumulators.
   // q15: exact int64 sums (|w g| < 2^46, Rows < 2^17), one rounding per
   // output, saturated to int32.
+  // q15: the sums come from the build's kernel (kernels/dot_q15.h).
   template <int WFrac, int Rows, int Cols>
   static constexpr void transposed_matvec(const Value (&w)[Rows][Cols], const Grad* g, int n_cols,
                                           Grad* out, GradAcc* scratch) noexcept {
-    for (int c = 0; c < n_cols; ++c) scratch[c] = 0;
-    for (int r = 0; r < Rows; ++r) {
-      const Grad gr = g[r];
-      if (gr == 0) continue;  // same result, skips dead gates
-      const Value* row = w[r];
-      for (int c = 0; c < n_cols; ++c) scratch[c] += static_cast<GradAcc>(row[c]) * gr;
-    }
-    for (int c = 0; c < n_cols; ++c) {
-      if constexpr (kFixed) {
-        out[c] = fixed::requantize_i32<WFrac, 0>(scratch[c]);
-      } else {
-        out[c] = scratch[c];
+    if constexpr (kFixed) {
+      kernels::dot_cols_q15_i32(w[0], Cols, Rows, g, n_cols, scratch);
+      for (int c = 0; c < n_cols; ++c) out[c] = fixed::requantize_i32<WFrac, 0>(scratch[c]);
+    } else {
+      for (int c = 0; c < n_cols; ++c) scratch[c] = 0;
+      for (int r = 0; r < Rows; ++r) {
+        const Grad gr = g[r];
+        if (gr == 0) continue;  // same result, skips dead gates
+        const Value* row = w[r];
+        for (int c = 0; c < n_cols; ++c) scratch[c] += static_cast<GradAcc>(row[c]) * gr;
       }
+      for (int c = 0; c < n_cols; ++c) out[c] = scratch[c];
     }
   }
 };

@@ -6,6 +6,8 @@
 
 #include "hadynet_model_f32.h"
 #include "hadynet_model_q15.h"
+#include "tools/link/link_session.h"
+#include "tools/link/qemu_process.h"
 
 namespace hadynet::hostsim {
 
@@ -46,30 +48,76 @@ std::vector<std::size_t> map_columns(const datalog::LogTable& log, const std::st
   return cols;
 }
 
+// The firmware compiled into this program.
 template <class M>
-ReplayResult replay_with(const datalog::LogTable& log, const std::string& file, const ReplayOptions& opt) {
+class HostDevice {
+ public:
+  explicit HostDevice(const ReplayOptions& opt) : rt_(std::make_unique<firmware::HadynetRuntime<M>>()) {
+    if (opt.control_epochs >= 0) rt_->control_settings().epochs = opt.control_epochs;
+    if (opt.control_truncation >= 1) rt_->control_settings().truncation = opt.control_truncation;
+  }
+  void set_pb(const float (&pb)[M::kPb]) { rt_->set_pb(pb); }
+  bool set_pb_state(int state) { return rt_->set_pb_state(state); }
+  void set_mode(firmware::Mode mode) { rt_->set_mode(mode); }
+  firmware::StepResult<M> step(const firmware::SensorFrame<M>& frame, ReplayStep& s) {
+    const firmware::StepResult<M> r = rt_->step(frame);
+    if (r.command_valid) {
+      s.loss_initial = firmware::GraspStabilizer<M>::loss_value(rt_->stabilizer().loss_initial());
+      s.loss_final = firmware::GraspStabilizer<M>::loss_value(rt_->stabilizer().loss_final());
+    }
+    return r;
+  }
+
+ private:
+  // The runtime holds the network, traces and history (~tens of KiB): on
+  // the heap here, a static object on the MCU.
+  std::unique_ptr<firmware::HadynetRuntime<M>> rt_;
+};
+
+// A device running the firmware, over its serial link.
+template <class M>
+class LinkDevice {
+ public:
+  LinkDevice(tools::ByteStream& stream, const ReplayOptions& opt) : session_(stream) {
+    if (opt.control_epochs >= 0 || opt.control_truncation >= 1)
+      throw std::invalid_argument("stabiliser settings cannot be changed over the link");
+    session_.connect();
+    const link::InfoReply info = session_.info();
+    if (info.model_hash != M::kModelHash || info.numeric != (firmware::kIsFixed<M> ? 0 : 1))
+      throw tools::LinkError(stream.name() + ": the device runs another model or numeric than this build");
+  }
+  void set_pb(const float (&pb)[M::kPb]) { session_.set_pb(pb); }
+  bool set_pb_state(int state) {
+    if (state < 0 || state >= M::kStates) return false;
+    session_.set_pb_state(static_cast<std::uint16_t>(state));
+    return true;
+  }
+  void set_mode(firmware::Mode mode) { session_.set_mode(mode); }
+  firmware::StepResult<M> step(const firmware::SensorFrame<M>& frame, ReplayStep&) { return session_.step(frame); }
+
+ private:
+  tools::LinkSession<M> session_;
+};
+
+template <class M, class Device>
+ReplayResult replay_on(Device& device, const datalog::LogTable& log, const std::string& file,
+                       const ReplayOptions& opt) {
   const CompiledModelInfo info = info_of<M>();
   const auto y_cols = map_columns(log, file, info.y_names);
   const auto u_cols = map_columns(log, file, info.u_names);
   const auto t_col = log.column_index("t");
-
-  // The runtime holds the network, traces and history (~tens of KiB): on
-  // the heap here, a static object on the MCU.
-  auto rt = std::make_unique<firmware::HadynetRuntime<M>>();
   if (!opt.pb.empty()) {
     if (static_cast<int>(opt.pb.size()) != M::kPb)
       throw std::invalid_argument("PB has " + std::to_string(opt.pb.size()) + " values, the model " +
                                   std::to_string(M::kPb));
     float pb[M::kPb];
     for (int i = 0; i < M::kPb; ++i) pb[i] = opt.pb[static_cast<std::size_t>(i)];
-    rt->set_pb(pb);
-  } else if (opt.pb_state >= 0 && !rt->set_pb_state(opt.pb_state)) {
+    device.set_pb(pb);
+  } else if (opt.pb_state >= 0 && !device.set_pb_state(opt.pb_state)) {
     throw std::invalid_argument("PB state " + std::to_string(opt.pb_state) + " is not in the model's table (" +
                                 std::to_string(M::kStates) + " states)");
   }
-  if (opt.control_epochs >= 0) rt->control_settings().epochs = opt.control_epochs;
-  if (opt.control_truncation >= 1) rt->control_settings().truncation = opt.control_truncation;
-  rt->set_mode(opt.mode);
+  device.set_mode(opt.mode);
 
   ReplayResult result;
   result.y_names = info.y_names;
@@ -78,12 +126,12 @@ ReplayResult replay_with(const datalog::LogTable& log, const std::string& file, 
   firmware::SensorFrame<M> frame{};
   for (std::size_t row = 0; row < log.rows(); ++row) {
     if (opt.control_from >= 0 && row == static_cast<std::size_t>(opt.control_from))
-      rt->set_mode(firmware::Mode::kControl);
+      device.set_mode(firmware::Mode::kControl);
     for (int i = 0; i < M::kY; ++i) frame.y[i] = static_cast<float>(log.at(row, y_cols[static_cast<std::size_t>(i)]));
     for (int i = 0; i < M::kU; ++i)
       frame.u_prev[i] = row == 0 ? 0.0f : static_cast<float>(log.at(row - 1, u_cols[static_cast<std::size_t>(i)]));
-    const firmware::StepResult<M> r = rt->step(frame);
     ReplayStep s;
+    const firmware::StepResult<M> r = device.step(frame, s);
     s.time = t_col ? log.at(row, *t_col) : static_cast<double>(row);
     s.prediction_valid = r.prediction_valid;
     s.prediction.assign(r.prediction, r.prediction + M::kY);
@@ -92,13 +140,29 @@ ReplayResult replay_with(const datalog::LogTable& log, const std::string& file, 
     s.contact = r.contact;
     s.command_valid = r.command_valid;
     s.command.assign(r.command, r.command + M::kU);
-    if (r.command_valid) {
-      s.loss_initial = firmware::GraspStabilizer<M>::loss_value(rt->stabilizer().loss_initial());
-      s.loss_final = firmware::GraspStabilizer<M>::loss_value(rt->stabilizer().loss_final());
-    }
     result.steps.push_back(std::move(s));
   }
   return result;
+}
+
+template <class M>
+ReplayResult replay_with(const datalog::LogTable& log, const std::string& file, const ReplayOptions& opt) {
+  switch (opt.target) {
+    case ReplayTarget::kQemu: {
+      tools::QemuProcess qemu({"qemu-system-arm", opt.qemu_machine, opt.qemu_image, false, opt.qemu_log});
+      LinkDevice<M> device(qemu.link(), opt);
+      return replay_on<M>(device, log, file, opt);
+    }
+    case ReplayTarget::kStream: {
+      if (opt.stream == nullptr) throw std::invalid_argument("target stream without a stream");
+      LinkDevice<M> device(*opt.stream, opt);
+      return replay_on<M>(device, log, file, opt);
+    }
+    case ReplayTarget::kHostSim:
+      break;
+  }
+  HostDevice<M> device(opt);
+  return replay_on<M>(device, log, file, opt);
 }
 
 void append_float(std::string& s, double v) {

@@ -11,10 +11,16 @@
 
 #include "datalog/log_table.h"
 #include "firmware/core/hadynet_runtime.h"
+#include "tools/link/byte_stream.h"
 
 namespace hadynet::hostsim {
 
 enum class ReplayNumeric { kQ15, kF32 };
+
+// Where the firmware runs: the core compiled into this program (host-sim),
+// a firmware image in QEMU, or any device on a byte stream (a serial port),
+// the last two over the serial link (docs/protocol.md).
+enum class ReplayTarget { kHostSim, kQemu, kStream };
 
 struct ReplayOptions {
   ReplayNumeric numeric = ReplayNumeric::kQ15;
@@ -24,6 +30,11 @@ struct ReplayOptions {
   std::vector<float> pb;       // explicit standardised PB; overrides pb_state if non-empty
   int control_epochs = -1;     // -1: the model's default
   int control_truncation = -1; // -1: the model's default
+  ReplayTarget target = ReplayTarget::kHostSim;
+  std::string qemu_image;      // firmware ELF (target qemu); its model must be the compiled-in one
+  std::string qemu_machine = "mps2-an386";
+  std::string qemu_log;        // QEMU's output ("" : discarded)
+  tools::ByteStream* stream = nullptr;  // target stream: the open link (not owned)
 };
 
 // One replayed step (log row t). Physical units except d and the losses
@@ -60,7 +71,10 @@ CompiledModelInfo compiled_model_info(ReplayNumeric numeric);
 
 // Replays `log` (read from `file`, named in errors). Throws
 // std::runtime_error naming the file if the log lacks a channel of the
-// compiled model, std::invalid_argument for bad options (PB size or state).
+// compiled model, std::invalid_argument for bad options (PB size or state,
+// stabiliser settings with target qemu), tools::LinkError if the device
+// fails or runs another model (its info's hash differs). With target qemu
+// the stabiliser's losses are not reported (0).
 ReplayResult replay_log(const datalog::LogTable& log, const std::string& file,
                         const ReplayOptions& options);
 

@@ -1,0 +1,73 @@
+// The board interface (DESIGN.md §6, STYLE.md item 6): everything the
+// portable firmware (firmware/app/) needs from the hardware, and nothing
+// more. Each board directory (boards/mps2-an386/, boards/stm32f405/)
+// implements it; the build links exactly one of them into an image, so no
+// portable code ever says #ifdef BOARD.
+//
+// Threading: everything here is called from the main loop only (thread
+// mode). The SysTick interrupt updates the tick count and the period flag.
+#ifndef HADYNET_BOARDS_BOARD_H_
+#define HADYNET_BOARDS_BOARD_H_
+
+#include <cstddef>
+#include <cstdint>
+
+namespace hadynet::board {
+
+// Number of loadcell channels a board can scan (the hand's tendon loadcells).
+inline constexpr int kLoadcells = 9;
+
+// The control period: period_elapsed() turns true every 1 / kPeriodHz s.
+inline constexpr std::uint32_t kPeriodHz = 5;
+
+// Static description of the board, from its board.cmake (the one place
+// that holds its memory sizes and clocks; generated into board_config.h).
+struct Description {
+  const char* name;              // e.g. "mps2-an386"
+  std::uint32_t core_clock_hz;   // CPU clock the board runs at after init()
+  std::uint32_t tick_hz;         // rate of ticks()
+  std::uint32_t flash_bytes;     // code + constant memory
+  std::uint32_t ram_bytes;       // data memory (all RAM regions together)
+};
+const Description& description() noexcept;
+
+// Clocks, SysTick (tick count and the 5 Hz period), the UART and the
+// board's sensors. Called once, first thing in main().
+void init() noexcept;
+
+// Free-running count of SysTick clock cycles (description().tick_hz per
+// second) since init(); wraps at 2^32. Differences of two readings are
+// exact while they are below 2^32 ticks (171 s at 25 MHz, 25 s at 168 MHz).
+std::uint32_t ticks() noexcept;
+
+// True once per control period (5 Hz): returns true at most once for each
+// period boundary passed since the last call. Missed boundaries (the loop was
+// busy longer than a period) are counted in overrun_periods().
+bool period_elapsed() noexcept;
+std::uint32_t overrun_periods() noexcept;
+
+// One received byte, without waiting: true and `byte` set if one was
+// available. Bytes arriving while nobody reads may be lost (a one-byte
+// hardware buffer); the link protocol's framing and CRC catch that.
+bool uart_read_byte(std::uint8_t& byte) noexcept;
+
+// Sends `size` bytes; returns when the last one is in the transmitter.
+void uart_write(const std::uint8_t* data, std::size_t size) noexcept;
+
+// The nine loadcell readings, in newtons. False (and `newtons` unchanged)
+// if the board has no loadcells or no complete scan has arrived yet.
+bool read_loadcells(float (&newtons)[kLoadcells]) noexcept;
+
+// Bytes of stack the firmware has used so far (high-water mark of a pattern
+// painted at reset), and the stack's size.
+std::size_t stack_used_bytes() noexcept;
+std::size_t stack_size_bytes() noexcept;
+
+// Ends the program with an exit code. Under QEMU (-semihosting) this is the
+// emulator's exit status (semihosting SYS_EXIT_EXTENDED); on hardware without
+// a debugger the semihosting call faults into the halting fault handler.
+[[noreturn]] void exit(int code) noexcept;
+
+}  // namespace hadynet::board
+
+#endif  // HADYNET_BOARDS_BOARD_H_

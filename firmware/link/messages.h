@@ -1,0 +1,301 @@
+// Payloads of the link's messages (docs/protocol.md, "Messages"): encode and
+// decode for each, sized from the generated model M at compile time. Pure,
+// bounded, allocation-free; firmware and host tools share them.
+//
+// Encoders write into a caller buffer (usually FrameBuilder::payload()) and
+// return the payload size, 0 if the buffer is too small (every payload but
+// the empty acks is at least one byte). Decoders of requests return a Status
+// whose code is the error reply's (kBadPayloadLength, kBadValue); decoders of
+// replies return false for a malformed payload.
+#ifndef HADYNET_FIRMWARE_LINK_MESSAGES_H_
+#define HADYNET_FIRMWARE_LINK_MESSAGES_H_
+
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "firmware/core/hadynet_runtime.h"
+#include "firmware/core/model_contract.h"
+#include "firmware/link/frame.h"
+
+namespace hadynet::link {
+
+inline constexpr std::size_t kMaxGeneratorVersion = 32;  // bytes of the info reply's generator string
+inline constexpr std::size_t kMaxReason = 64;            // bytes of an error reply's reason text
+
+// Payload sizes (bytes) that do not depend on the model.
+inline constexpr std::size_t kInfoPayloadMax = 8 + 2 + 1 + 1 + 8 * 2 + 1 + 4 + 1 + kMaxGeneratorVersion;
+inline constexpr std::size_t kSetModePayload = 1;
+inline constexpr std::size_t kSetPbStatePayload = 1 + 2;
+inline constexpr std::size_t kErrorPayloadMax = 1 + 2 + 1 + kMaxReason;
+
+// Payload sizes (bytes) for model M; the build fails if M is too large for
+// version-1 frames.
+template <firmware::GeneratedModel M>
+struct PayloadSizes {
+  static constexpr std::size_t kSensorFrame = 4 * (M::kY + M::kU);
+  static constexpr std::size_t kStepResult = 1 + 4 * M::kY + 4 + 4 * M::kU;
+  static constexpr std::size_t kSetPbValues = 1 + 4 * M::kPb;
+  static_assert(kSensorFrame <= kMaxPayload && kStepResult <= kMaxPayload && kSetPbValues <= kMaxPayload,
+                "the model's messages exceed the protocol's kMaxPayload");
+};
+static_assert(kInfoPayloadMax <= kMaxPayload && kErrorPayloadMax <= kMaxPayload);
+
+// IEEE binary32: finite unless the exponent bits are all ones (inf, NaN).
+constexpr bool is_finite_f32(float v) noexcept {
+  return (std::bit_cast<std::uint32_t>(v) & 0x7F800000u) != 0x7F800000u;
+}
+
+// ---- 0x81 info
+
+enum class WireNumeric : std::uint8_t { kQ15 = 0, kF32 = 1 };
+
+struct InfoReply {
+  std::uint64_t model_hash = 0;  // FNV-1a 64 of the model file
+  std::uint16_t contract_version = 0;
+  std::uint8_t protocol_version = 0;
+  std::uint8_t numeric = 0;  // WireNumeric
+  std::uint16_t x = 0, u = 0, y = 0, pb = 0, hidden = 0, states = 0;
+  std::uint16_t detect_steps = 0;     // N_detect
+  std::uint16_t control_horizon = 0;  // N_control
+  std::uint8_t has_detection = 0;
+  float detect_threshold = 0.0f;  // C_detect on d
+  std::uint8_t generator_version_size = 0;
+  char generator_version[kMaxGeneratorVersion + 1] = {};  // NUL-terminated
+};
+
+// The info of model M (generator string cut at kMaxGeneratorVersion bytes).
+template <firmware::GeneratedModel M>
+constexpr InfoReply info_of() noexcept {
+  InfoReply r;
+  r.model_hash = M::kModelHash;
+  r.contract_version = static_cast<std::uint16_t>(M::kContractVersion);
+  r.protocol_version = kProtocolVersion;
+  r.numeric = static_cast<std::uint8_t>(M::kNumeric == firmware::Numeric::kQ15 ? WireNumeric::kQ15 : WireNumeric::kF32);
+  r.x = static_cast<std::uint16_t>(M::kX);
+  r.u = static_cast<std::uint16_t>(M::kU);
+  r.y = static_cast<std::uint16_t>(M::kY);
+  r.pb = static_cast<std::uint16_t>(M::kPb);
+  r.hidden = static_cast<std::uint16_t>(M::kHidden);
+  r.states = static_cast<std::uint16_t>(M::kStates);
+  r.detect_steps = static_cast<std::uint16_t>(M::kDetectSteps);
+  r.control_horizon = static_cast<std::uint16_t>(M::kControlHorizon);
+  r.has_detection = M::kHasDetection ? 1 : 0;
+  r.detect_threshold = static_cast<float>(M::kDetectThreshold);
+  const char* g = M::kGeneratorVersion;
+  std::size_t n = 0;
+  while (n < kMaxGeneratorVersion && g[n] != '\0') {
+    r.generator_version[n] = g[n];
+    ++n;
+  }
+  r.generator_version[n] = '\0';
+  r.generator_version_size = static_cast<std::uint8_t>(n);
+  return r;
+}
+
+constexpr std::size_t encode_info(const InfoReply& r, std::span<std::uint8_t> out) noexcept {
+  ByteWriter w(out);
+  w.u64(r.model_hash);
+  w.u16(r.contract_version);
+  w.u8(r.protocol_version);
+  w.u8(r.numeric);
+  for (const std::uint16_t d : {r.x, r.u, r.y, r.pb, r.hidden, r.states, r.detect_steps, r.control_horizon}) w.u16(d);
+  w.u8(r.has_detection);
+  w.f32(r.detect_threshold);
+  const std::uint8_t n = r.generator_version_size <= kMaxGeneratorVersion
+                             ? r.generator_version_size
+                             : static_cast<std::uint8_t>(kMaxGeneratorVersion);
+  w.u8(n);
+  for (std::size_t i = 0; i < n; ++i) w.u8(static_cast<std::uint8_t>(r.generator_version[i]));
+  return w.ok() ? w.size() : 0;
+}
+
+constexpr bool decode_info(std::span<const std::uint8_t> in, InfoReply& r) noexcept {
+  ByteReader rd(in);
+  r = InfoReply{};
+  r.model_hash = rd.u64();
+  r.contract_version = rd.u16();
+  r.protocol_version = rd.u8();
+  r.numeric = rd.u8();
+  for (std::uint16_t* d : {&r.x, &r.u, &r.y, &r.pb, &r.hidden, &r.states, &r.detect_steps, &r.control_horizon}) {
+    *d = rd.u16();
+  }
+  r.has_detection = rd.u8();
+  r.detect_threshold = rd.f32();
+  const std::uint8_t n = rd.u8();
+  if (!rd.ok() || n > kMaxGeneratorVersion || rd.remaining() != n) return false;
+  for (std::size_t i = 0; i < n; ++i) r.generator_version[i] = static_cast<char>(rd.u8());
+  r.generator_version[n] = '\0';
+  r.generator_version_size = n;
+  return rd.ok();
+}
+
+// ---- 0x02 sensor frame: y[kY], u_prev[kU] (f32, physical units)
+
+template <firmware::GeneratedModel M>
+constexpr std::size_t encode_sensor_frame(const firmware::SensorFrame<M>& f, std::span<std::uint8_t> out) noexcept {
+  ByteWriter w(out);
+  for (const float v : f.y) w.f32(v);
+  for (const float v : f.u_prev) w.f32(v);
+  return w.ok() ? w.size() : 0;
+}
+
+// Non-finite sensor values are passed on: the runtime maps NaN to the
+// channel mean and saturates infinities (docs/firmware.md).
+template <firmware::GeneratedModel M>
+constexpr Status decode_sensor_frame(std::span<const std::uint8_t> in, firmware::SensorFrame<M>& f) noexcept {
+  if (in.size() != PayloadSizes<M>::kSensorFrame) return {ErrorCode::kBadPayloadLength, "sensor frame: wrong size"};
+  ByteReader rd(in);
+  for (float& v : f.y) v = rd.f32();
+  for (float& v : f.u_prev) v = rd.f32();
+  return {};
+}
+
+// ---- 0x82 step result: flags u8, prediction[kY], d, command[kU] (f32)
+
+inline constexpr std::uint8_t kFlagPredictionValid = 1u << 0;
+inline constexpr std::uint8_t kFlagDistanceValid = 1u << 1;
+inline constexpr std::uint8_t kFlagContact = 1u << 2;
+inline constexpr std::uint8_t kFlagCommandValid = 1u << 3;
+
+template <firmware::GeneratedModel M>
+constexpr std::size_t encode_step_result(const firmware::StepResult<M>& r, std::span<std::uint8_t> out) noexcept {
+  ByteWriter w(out);
+  std::uint8_t flags = 0;
+  if (r.prediction_valid) flags |= kFlagPredictionValid;
+  if (r.distance_valid) flags |= kFlagDistanceValid;
+  if (r.contact) flags |= kFlagContact;
+  if (r.command_valid) flags |= kFlagCommandValid;
+  w.u8(flags);
+  for (const float v : r.prediction) w.f32(v);
+  w.f32(r.d);
+  for (const float v : r.command) w.f32(v);
+  return w.ok() ? w.size() : 0;
+}
+
+template <firmware::GeneratedModel M>
+constexpr bool decode_step_result(std::span<const std::uint8_t> in, firmware::StepResult<M>& r) noexcept {
+  if (in.size() != PayloadSizes<M>::kStepResult) return false;
+  ByteReader rd(in);
+  const std::uint8_t flags = rd.u8();
+  r.prediction_valid = (flags & kFlagPredictionValid) != 0;
+  r.distance_valid = (flags & kFlagDistanceValid) != 0;
+  r.contact = (flags & kFlagContact) != 0;
+  r.command_valid = (flags & kFlagCommandValid) != 0;
+  for (float& v : r.prediction) v = rd.f32();
+  r.d = rd.f32();
+  for (float& v : r.command) v = rd.f32();
+  return rd.ok() && (flags & 0xF0u) == 0;
+}
+
+// ---- 0x03 set PB: kind u8; kind 0: state index u16; kind 1: kPb f32
+// (standardised PB values, all finite).
+
+enum class PbKind : std::uint8_t { kState = 0, kValues = 1 };
+
+template <firmware::GeneratedModel M>
+struct SetPbRequest {
+  PbKind kind = PbKind::kState;
+  std::uint16_t state = 0;    // kind kState: row of the PB table
+  float values[M::kPb] = {};  // kind kValues
+};
+
+template <firmware::GeneratedModel M>
+constexpr std::size_t encode_set_pb(const SetPbRequest<M>& q, std::span<std::uint8_t> out) noexcept {
+  ByteWriter w(out);
+  w.u8(static_cast<std::uint8_t>(q.kind));
+  if (q.kind == PbKind::kState) {
+    w.u16(q.state);
+  } else {
+    for (const float v : q.values) w.f32(v);
+  }
+  return w.ok() ? w.size() : 0;
+}
+
+// Checks size, kind, state range (< M::kStates) and finiteness.
+template <firmware::GeneratedModel M>
+constexpr Status decode_set_pb(std::span<const std::uint8_t> in, SetPbRequest<M>& q) noexcept {
+  if (in.empty()) return {ErrorCode::kBadPayloadLength, "set PB: empty payload"};
+  ByteReader rd(in);
+  const std::uint8_t kind = rd.u8();
+  if (kind == static_cast<std::uint8_t>(PbKind::kState)) {
+    if (in.size() != kSetPbStatePayload) return {ErrorCode::kBadPayloadLength, "set PB state: wrong size"};
+    q.kind = PbKind::kState;
+    q.state = rd.u16();
+    if (q.state >= M::kStates) return {ErrorCode::kBadValue, "set PB state: state out of range"};
+    return {};
+  }
+  if (kind == static_cast<std::uint8_t>(PbKind::kValues)) {
+    if (in.size() != PayloadSizes<M>::kSetPbValues) return {ErrorCode::kBadPayloadLength, "set PB values: wrong size"};
+    q.kind = PbKind::kValues;
+    for (float& v : q.values) {
+      v = rd.f32();
+      if (!is_finite_f32(v)) return {ErrorCode::kBadValue, "set PB values: non-finite value"};
+    }
+    return {};
+  }
+  return {ErrorCode::kBadValue, "set PB: unknown kind"};
+}
+
+// ---- 0x04 set mode: u8 (0 observe, 1 detect, 2 control)
+
+constexpr std::size_t encode_set_mode(firmware::Mode mode, std::span<std::uint8_t> out) noexcept {
+  ByteWriter w(out);
+  w.u8(static_cast<std::uint8_t>(mode));
+  return w.ok() ? w.size() : 0;
+}
+
+constexpr Status decode_set_mode(std::span<const std::uint8_t> in, firmware::Mode& mode) noexcept {
+  if (in.size() != kSetModePayload) return {ErrorCode::kBadPayloadLength, "set mode: wrong size"};
+  if (in[0] > static_cast<std::uint8_t>(firmware::Mode::kControl))
+    return {ErrorCode::kBadValue, "set mode: unknown mode"};
+  mode = static_cast<firmware::Mode>(in[0]);
+  return {};
+}
+
+// ---- 0x01 info request, 0x05 reset, and the acks: empty payloads
+
+constexpr Status decode_empty(std::span<const std::uint8_t> in) noexcept {
+  if (!in.empty()) return {ErrorCode::kBadPayloadLength, "payload must be empty"};
+  return {};
+}
+
+// ---- 0x7F error: code u8, offending sequence number u16, reason (u8 length + ASCII)
+
+struct ErrorReply {
+  ErrorCode code = ErrorCode::kNone;
+  std::uint16_t sequence = 0;  // the offending frame's, 0 if unknown
+  std::uint8_t reason_size = 0;
+  char reason[kMaxReason + 1] = {};  // NUL-terminated
+};
+
+// `reason` is NUL-terminated ASCII, cut at kMaxReason bytes.
+constexpr std::size_t encode_error(ErrorCode code, std::uint16_t sequence, const char* reason,
+                                   std::span<std::uint8_t> out) noexcept {
+  std::size_t n = 0;
+  while (n < kMaxReason && reason[n] != '\0') ++n;
+  ByteWriter w(out);
+  w.u8(static_cast<std::uint8_t>(code));
+  w.u16(sequence);
+  w.u8(static_cast<std::uint8_t>(n));
+  for (std::size_t i = 0; i < n; ++i) w.u8(static_cast<std::uint8_t>(reason[i]));
+  return w.ok() ? w.size() : 0;
+}
+
+constexpr bool decode_error(std::span<const std::uint8_t> in, ErrorReply& e) noexcept {
+  ByteReader rd(in);
+  e = ErrorReply{};
+  e.code = static_cast<ErrorCode>(rd.u8());
+  e.sequence = rd.u16();
+  const std::uint8_t n = rd.u8();
+  if (!rd.ok() || n > kMaxReason || rd.remaining() != n) return false;
+  for (std::size_t i = 0; i < n; ++i) e.reason[i] = static_cast<char>(rd.u8());
+  e.reason[n] = '\0';
+  e.reason_size = n;
+  return rd.ok();
+}
+
+}  // namespace hadynet::link
+
+#endif  // HADYNET_FIRMWARE_LINK_MESSAGES_H_

@@ -1,0 +1,51 @@
+# End to end (issue 5): a held-out plant log replayed through the firmware
+# image in QEMU (the MCU build with its DSP kernels, behind the real link)
+# and through host-sim's q15 core must give bit-identical results: every
+# column of the two CSVs but the stabiliser's losses, which only host-sim
+# reports (tolerance zero: q15 is bit-identical on host and MCU).
+# Usage: cmake -DHADYNET=<hadynet> -DIMAGE=<elf> -DMACHINE=<qemu machine> -DWORK=<dir> -P replay_qemu.cmake
+foreach(var HADYNET IMAGE MACHINE WORK)
+  if(NOT ${var})
+    message(FATAL_ERROR "replay_qemu: set ${var}")
+  endif()
+endforeach()
+if(NOT EXISTS "${IMAGE}")
+  message(FATAL_ERROR "replay_qemu: no image ${IMAGE}: build the cortex-m4 preset first (scripts/test.sh does)")
+endif()
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}")
+
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "replay_qemu: failed (${rc}): ${ARGN}\n${out}${err}")
+  endif()
+  message(STATUS "${out}")
+endfunction()
+
+# A grasp of a state the model never trained on; control from row 20.
+run("${HADYNET}" collect --object Cylinder --motion random2 --init 3 --steps 60 --split test --out "${WORK}" --quiet)
+set(log "${WORK}/test/Cylinder_random2_i3_w0.csv")
+run("${HADYNET}" replay "${log}" --out "${WORK}/host.csv" --control-from 20)
+run("${HADYNET}" replay "${log}" --out "${WORK}/qemu.csv" --control-from 20 --target qemu --image "${IMAGE}"
+    --machine "${MACHINE}" --qemu-log "${WORK}/qemu.log")
+
+file(STRINGS "${WORK}/host.csv" host)
+file(STRINGS "${WORK}/qemu.csv" qemu)
+list(LENGTH host n_host)
+list(LENGTH qemu n_qemu)
+if(NOT n_host EQUAL 61 OR NOT n_qemu EQUAL 61)
+  message(FATAL_ERROR "replay_qemu: expected 61 lines, got ${n_host} (host) and ${n_qemu} (qemu)")
+endif()
+set(commands 0)
+foreach(i RANGE 0 60)
+  list(GET host ${i} h)
+  list(GET qemu ${i} q)
+  # Drop the last two columns (loss_initial, loss_final).
+  string(REGEX REPLACE ",[^,]*,[^,]*$" "" h "${h}")
+  string(REGEX REPLACE ",[^,]*,[^,]*$" "" q "${q}")
+  if(NOT h STREQUAL q)
+    message(FATAL_ERROR "replay_qemu: row ${i} differs\n  host-sim: ${h}\n  qemu:     ${q}")
+  endif()
+endforeach()
+message(STATUS "replay_qemu: 60 rows bit-identical (prediction, d, contact, command) on ${MACHINE}")

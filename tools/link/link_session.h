@@ -1,0 +1,104 @@
+// One host-side conversation with a device running the firmware: requests
+// go out numbered (firmware/link/link_client.h), each waits for its reply;
+// an error reply or a timeout becomes a LinkError with the device's reason.
+// The same protocol code as the firmware (docs/protocol.md).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "firmware/link/link_client.h"
+#include "firmware/link/stream_decoder.h"
+#include "tools/link/byte_stream.h"
+
+namespace hadynet::tools {
+
+template <firmware::GeneratedModel M>
+class LinkSession {
+ public:
+  // timeout_ms: how long one reply may take (a control period on a slow
+  // device is ~0.1 s; QEMU without KVM is slower).
+  explicit LinkSession(ByteStream& stream, int timeout_ms = 5000) : stream_(stream), timeout_ms_(timeout_ms) {}
+
+  // Reset is accepted with any sequence number and restarts the numbering:
+  // call it first to synchronise with a device that has talked to others.
+  void reset() { transact(client_.reset(wire_), link::MessageType::kResetAck); }
+
+  // Opens the conversation with a device that may still be starting (a UART
+  // that is not enabled yet drops what arrives, e.g. STM32 on QEMU): sends a
+  // delimiter and a reset every `retry_ms` until the reset is acknowledged,
+  // ignoring error replies to half-received frames, for at most timeout_ms.
+  void connect(int timeout_ms = 10000, int retry_ms = 300) {
+    const std::uint8_t delimiter = 0;
+    for (int waited = 0; waited < timeout_ms; waited += retry_ms) {
+      stream_.write(std::span<const std::uint8_t>(&delimiter, 1));
+      const std::size_t n = client_.reset(wire_);
+      const std::uint16_t sequence = client_.next_sequence();
+      stream_.write(std::span<const std::uint8_t>(wire_, n));
+      std::uint8_t buffer[256];
+      std::size_t got;
+      while ((got = stream_.read(buffer, retry_ms)) > 0) {
+        for (std::size_t i = 0; i < got; ++i) {
+          if (rx_.push(buffer[i]) != link::StreamDecoder::Event::kFrame) continue;
+          const link::Reply r = client_.accept(rx_.frame());
+          if (r.ok() && r.type == link::MessageType::kResetAck && r.sequence == sequence) return;
+        }
+      }
+    }
+    throw LinkError(stream_.name() + ": the device did not answer a reset within " + std::to_string(timeout_ms) +
+                    " ms");
+  }
+  link::InfoReply info() {
+    const link::Reply r = transact(client_.info_request(wire_), link::MessageType::kInfo);
+    link::InfoReply info;
+    if (!link::decode_info(r.payload, info)) throw LinkError(stream_.name() + ": malformed info reply");
+    return info;
+  }
+  void set_mode(firmware::Mode mode) { transact(client_.set_mode(mode, wire_), link::MessageType::kSetModeAck); }
+  void set_pb_state(std::uint16_t state) {
+    transact(client_.set_pb_state(state, wire_), link::MessageType::kSetPbAck);
+  }
+  void set_pb(const float (&values)[M::kPb]) { transact(client_.set_pb(values, wire_), link::MessageType::kSetPbAck); }
+  firmware::StepResult<M> step(const firmware::SensorFrame<M>& frame) {
+    const link::Reply r = transact(client_.sensor_frame(frame, wire_), link::MessageType::kStepResult);
+    firmware::StepResult<M> result;
+    if (!link::decode_step_result<M>(r.payload, result))
+      throw LinkError(stream_.name() + ": malformed step result");
+    return result;
+  }
+
+ private:
+  // Sends the request in wire_ and returns its reply (of type `expected`).
+  link::Reply transact(std::size_t wire_size, link::MessageType expected) {
+    if (wire_size == 0) throw LinkError(stream_.name() + ": request does not fit a frame");
+    const std::uint16_t sequence = client_.next_sequence();
+    stream_.write(std::span<const std::uint8_t>(wire_, wire_size));
+    std::uint8_t buffer[256];
+    while (true) {
+      const std::size_t n = stream_.read(buffer, timeout_ms_);
+      if (n == 0) throw LinkError(stream_.name() + ": no reply within " + std::to_string(timeout_ms_) + " ms");
+      for (std::size_t i = 0; i < n; ++i) {
+        if (rx_.push(buffer[i]) != link::StreamDecoder::Event::kFrame) continue;
+        const link::Reply r = client_.accept(rx_.frame());
+        if (!r.status.ok()) throw LinkError(stream_.name() + ": malformed reply frame");
+        if (r.type == link::MessageType::kError) {
+          link::ErrorReply e;
+          const bool decoded = link::decode_error(r.payload, e);
+          throw LinkError(stream_.name() + ": the device refused request " + std::to_string(sequence) + ": " +
+                          (decoded ? std::string(e.reason) + " (code " + std::to_string(static_cast<int>(e.code)) + ")"
+                                   : std::string("malformed error reply")));
+        }
+        if (r.sequence != sequence || r.type != expected) continue;  // a stale reply
+        return r;
+      }
+    }
+  }
+
+  ByteStream& stream_;
+  int timeout_ms_;
+  link::LinkClient<M> client_;
+  link::StreamDecoder rx_;
+  std::uint8_t wire_[link::kMaxWireFrame] = {};
+};
+
+}  // namespace hadynet::tools
