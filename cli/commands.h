@@ -18,5 +18,6 @@ int run_link(int argc, char** argv);
 int run_stabilize(int argc, char** argv);
 int run_measure_ranges(int argc, char** argv);
 int run_codegen(int argc, char** argv);
+int run_residual(int argc, char** argv);
 
 }  // namespace hadynet::cli

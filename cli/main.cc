@@ -26,6 +26,7 @@ constexpr Command kCommands[] = {
     {"calibrate-detect", "contact-detection statistics and threshold from contact-free logs",
      hadynet::cli::run_calibrate_detect},
     {"detect", "contact detection over logs: d per step, flags, traces plot", hadynet::cli::run_detect},
+    {"residual", "the model's residuals, residual tests and the effect it lacks (report, JSON)", hadynet::cli::run_residual},
     {"simulate", "predict a log from a start state, commands and any PB (contact simulation)",
      hadynet::cli::run_simulate},
     {"measure-ranges", "measure the value ranges codegen needs and store them in the model",

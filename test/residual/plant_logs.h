@@ -1,0 +1,52 @@
+// Plant logs for the residual tests: recorded from the MuJoCo hand on the fly
+// (deterministic) in dynamics states the build's model was trained on (paper
+// preset, seed 1, inits 0..2), with the plant's switchable effects switched on
+// through ExperimentSpec::effects and declared nowhere in the logs.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "host-sim/plant/experiment.h"
+#include "trainer/model_file.h"
+#include "trainer/residual/residuals.h"
+
+namespace hadynet::test {
+
+inline const trainer::HadynetModel& build_model() {
+  static const trainer::HadynetModel model = trainer::load_model(HADYNET_MODEL_PATH);
+  return model;
+}
+
+struct PlantLog {
+  const char* object;  // plant name, e.g. "Cylinder"
+  const char* motion;  // random1 | random2
+  int init;            // a trained initialisation (0..2)
+};
+
+// The logs every effect test analyses: grasps of three objects (the loadcell
+// effects need contact) and a Random-1 run, each `steps` rows.
+inline const std::vector<PlantLog> kEffectLogs = {
+    {"Cylinder", "random2", 1}, {"Ball", "random2", 2}, {"Gripper", "random2", 0}, {"Cylinder", "random1", 0}};
+
+// The logs recorded with `effect` ("" for clean; plant syntax NAME[=VALUE]).
+inline std::vector<trainer::residual::LogInput> plant_logs(const std::string& effect, int steps = 300) {
+  std::vector<trainer::residual::LogInput> out;
+  for (const auto& l : kEffectLogs) {
+    plant::ExperimentSpec spec;
+    spec.object = *plant::parse_object(l.object);
+    spec.motion = *plant::parse_motion(l.motion);
+    spec.init_id = l.init;
+    spec.steps = steps;
+    spec.seed = 1;
+    if (!effect.empty()) {
+      const std::string err = plant::apply_effect_arg(effect, spec.effects);
+      if (!err.empty()) throw std::invalid_argument(err);
+    }
+    out.push_back({plant::run_experiment(spec).log, plant::log_file_name(spec)});
+  }
+  return out;
+}
+
+}  // namespace hadynet::test

@@ -1,0 +1,127 @@
+// Statistics of the residual loop against known answers. Tolerances: the
+// distribution tails are compared with textbook quantiles printed to 12-16
+// significant digits (or closed forms), so 1e-9 relative; the random-series
+// tests use fixed seeds and state their bounds where they appear.
+#include "trainer/residual/statistics.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+namespace hadynet::trainer::residual {
+namespace {
+
+Eigen::VectorXd white_noise(int n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal;
+  Eigen::VectorXd v(n);
+  for (int i = 0; i < n; ++i) v(i) = normal(rng);
+  return v;
+}
+
+Eigen::VectorXd ar1(int n, double phi, std::uint64_t seed) {
+  Eigen::VectorXd e = white_noise(n, seed), v(n);
+  v(0) = e(0);
+  for (int i = 1; i < n; ++i) v(i) = phi * v(i - 1) + e(i);
+  return v;
+}
+
+TEST(Distributions, ChiSquareTailsMatchTextbookQuantiles) {
+  EXPECT_NEAR(chi_square_sf(3.841458820694124, 1), 0.05, 1e-9 * 0.05);
+  EXPECT_NEAR(chi_square_sf(6.634896601021214, 1), 0.01, 1e-9 * 0.01);
+  EXPECT_NEAR(chi_square_sf(23.20925115895436, 10), 0.01, 1e-9 * 0.01);
+  EXPECT_NEAR(chi_square_sf(37.65248413348278, 25), 0.05, 1e-9 * 0.05);
+  EXPECT_NEAR(chi_square_sf(44.31410489621915, 25), 0.01, 1e-9 * 0.01);
+  // Two degrees of freedom: P(X > q) = exp(-q / 2), also far in the tail
+  // (the continued fraction's side).
+  for (double q : {0.1, 1.0, 5.0, 40.0, 300.0}) EXPECT_NEAR(chi_square_sf(q, 2) / std::exp(-q / 2), 1.0, 1e-12);
+  EXPECT_EQ(chi_square_sf(0.0, 5), 1.0);
+}
+
+TEST(Distributions, IncompleteGammaAndBetaClosedForms) {
+  for (double x : {0.01, 0.5, 1.0, 3.0, 20.0}) {
+    EXPECT_NEAR(gamma_p(1.0, x), 1.0 - std::exp(-x), 1e-14);           // exponential
+    EXPECT_NEAR(gamma_p(0.5, x), std::erf(std::sqrt(x)), 1e-13);        // half-integer
+    EXPECT_NEAR(gamma_p(3.0, x) + gamma_q(3.0, x), 1.0, 1e-14);
+  }
+  for (double x : {0.0, 0.2, 0.7, 1.0}) EXPECT_NEAR(beta_inc(2.5, 1.0, x), std::pow(x, 2.5), 1e-13);
+  EXPECT_NEAR(beta_inc(2.0, 3.0, 0.4), 0.5248, 1e-13);  // 1 - sum_{k<2} C(4,k) 0.4^k 0.6^(4-k)
+  EXPECT_THROW(gamma_p(-1.0, 1.0), std::domain_error);
+  EXPECT_THROW(beta_inc(1.0, 1.0, 1.5), std::domain_error);
+}
+
+TEST(Distributions, StudentTAndF) {
+  EXPECT_NEAR(student_t_sf(2.228138851986274, 10), 0.025, 1e-9 * 0.025);
+  EXPECT_NEAR(student_t_sf(2.575829303548901, 1e9), 0.005, 1e-7);  // -> normal
+  for (double t : {-3.0, 0.5, 4.0}) EXPECT_NEAR(student_t_sf(t, 1), 0.5 - std::atan(t) / std::numbers::pi, 1e-13);
+  EXPECT_NEAR(f_sf(4.964602743730711, 1, 10), 0.05, 1e-9 * 0.05);
+  EXPECT_NEAR(f_sf(3.0 * 3.0, 1, 25), 2 * student_t_sf(3.0, 25), 1e-13);  // F(1, n) = t^2
+}
+
+TEST(Whiteness, WhiteNoisePassesAcrossPooledLogs) {
+  // Three logs with different offsets: pooling centres each log on its own mean.
+  const Segments logs = {white_noise(700, 1).array() + 5.0, white_noise(700, 2).array() - 3.0, white_noise(700, 3)};
+  const LjungBox lb = ljung_box(logs, 25);
+  EXPECT_EQ(lb.dof, 25);
+  // Under H0 the p-value is uniform; with these fixed seeds it is well inside.
+  EXPECT_GT(lb.p_value, 0.01);
+  const Eigen::VectorXd acf = autocorrelation(logs, 25);
+  const double bound = correlation_bound_99(total_samples(logs));
+  EXPECT_NEAR(bound, 2.58 / std::sqrt(2100.0), 1e-15);
+  EXPECT_LE((acf.array().abs() > bound).count(), 2);  // expected 0.25 of 25 lags
+}
+
+TEST(Whiteness, Ar1FailsAndItsAutocorrelationIsPhi) {
+  const Segments logs = {ar1(1000, 0.5, 7), ar1(1000, 0.5, 8)};
+  const LjungBox lb = ljung_box(logs, 25);
+  EXPECT_LT(lb.p_value, 1e-30);
+  const Eigen::VectorXd acf = autocorrelation(logs, 3);
+  // rho_k = 0.5^k; the sampling sd is about 1/sqrt(2000) = 0.022, so 0.07 is 3 sd.
+  EXPECT_NEAR(acf(0), 0.5, 0.07);
+  EXPECT_NEAR(acf(1), 0.25, 0.07);
+  EXPECT_NEAR(fit_ar(logs, 1)(0), 0.5, 0.07);
+  EXPECT_EQ(choose_ar_order(logs, 10), 1);
+  // The whitened series is white.
+  EXPECT_GT(ljung_box(ar_filter(logs, fit_ar(logs, 1)), 25).p_value, 0.01);
+}
+
+TEST(Whiteness, NoProductAcrossLogBoundaries) {
+  // Each log alternates +1/-1 inside; concatenated naively, the boundary would add a +1 product.
+  Eigen::VectorXd a(4), b(4);
+  a << 1, -1, 1, -1;
+  b << 1, -1, 1, -1;
+  const Eigen::VectorXd acf = autocorrelation({a, b}, 1);
+  EXPECT_DOUBLE_EQ(acf(0), -6.0 / 8.0);  // 3 pairs per log, each -1; sum of squares 8
+  EXPECT_EQ(pairs_at_lag({a, b}, 1), 6);
+}
+
+TEST(CrossCorrelation, DelayedCopyPeaksAtTheDelay) {
+  const Eigen::VectorXd u = white_noise(1500, 11), e = white_noise(1500, 12);
+  Eigen::VectorXd r = 0.3 * e;
+  for (int t = 3; t < 1500; ++t) r(t) += u(t - 3);  // r_t = u_{t-3} + noise
+  const Eigen::VectorXd rho = cross_correlation({r}, {u}, 25);
+  Eigen::Index at = 0;
+  rho.cwiseAbs().maxCoeff(&at);
+  EXPECT_EQ(at - 25, 3);  // positive lag: the input leads
+  EXPECT_GT(rho(at), 0.9);
+  const double bound = correlation_bound_99(1500);
+  for (Eigen::Index k = 0; k < rho.size(); ++k)
+    if (k != at) {
+      EXPECT_LT(std::abs(rho(k)), 2 * bound) << "lag " << k - 25;
+    }
+}
+
+TEST(MultipleComparisons, HolmMatchesHandComputation) {
+  const std::vector<double> adjusted = holm_adjust({0.01, 0.04, 0.03, 0.005});
+  // sorted: 0.005*4 = 0.02, 0.01*3 = 0.03, 0.03*2 = 0.06, 0.04*1 -> max(0.06, 0.04)
+  EXPECT_DOUBLE_EQ(adjusted[3], 0.02);
+  EXPECT_DOUBLE_EQ(adjusted[0], 0.03);
+  EXPECT_DOUBLE_EQ(adjusted[2], 0.06);
+  EXPECT_DOUBLE_EQ(adjusted[1], 0.06);
+  EXPECT_DOUBLE_EQ(holm_adjust({0.9, 0.8})[0], 1.0);
+}
+
+}  // namespace
+}  // namespace hadynet::trainer::residual

@@ -1,0 +1,229 @@
+#include "trainer/residual/attribution.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "trainer/residual/statistics.h"
+
+namespace hadynet::trainer::residual {
+
+namespace {
+
+// One part (training or held-out) of every log: centred residual and regressors.
+struct Part {
+  Segments r;                         // one segment per log
+  std::vector<Eigen::MatrixXd> z;     // n_log x k per log
+};
+
+Eigen::MatrixXd stack(const std::vector<Eigen::MatrixXd>& parts, Eigen::Index cols) {
+  Eigen::Index rows = 0;
+  for (const auto& p : parts) rows += p.rows();
+  Eigen::MatrixXd out(rows, cols);
+  Eigen::Index r = 0;
+  for (const auto& p : parts) {
+    out.middleRows(r, p.rows()) = p;
+    r += p.rows();
+  }
+  return out;
+}
+
+Eigen::VectorXd stack(const Segments& parts) {
+  Eigen::Index rows = 0;
+  for (const auto& p : parts) rows += p.size();
+  Eigen::VectorXd out(rows);
+  Eigen::Index r = 0;
+  for (const auto& p : parts) {
+    out.segment(r, p.size()) = p;
+    r += p.size();
+  }
+  return out;
+}
+
+// Whitens every column of every log's regressors with the AR filter `a`.
+std::vector<Eigen::MatrixXd> filter_columns(const std::vector<Eigen::MatrixXd>& z, const Eigen::VectorXd& a) {
+  std::vector<Eigen::MatrixXd> out;
+  for (const auto& m : z) {
+    const Eigen::Index n = std::max<Eigen::Index>(0, m.rows() - a.size());
+    Eigen::MatrixXd f(n, m.cols());
+    for (Eigen::Index k = 0; k < m.cols(); ++k) f.col(k) = ar_filter({m.col(k)}, a).front();
+    out.push_back(std::move(f));
+  }
+  return out;
+}
+
+Eigen::VectorXd least_squares(const Eigen::MatrixXd& z, const Eigen::VectorXd& r) {
+  if (z.rows() == 0) return Eigen::VectorXd::Zero(z.cols());
+  return z.colPivHouseholderQr().solve(r);
+}
+
+struct Explained {
+  double share = 0;       // 1 - SS(r - Z beta) / SS(r)
+  double per_sample = 0;  // (SS(r) - SS(r - Z beta)) / n
+};
+Explained explained(const Part& part, const Eigen::VectorXd& beta) {
+  double ss = 0, ss_res = 0;
+  long n = 0;
+  for (std::size_t i = 0; i < part.r.size(); ++i) {
+    ss += part.r[i].squaredNorm();
+    ss_res += (part.r[i] - part.z[i] * beta).squaredNorm();
+    n += static_cast<long>(part.r[i].size());
+  }
+  Explained e;
+  if (ss > 0) e.share = 1.0 - ss_res / ss;
+  if (n > 0) e.per_sample = (ss - ss_res) / static_cast<double>(n);
+  return e;
+}
+
+}  // namespace
+
+HypothesisResult test_hypothesis(const ResidualData& data, const Hypothesis& h, const AttributionOptions& options) {
+  HypothesisResult res;
+  res.hypothesis = h;
+  res.effect = effect_info(h.kind).name;
+  const auto c = static_cast<Eigen::Index>(h.target);
+  const int min_rows = options.max_ar_order + 5;
+
+  Part train, held;
+  Eigen::Index k = 0;
+  Eigen::VectorXi support;  // training samples where each regressor is non-zero
+  for (const auto& log : data.logs) {
+    const Features f = features(h, log);
+    k = f.z.cols();
+    const int n = log.size();
+    const int split = static_cast<int>(options.train_fraction * n);
+    const int t0 = f.first_valid, t1 = split, h0 = std::max(split, f.first_valid), h1 = n;
+    if (t1 - t0 < min_rows || h1 - h0 < min_rows) continue;
+    const Eigen::VectorXd r = log.r.row(c).transpose();
+    if (support.size() != k) support = Eigen::VectorXi::Zero(k);
+    support += (f.z.middleRows(t0, t1 - t0).array().abs() > 1e-12).cast<int>().matrix().colwise().sum().transpose();
+    const double mr = r.segment(t0, t1 - t0).mean();
+    const Eigen::RowVectorXd mz = f.z.middleRows(t0, t1 - t0).colwise().mean();
+    train.r.push_back(r.segment(t0, t1 - t0).array() - mr);
+    train.z.push_back(f.z.middleRows(t0, t1 - t0).rowwise() - mz);
+    held.r.push_back(r.segment(h0, h1 - h0).array() - mr);
+    held.z.push_back(f.z.middleRows(h0, h1 - h0).rowwise() - mz);
+  }
+  res.coef = Eigen::VectorXd::Zero(k);
+  if (train.r.empty()) {
+    res.testable = false;
+    res.label = describe(h, data, res.coef) + " (logs too short)";
+    return res;
+  }
+  bool constant = false;
+  Eigen::VectorXd spread = Eigen::VectorXd::Zero(k);
+  for (const auto& z : train.z) spread += z.colwise().squaredNorm().transpose();
+  for (Eigen::Index j = 0; j < k; ++j) constant = constant || support(j) < options.min_support || !(spread(j) > 1e-18);
+  if (constant) {
+    res.testable = false;
+    res.label = describe(h, data, res.coef) + " (not testable: a regressor is constant in the training part)";
+    return res;
+  }
+
+  // Cochrane-Orcutt: OLS, AR(p) on its residual, whitened OLS; twice.
+  Eigen::VectorXd beta = least_squares(stack(train.z, k), stack(train.r));
+  Eigen::VectorXd a;
+  for (int pass = 0; pass < 2; ++pass) {
+    Segments e;
+    for (std::size_t i = 0; i < train.r.size(); ++i) e.push_back(train.r[i] - train.z[i] * beta);
+    res.ar_order = choose_ar_order(e, options.max_ar_order);
+    a = fit_ar(e, res.ar_order);
+    beta = least_squares(stack(filter_columns(train.z, a), k), stack(ar_filter(train.r, a)));
+  }
+  res.coef = beta;
+  res.parameter = main_parameter(h, beta);
+  res.label = describe(h, data, beta);
+  res.explained_train = explained(train, beta).share;
+  const Explained e_held = explained(held, beta);
+  res.explained = e_held.share;
+  const double scale = data.y_scale(c);
+  res.explained_std = e_held.per_sample / (scale * scale);
+
+  // Held-out test: whitened residual against the whitened fixed prediction, an intercept per log.
+  const Segments r_w = ar_filter(held.r, a);
+  const std::vector<Eigen::MatrixXd> z_w = filter_columns(held.z, a);
+  double sxy = 0, sxx = 0, syy = 0;
+  long n = 0;
+  for (std::size_t i = 0; i < r_w.size(); ++i) {
+    if (r_w[i].size() < 2) continue;
+    const Eigen::VectorXd p = z_w[i] * beta;
+    const Eigen::VectorXd pc = p.array() - p.mean();
+    const Eigen::VectorXd rc = r_w[i].array() - r_w[i].mean();
+    sxy += pc.dot(rc);
+    sxx += pc.squaredNorm();
+    syy += rc.squaredNorm();
+    n += static_cast<long>(rc.size());
+  }
+  long n_train = 0;
+  for (const auto& s : ar_filter(train.r, a)) n_train += static_cast<long>(s.size());
+  res.n_train = n_train;
+  res.n_held_out = n;
+  const double dof = static_cast<double>(n) - static_cast<double>(r_w.size()) - 1.0;
+  if (sxx > 1e-12 * std::max(1.0, syy) && syy > 0 && dof > 0) {
+    const double slope = sxy / sxx;
+    const double ss_res = std::max(syy - slope * sxy, 1e-300);
+    const double se = std::sqrt(ss_res / dof / sxx);
+    res.t_stat = slope / se;
+    res.p_value = student_t_sf(res.t_stat, dof);
+  }
+  return res;
+}
+
+std::optional<HypothesisResult> Attribution::winner() const {
+  if (ranked.empty() || !ranked.front().significant) return std::nullopt;
+  return ranked.front();
+}
+
+std::vector<HypothesisResult> Attribution::winner_family() const {
+  std::vector<HypothesisResult> out;
+  const auto w = winner();
+  if (!w) return out;
+  std::map<int, bool> seen;
+  for (const auto& r : ranked) {
+    if (!r.significant) break;
+    if (r.hypothesis.kind != w->hypothesis.kind) continue;
+    if ((r.hypothesis.kind == EffectKind::kSensorDelay || r.hypothesis.kind == EffectKind::kInputDelay) &&
+        r.hypothesis.delay != w->hypothesis.delay)
+      continue;
+    if (seen[r.hypothesis.target]) continue;
+    seen[r.hypothesis.target] = true;
+    out.push_back(r);
+  }
+  return out;
+}
+
+Attribution attribute(const ResidualData& data, const std::vector<Hypothesis>& hypotheses,
+                      const AttributionOptions& options) {
+  Attribution att;
+  att.options = options;
+  std::vector<HypothesisResult> results;
+  results.reserve(hypotheses.size());
+  for (const auto& h : hypotheses) results.push_back(test_hypothesis(data, h, options));
+  // The family: every testable hypothesis (an untestable one has no p-value).
+  std::vector<double> p;
+  std::vector<std::size_t> family;
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    if (!results[i].testable) continue;
+    family.push_back(i);
+    p.push_back(results[i].p_value);
+  }
+  att.tested = static_cast<long>(family.size());
+  const std::vector<double> adjusted = holm_adjust(p);
+  for (std::size_t f = 0; f < family.size(); ++f) {
+    const std::size_t i = family[f];
+    results[i].p_adjusted = adjusted[f];
+    results[i].significant = adjusted[f] < options.alpha &&
+                             results[i].explained >= options.min_explained &&
+                             results[i].explained_std >= options.min_explained_std;
+  }
+  std::stable_sort(results.begin(), results.end(), [](const HypothesisResult& a, const HypothesisResult& b) {
+    if (a.significant != b.significant) return a.significant;
+    if (a.significant) return a.explained_std > b.explained_std;
+    return a.p_value < b.p_value;
+  });
+  att.ranked = std::move(results);
+  return att;
+}
+
+}  // namespace hadynet::trainer::residual

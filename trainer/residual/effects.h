@@ -1,0 +1,76 @@
+// The effect library of the residual loop (docs/residual.md): each effect is a
+// named hypothesis about what the model lacks, with
+//   (a) a feature test: regressors built from the logs, the model's 1-step
+//       predictions and the auxiliary channels, which should explain the
+//       1-step residual of one target channel if the effect is present, and
+//   (b) a model augmentation (implemented later by `hadynet residual --fix`;
+//       `augmentation` describes it).
+// A hypothesis is one effect with its parameters (target channel, source,
+// delay, rail). Nothing here knows the hand: channels come by index into the
+// ResidualData's names.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "trainer/residual/residuals.h"
+
+namespace hadynet::trainer::residual {
+
+enum class EffectKind {
+  kSensorDelay,  // the target is reported `delay` steps late
+  kInputDelay,   // the commands act `delay` steps later than the model assumes
+  kFriction,     // dry friction / hysteresis driven by the motion of muscle `source` (u channel)
+  kDriftLoad,    // a sensor bias growing with the target's accumulated value (load)
+  kDriftTime,    // a sensor bias growing with time
+  kSaturation,   // the measured target is clipped at a rail (`side` +1 upper, -1 lower)
+  kCrosstalk,    // the target picks up a fraction of channel `source` (y channel)
+  kAuxChannel,   // an unused logged channel (aux `source`) explains the target
+};
+
+struct EffectInfo {
+  EffectKind kind;
+  const char* name;          // used in the CLI, the JSON and the report
+  const char* feature;       // the regressors of the feature test
+  const char* parameter;     // what the fitted parameter means
+  const char* augmentation;  // the planned model augmentation (--fix)
+};
+const std::vector<EffectInfo>& effect_library();
+const EffectInfo& effect_info(EffectKind kind);
+
+struct Hypothesis {
+  EffectKind kind = EffectKind::kSensorDelay;
+  int target = 0;      // y channel whose residual is explained
+  int source = -1;     // u channel (friction), y channel (crosstalk), aux channel (aux); else -1
+  int delay = 0;       // steps (delays)
+  int side = 0;        // saturation: +1 upper rail, -1 lower rail
+  double rail = 0;     // saturation: the rail, target units
+};
+
+// Regressors of a hypothesis for one log, aligned with the log's residual
+// columns (row t = j + 2); rows before `first_valid` are undefined (delays).
+struct Features {
+  Eigen::MatrixXd z;  // n x k
+  int first_valid = 0;
+};
+Features features(const Hypothesis& h, const ResidualLog& log);
+
+// Human-readable parameters, e.g. "delay = 2 steps on fc3", from the fitted
+// coefficients (`coef`: one per regressor, in target units per regressor unit).
+std::string describe(const Hypothesis& h, const ResidualData& data, const Eigen::VectorXd& coef);
+// The main fitted parameter (e.g. gain, friction in target units, drift rate).
+double main_parameter(const Hypothesis& h, const Eigen::VectorXd& coef);
+
+struct LibraryOptions {
+  int max_delay = 5;                // delays 1..max_delay steps
+  bool crosstalk_same_group = true; // cross-talk sources: channels of the target's group only
+};
+
+// Every hypothesis of the library for these logs: delays per target and
+// delay, friction per target and muscle, drift per target, saturation per
+// target and side (rails: the measured extremes over all logs), cross-talk
+// per target and source, aux per target and aux channel.
+std::vector<Hypothesis> enumerate_hypotheses(const ResidualData& data, const LibraryOptions& options);
+
+}  // namespace hadynet::trainer::residual

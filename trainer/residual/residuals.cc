@@ -1,0 +1,186 @@
+#include "trainer/residual/residuals.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <stdexcept>
+
+#include "trainer/hadynet_network.h"
+#include "trainer/pb_adaptation.h"
+#include "trainer/window_dataset.h"
+
+namespace hadynet::trainer::residual {
+
+namespace {
+
+double parse_number(const std::string& text, const std::string& what) {
+  double v = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, v);
+  if (ec != std::errc() || ptr != end) throw std::runtime_error(what + ": expected a number, got '" + text + "'");
+  return v;
+}
+
+// aux_* names present in every log, in the first log's order.
+std::vector<std::string> common_aux_names(const std::vector<LogInput>& logs) {
+  std::vector<std::string> names;
+  if (logs.empty()) return names;
+  for (const auto& c : logs.front().table.columns)
+    if (c.rfind("aux_", 0) == 0) names.push_back(c);
+  std::erase_if(names, [&](const std::string& n) {
+    return std::any_of(logs.begin(), logs.end(),
+                       [&](const LogInput& l) { return !l.table.column_index(n).has_value(); });
+  });
+  return names;
+}
+
+Eigen::VectorXf adapt_to(const HadynetModel& model, const std::vector<LogSequence>& seqs) {
+  const WindowDataset data(seqs, std::vector<int>(seqs.size(), 0), model.layout, model.norm, model.train_steps);
+  if (data.size() == 0) {
+    throw std::runtime_error("state '" + seqs.front().state + "': logs too short for one window of " +
+                             std::to_string(model.train_steps) + " steps");
+  }
+  std::vector<int> ids(static_cast<std::size_t>(data.size()));
+  std::iota(ids.begin(), ids.end(), 0);
+  return adapt_pb(model, data, ids, Eigen::VectorXf::Zero(model.params.dims.pb), AdaptOptions{}).pb;
+}
+
+// An explicit PB: "zero", a state of the model, or comma-separated numbers.
+Eigen::VectorXf explicit_pb(const HadynetModel& model, const std::string& text) {
+  const int d = model.params.dims.pb;
+  if (text == "zero") return Eigen::VectorXf::Zero(d);
+  if (const int k = model.state_index(text); k >= 0) return model.params.pb.row(k).transpose();
+  std::vector<float> v;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    v.push_back(static_cast<float>(parse_number(text.substr(start, comma - start), "PB '" + text + "'")));
+    start = comma + 1;
+  }
+  if (static_cast<int>(v.size()) != d) {
+    throw std::runtime_error("PB '" + text + "': not zero, auto, state, adapt, a state of the model or " +
+                             std::to_string(d) + " comma-separated numbers");
+  }
+  return Eigen::Map<Eigen::VectorXf>(v.data(), d);
+}
+
+}  // namespace
+
+Eigen::MatrixXd predict_windows(const HadynetModel& model, const LogSequence& seq, const Eigen::VectorXf& pb,
+                                int steps) {
+  const WindowDataset data({seq}, {0}, model.layout, model.norm, steps);
+  const int B = data.size();
+  if (B == 0) return Eigen::MatrixXd(model.params.dims.y, 0);
+  std::vector<int> ids(static_cast<std::size_t>(B));
+  std::iota(ids.begin(), ids.end(), 0);
+  WindowBatch<float> batch;
+  Matrix<float> target;
+  data.gather(ids, batch, target);
+  batch.pb = pb.replicate(1, B);
+  HadynetNetwork<float> net;
+  Eigen::MatrixXd y = net.forward(model.params, batch, BnMode::kEval).cast<double>();
+  y = (y.array().colwise() * model.norm.y.std.array()).colwise() + model.norm.y.mean.array();
+  return y;
+}
+
+ResidualData compute_residuals(const HadynetModel& model, const std::vector<LogInput>& logs,
+                               const std::string& pb_choice) {
+  if (logs.empty()) throw std::runtime_error("no logs");
+  ResidualData data;
+  data.y_names = model.layout.y_names;
+  data.u_names = model.layout.u_names;
+  data.aux_names = common_aux_names(logs);
+  data.y_scale = model.norm.y.std;
+
+  for (const auto& in : logs) {
+    ResidualLog log;
+    log.seq = log_sequence(in.table, in.file, model.layout);
+    if (log.seq.steps() < ResidualLog::kFirstRow + 1 + model.train_steps) {
+      throw std::runtime_error(in.file + ": " + std::to_string(log.seq.steps()) + " rows; at least " +
+                               std::to_string(ResidualLog::kFirstRow + 1 + model.train_steps) + " needed");
+    }
+    const auto dt = in.table.metadata.get("dt_s");
+    log.dt_s = dt ? parse_number(*dt, in.file + ": metadata dt_s") : 1.0;
+    const auto T = static_cast<Eigen::Index>(in.table.rows());
+    log.aux.resize(static_cast<Eigen::Index>(data.aux_names.size()), T);
+    for (std::size_t a = 0; a < data.aux_names.size(); ++a) {
+      const std::size_t col = *in.table.column_index(data.aux_names[a]);
+      for (Eigen::Index t = 0; t < T; ++t)
+        log.aux(static_cast<Eigen::Index>(a), t) = in.table.at(static_cast<std::size_t>(t), col);
+    }
+    data.logs.push_back(std::move(log));
+  }
+
+  // PB per log; adaptation runs once per state over all of that state's logs.
+  std::map<std::string, std::vector<std::size_t>> by_state;
+  for (std::size_t i = 0; i < data.logs.size(); ++i) by_state[data.logs[i].seq.state].push_back(i);
+  for (const auto& [state, members] : by_state) {
+    Eigen::VectorXf pb;
+    std::string source;
+    const int k = model.state_index(state);
+    if (pb_choice == "adapt" || (pb_choice == "auto" && k < 0)) {
+      std::vector<LogSequence> seqs;
+      for (std::size_t i : members) seqs.push_back(data.logs[i].seq);
+      pb = adapt_to(model, seqs);
+      source = "adapted to the state's logs";
+    } else if (pb_choice == "state" || pb_choice == "auto") {
+      if (k < 0) {
+        throw std::runtime_error(data.logs[members.front()].seq.file + ": state '" + state +
+                                 "' is not in the model's PB table (use --pb adapt)");
+      }
+      pb = model.params.pb.row(k).transpose();
+      source = "state " + state;
+    } else {
+      pb = explicit_pb(model, pb_choice);
+      source = pb_choice;
+    }
+    for (std::size_t i : members) {
+      data.logs[i].pb = pb;
+      data.logs[i].pb_source = source;
+    }
+  }
+
+  for (auto& log : data.logs) {
+    log.y_hat = predict_windows(model, log.seq, log.pb, 1);  // windows start at 1: rows 2..T-1
+    log.r = log.seq.y.rightCols(log.y_hat.cols()) - log.y_hat;
+  }
+  return data;
+}
+
+HorizonMetrics horizon_metrics(const HadynetModel& model, const ResidualData& data, int horizon) {
+  if (horizon < 1) throw std::invalid_argument("horizon must be >= 1");
+  const auto ny = static_cast<Eigen::Index>(data.y_names.size());
+  HorizonMetrics m;
+  m.horizon = horizon;
+  Eigen::MatrixXd sum_y = Eigen::MatrixXd::Zero(ny, horizon), sum_yy = sum_y, sum_ee = sum_y;
+  for (const auto& log : data.logs) {
+    const Eigen::MatrixXd y_hat = predict_windows(model, log.seq, log.pb, horizon);
+    const Eigen::Index B = y_hat.cols() / horizon;
+    m.samples += B;
+    for (int k = 0; k < horizon; ++k) {
+      // Window b starts at row b + 1 and predicts row b + 1 + k + 1 at step k.
+      const Eigen::MatrixXd y_phys = log.seq.y.middleCols(k + 2, B);
+      const Eigen::MatrixXd e = y_phys - y_hat.middleCols(k * B, B);
+      // Sums of y - (training mean): the shift keeps ||y - mean(y)||^2 free of cancellation.
+      const Eigen::MatrixXd y = y_phys.colwise() - model.norm.y.mean;
+      sum_y.col(k) += y.rowwise().sum();
+      sum_yy.col(k) += y.array().square().matrix().rowwise().sum();
+      sum_ee.col(k) += e.array().square().matrix().rowwise().sum();
+    }
+  }
+  const double n = static_cast<double>(m.samples);
+  m.fit.resize(ny, horizon);
+  m.rmse.resize(ny, horizon);
+  for (Eigen::Index c = 0; c < ny; ++c) {
+    for (int k = 0; k < horizon; ++k) {
+      const double ss_total = sum_yy(c, k) - sum_y(c, k) * sum_y(c, k) / n;  // ||y - mean(y)||^2
+      m.rmse(c, k) = n > 0 ? std::sqrt(sum_ee(c, k) / n) : 0.0;
+      m.fit(c, k) = ss_total > 0 ? 100.0 * (1.0 - std::sqrt(sum_ee(c, k) / ss_total)) : 0.0;
+    }
+  }
+  return m;
+}
+
+}  // namespace hadynet::trainer::residual

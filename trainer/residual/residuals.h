@@ -1,0 +1,77 @@
+// Multi-step residuals of a HADYNET model over logs (docs/residual.md):
+//   r_t^(h) = y_t - y_hat_t^(h),   y_hat_t^(h) predicted h steps ahead from x_{t-h}, u_[t-h, t)
+// with one PB per log (the model's PB for the log's state, or one adapted to it).
+// Nothing here knows the hand: channels come from the model's layout, the
+// auxiliary channels from the logs' aux_* columns.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "datalog/log_table.h"
+#include "trainer/hadynet_model.h"
+#include "trainer/log_dataset.h"
+
+namespace hadynet::trainer::residual {
+
+// One log with its 1-step predictions and residuals.
+struct ResidualLog {
+  // The 1-step series starts at row 2: y_t is predicted from x_{t-1} (x exists from row 1).
+  static constexpr int kFirstRow = 2;
+
+  LogSequence seq;      // y (y x T) and u (u x T) in physical units
+  Eigen::MatrixXd aux;  // aux x T: the aux_* columns named in ResidualData::aux_names
+  double dt_s = 0;      // control period (metadata dt_s)
+  Eigen::VectorXf pb;   // the PB the predictions used
+  std::string pb_source;  // "state Cylinder/i1/w0", "adapted", ...
+  Eigen::MatrixXd y_hat;  // y x n, n = T - 2: column j predicts row t = j + 2
+  Eigen::MatrixXd r;      // y x n: y_t - y_hat_t
+
+  int size() const { return static_cast<int>(r.cols()); }
+  // Row of the log that column j of y_hat and r belongs to.
+  static int row(int j) { return j + kFirstRow; }
+};
+
+struct ResidualData {
+  std::vector<std::string> y_names, u_names, aux_names;
+  // The model's standardisation std of each y channel (physical units): a
+  // residual variance divided by its square is in the units of the model's loss.
+  Eigen::VectorXd y_scale;
+  std::vector<ResidualLog> logs;
+};
+
+// A log as read from a file: its table and the path for messages.
+struct LogInput {
+  datalog::LogTable table;
+  std::string file;
+};
+
+// The PB of each log: "auto" (the model's PB for the log's state when the
+// model knows it, else a PB adapted to the logs of that state), "state"
+// (the state's PB; an unknown state is an error), "adapt" (adapted to the
+// logs of each state, MomentumSGD as `hadynet adapt`), "zero", a state name
+// of the model, or comma-separated values.
+// Throws std::runtime_error naming the log or the bad PB text.
+ResidualData compute_residuals(const HadynetModel& model, const std::vector<LogInput>& logs,
+                               const std::string& pb_choice);
+
+// Raw network predictions of every window of `steps` steps of a log:
+// column k * B + b is the prediction of row (start_b + k + 1), start_b = b + 1,
+// in physical units (y x steps * B, B = T - 1 - steps windows).
+Eigen::MatrixXd predict_windows(const HadynetModel& model, const LogSequence& seq,
+                                const Eigen::VectorXf& pb, int steps);
+
+// Fit and RMSE per channel and horizon h = 1..H over every window start of
+// every log (pooled: the norms run over all logs; the mean is the pooled mean
+// of the targets at that horizon):
+//   fit = 100 (1 - ||y - y_hat|| / ||y - mean(y)||)       (100: perfect, 0: no better than the mean)
+struct HorizonMetrics {
+  int horizon = 0;
+  long samples = 0;         // window starts (the same set for every h)
+  Eigen::MatrixXd fit;      // y x H, percent
+  Eigen::MatrixXd rmse;     // y x H, physical units
+};
+HorizonMetrics horizon_metrics(const HadynetModel& model, const ResidualData& data, int horizon);
+
+}  // namespace hadynet::trainer::residual

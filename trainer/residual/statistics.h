@@ -1,0 +1,74 @@
+// Statistics of the residual loop (docs/residual.md): distribution tails,
+// correlations pooled over several logs, whiteness tests, Holm's correction
+// and the small least-squares tools the attribution uses.
+//
+// Pooling: a "segmented" series is one Eigen vector per log. Every sum runs
+// inside one segment only (no product ever pairs samples of two logs), and
+// each segment is centred on its own mean (logs may have different offsets).
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace hadynet::trainer::residual {
+
+using Segments = std::vector<Eigen::VectorXd>;
+
+// Regularised incomplete gamma functions P(a, x) = gamma(a, x) / Gamma(a) and
+// Q = 1 - P, for a > 0, x >= 0 (series for x < a + 1, continued fraction
+// otherwise; relative accuracy ~1e-14). Throw std::domain_error otherwise.
+double gamma_p(double a, double x);
+double gamma_q(double a, double x);
+// Regularised incomplete beta I_x(a, b), a, b > 0, 0 <= x <= 1.
+double beta_inc(double a, double b, double x);
+
+// Upper tails: P(X > q) for X ~ chi-square(dof), P(T > t) for Student's t
+// with `dof` degrees of freedom (one-sided), P(F > f) for F(d1, d2).
+double chi_square_sf(double q, double dof);
+double student_t_sf(double t, double dof);
+double f_sf(double f, double d1, double d2);
+
+// Pooled autocorrelation at lags 1..max_lag (element k-1 is lag k):
+//   rho(k) = sum_logs sum_t a_t a_{t+k} / sum_logs sum_t a_t^2   (a centred per log)
+Eigen::VectorXd autocorrelation(const Segments& a, int max_lag);
+
+// Pooled cross-correlation at lags -max_lag..max_lag (element k + max_lag is lag k):
+//   rho_ab(k) = sum a_t b_{t-k} / sqrt(sum a^2 sum b^2)
+// A positive k pairs a with b k steps earlier: b leads a (e.g. an input that
+// acts on a residual k steps later). Segments of a and b must have equal sizes.
+Eigen::VectorXd cross_correlation(const Segments& a, const Segments& b, int max_lag);
+
+// Number of samples in all segments; pairs at lag k: sum over logs of (n_log - k).
+long total_samples(const Segments& a);
+long pairs_at_lag(const Segments& a, int lag);
+
+// The 99 % bound of a correlation of white noise: 2.58 / sqrt(N).
+double correlation_bound_99(long samples);
+
+// Ljung-Box portmanteau test of whiteness on the pooled autocorrelation:
+//   Q = N (N + 2) sum_{k=1..h} rho_k^2 / n_k,   n_k = pairs at lag k
+// (n_k = N - k for one log, the textbook formula), Q ~ chi-square(h) when the
+// series is white.
+struct LjungBox {
+  double q = 0;
+  int dof = 0;
+  double p_value = 1;
+};
+LjungBox ljung_box(const Segments& a, int max_lag);
+
+// Holm's step-down correction of a family of p-values: adjusted p-values
+// (monotone, capped at 1) in the input order. Controls the family-wise error
+// rate under any dependence between the tests.
+std::vector<double> holm_adjust(const std::vector<double>& p_values);
+
+// Least-squares AR(p) fit x_t = sum_i a_i x_{t-i} + e_t on segmented,
+// centred data (no pair across a log boundary). Returns a (size p) and the
+// residual variance through `noise_variance` (if not null).
+Eigen::VectorXd fit_ar(const Segments& x, int order, double* noise_variance = nullptr);
+// AR order in 0..max_order minimising BIC = n log(sigma^2) + p log(n).
+int choose_ar_order(const Segments& x, int max_order);
+// Applies the whitening filter e_t = x_t - sum_i a_i x_{t-i} per segment; the
+// first p samples of each segment are dropped.
+Segments ar_filter(const Segments& x, const Eigen::VectorXd& a);
+
+}  // namespace hadynet::trainer::residual
