@@ -2,8 +2,10 @@
 # Codegen and the firmware core on the model the main job just trained:
 # generate its q15 and f32 headers, build host-sim with it (a second build
 # tree, build/main-model), replay held-out plant logs through the firmware
-# (prediction, d, contact), and run the grasp stabiliser in closed loop with
-# the MuJoCo hand under the scripted strikes (E with and without control).
+# (prediction, d, contact), build the Cortex-M4 images with it
+# (build/main-model-m4) and replay a log through the MCU image in QEMU (must
+# equal host-sim bit for bit), and run the grasp stabiliser in closed loop
+# with the MuJoCo hand under the scripted strikes (E with and without).
 # Writes everything to OUT and a summary to OUT/summary.md (docs/firmware.md
 # discusses the figures).
 # Usage: scripts/firmware_experiments.sh [MODEL] [DATA_DIR] [OUT_DIR]
@@ -45,6 +47,23 @@ end_section
 section "replay: the same grasp log, q15 against f32 (the CSVs differ only by quantisation)"
 record "$hadynet" replay "$data/test/Cylinder_random2_i3_w0.csv" --numeric f32 \
   --out "$out/replay_Cylinder_random2_i3_w0_f32.csv"
+end_section
+
+section "the same log through the MCU image (Cortex-M4, DSP kernels) in QEMU, over the link"
+cmake --preset cortex-m4 -B build/main-model-m4 -DHADYNET_MODEL="$PWD/$model" \
+  -DHADYNET_CODEGEN_EXECUTABLE="$PWD/build/main-model/codegen/hadynet-codegen" >/dev/null
+cmake --build build/main-model-m4 --parallel "$(nproc)" | grep -E '^-- size' | tee -a "$summary" || true
+record "$hadynet" replay "$data/test/Cylinder_random2_i3_w0.csv" --target qemu \
+  --image build/main-model-m4/images/mps2-an386/hadynet-firmware.elf --out "$out/replay_Cylinder_random2_i3_w0_qemu.csv"
+# Every column but the stabiliser's losses (which only host-sim reports).
+strip_losses() { sed -E 's/,[^,]*,[^,]*$//' "$1"; }
+if cmp -s <(strip_losses "$out/replay_Cylinder_random2_i3_w0.csv") \
+          <(strip_losses "$out/replay_Cylinder_random2_i3_w0_qemu.csv"); then
+  echo "QEMU (MCU image) and host-sim q15: bit-identical" | tee -a "$summary"
+else
+  echo "QEMU (MCU image) and host-sim q15 DIFFER" | tee -a "$summary"
+  exit 1
+fi
 end_section
 
 section "grasp stabiliser in closed loop with the plant: Cylinder init 3, default strikes, q15"

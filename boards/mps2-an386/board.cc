@@ -35,7 +35,10 @@ constexpr std::uint32_t kBaud = 115200;
 constexpr std::uint32_t kBaudDiv = (config::kCoreClockHz + kBaud / 2) / kBaud;
 static_assert(kBaudDiv >= 16, "CMSDK UART needs BAUDDIV >= 16");
 
-RxRing<256> g_rx;
+// Room for two maximal wire frames (2 x 513 bytes, next power of two): a
+// whole frame arriving while the main loop is busy (a control period, or
+// QEMU delivering a burst faster than any baud rate) is never dropped.
+RxRing<2048> g_rx;
 
 constexpr Description kDescription = {
     config::kName, config::kCoreClockHz, config::kCoreClockHz, config::kFlashBytes, config::kRamBytes,

@@ -25,7 +25,10 @@ constexpr std::uint32_t kBaud = 115200;
 constexpr int kTxPin = 9, kRxPin = 10;  // PA9, PA10
 constexpr std::uint32_t kUsart1AlternateFunction = 7;
 
-RxRing<256> g_rx;
+// Room for two maximal wire frames (2 x 513 bytes, next power of two): a
+// whole frame arriving while the main loop is busy (a control period, or
+// QEMU delivering a burst faster than any baud rate) is never dropped.
+RxRing<2048> g_rx;
 
 // Filled in by init() with the clock the board actually runs at.
 Description g_description = {

@@ -33,6 +33,12 @@ class QemuLink : public ::testing::Test {
     tools::LinkSession<Q> session(qemu_->link());
     session.connect();  // reset: sequence numbers restart at the session's next (1)
     client_.set_next_sequence(1);
+    // connect() may have sent its reset more than once (a slow machine);
+    // drop the late acknowledgements so that every exchange below reads its
+    // own reply.
+    std::uint8_t buffer[256];
+    while (qemu_->link().read(buffer, 500) > 0) {
+    }
   }
 
   // Sends raw wire bytes and returns the next reply frame (decoded, checked).
