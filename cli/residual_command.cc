@@ -17,6 +17,7 @@
 #include "datalog/log_reader.h"
 #include "trainer/model_file.h"
 #include "trainer/residual/attribution.h"
+#include "trainer/residual/augment.h"
 #include "trainer/residual/residuals.h"
 #include "trainer/residual/whiteness.h"
 
@@ -357,6 +358,85 @@ std::string markdown(const Analysis& a, const std::string& model_path, const std
   return m;
 }
 
+// ---- --fix ----
+
+json held_out_json(const rs::HeldOutError& e) {
+  json ch = json::array();
+  for (std::size_t c = 0; c < e.channels.size(); ++c) {
+    const auto i = static_cast<Eigen::Index>(c);
+    const auto& w = e.whiteness[c];
+    ch.push_back({{"channel", e.channels[c]}, {"rmse", e.rmse(i)}, {"fit_percent", e.fit(i)},
+                  {"ljung_box", {{"q", w.ljung_box.q}, {"dof", w.ljung_box.dof}, {"p_value", w.ljung_box.p_value}}},
+                  {"white", w.white()}, {"acf_lags_outside", w.outside}, {"input_lags_outside", e.inputs_outside[c]}});
+  }
+  return {{"samples", e.samples}, {"verdict", e.verdict}, {"channels", ch}};
+}
+
+json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
+  json j = {{"status", f.status},
+            {"changed", f.changed},
+            {"train_fraction", o.train_fraction},
+            {"epochs", o.epochs},
+            {"lr", o.lr},
+            {"seed", o.seed},
+            {"before", held_out_json(f.before)}};
+  if (f.augmentation) {
+    j["augmentation"] = {{"effect", f.augmentation->effect}, {"description", f.augmentation->description},
+                         {"channels", f.augmentation->channels}, {"delay_steps", f.augmentation->delay}};
+  }
+  if (f.control) j["control"] = held_out_json(*f.control);
+  if (f.changed) {
+    j["after"] = held_out_json(f.after);
+    j["loss_history"] = f.loss_history;
+    j["train_windows"] = f.train_windows;
+  }
+  return j;
+}
+
+// Per channel: RMSE and fit before / fine-tune only / after, and Ljung-Box p before / after.
+std::string fix_table(const rs::FixResult& f) {
+  auto find = [](const rs::HeldOutError& e, const std::string& name) -> int {
+    for (std::size_t c = 0; c < e.channels.size(); ++c)
+      if (e.channels[c] == name) return static_cast<int>(c);
+    return -1;
+  };
+  const rs::HeldOutError& last = f.changed ? f.after : f.before;
+  std::string m = "| channel | RMSE before | RMSE fine-tune only | RMSE after | fit before (%) | fit after (%) | "
+                  "Ljung-Box p before | after | input lags outside before | after |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& name : last.channels) {
+    const int b = find(f.before, name), c = f.control ? find(*f.control, name) : -1, a = find(f.after, name);
+    auto cell = [](const rs::HeldOutError* e, int i, const char* fmt, int what) -> std::string {
+      if (e == nullptr || i < 0) return "-";
+      const auto k = static_cast<Eigen::Index>(i);
+      const double v = what == 0 ? e->rmse(k) : what == 1 ? e->fit(k) : what == 2
+                       ? e->whiteness[static_cast<std::size_t>(i)].ljung_box.p_value
+                       : e->inputs_outside[static_cast<std::size_t>(i)];
+      return num(fmt, v);
+    };
+    const rs::HeldOutError* after = f.changed ? &f.after : nullptr;
+    const rs::HeldOutError* ctrl = f.control ? &*f.control : nullptr;
+    m += "| " + name + " | " + cell(&f.before, b, "%.4g", 0) + " | " + cell(ctrl, c, "%.4g", 0) + " | " +
+         cell(after, a, "%.4g", 0) + " | " + cell(&f.before, b, "%.1f", 1) + " | " + cell(after, a, "%.1f", 1) + " | " +
+         cell(&f.before, b, "%.2g", 2) + " | " + cell(after, a, "%.2g", 2) + " | " + cell(&f.before, b, "%.0f", 3) +
+         " | " + cell(after, a, "%.0f", 3) + " |\n";
+  }
+  return m;
+}
+
+std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const std::string& out) {
+  std::string m = "\n## Fix (--fix)\n\n**" + f.status + "**";
+  if (f.augmentation) m += ": " + f.augmentation->effect + ", " + f.augmentation->description;
+  m += "\n\nFine-tuned " + std::to_string(o.epochs) + " epochs (batch norm frozen, Adam lr " + num("%g", o.lr) +
+       ", seed " + std::to_string(o.seed) + ") on the first " + num("%.0f", 100 * o.train_fraction) +
+       " % of each log's rows; every number below is on the remaining rows (" + std::to_string(f.before.samples) +
+       " held-out rows, causal 1-step predictions of the measured values). \"Fine-tune only\" is the same "
+       "fine-tuning without the augmentation.\n\n";
+  m += "Verdict before: " + f.before.verdict + "\n\n";
+  if (f.changed) m += "Verdict after (the augmented model on its own frame): " + f.after.verdict + "\n\n";
+  if (!out.empty()) m += "Model written: `" + out + "`\n\n";
+  return m + fix_table(f);
+}
+
 std::string verdict_text(const rs::Attribution& att) {
   const auto w = att.winner();
   if (!w) return "no significant effect";
@@ -397,6 +477,13 @@ int run_residual(int argc, char** argv) {
   opt.flag("all-sources", "cross-talk sources from every observed group (default: the target's group)");
   opt.value("report", "DIR", "write DIR/REPORT.md with PNG plots (gnuplot) and DIR/residual.json");
   opt.value("json", "FILE", "write every number as JSON");
+  opt.flag("fix", "add the winning effect (sensor-delay: time alignment; aux-channel: as an input), fine-tune on the\n"
+                  "first --train-fraction of each log and report before/after on the rest");
+  opt.value("out", "FILE", "with --fix: write the augmented model (only when something was fixed)");
+  opt.value("fix-epochs", "N", "with --fix: fine-tuning epochs", "20");
+  opt.value("fix-lr", "X", "with --fix: Adam learning rate", "0.001");
+  opt.value("fix-seed", "N", "with --fix: seed of the window order", "1");
+  opt.flag("no-control", "with --fix: skip the fine-tune-only comparison");
   if (!opt.parse(argc, argv)) return 2;
   if (opt.help_requested()) return 0;
   if (opt.positional().size() < 2) {
@@ -415,6 +502,14 @@ int run_residual(int argc, char** argv) {
     if (!horizon) return 2;
   }
   if (!max_lag || !max_delay || !fraction || !alpha || !min_share || !min_std) return 2;
+  const auto fix_epochs = opt.get_int("fix-epochs", 1, 100000);
+  const auto fix_lr = opt.get_double("fix-lr", 1e-12, 10.0);
+  const auto fix_seed = opt.get_int("fix-seed", 0, (1ll << 62));
+  if (!fix_epochs || !fix_lr || !fix_seed) return 2;
+  if (opt.has("out") && !opt.has("fix")) {
+    std::fprintf(stderr, "hadynet residual: --out needs --fix\n");
+    return 2;
+  }
 
   try {
     const std::string model_path = opt.positional().front();
@@ -474,7 +569,42 @@ int run_residual(int argc, char** argv) {
     }
     std::printf("\nverdict: %s\n", a.verdict.c_str());
 
-    const json j = analysis_json(a, model_path, pb_choice);
+    json j = analysis_json(a, model_path, pb_choice);
+    rs::FixOptions fo;
+    fo.train_fraction = *fraction;
+    fo.epochs = static_cast<int>(*fix_epochs);
+    fo.lr = *fix_lr;
+    fo.seed = static_cast<std::uint64_t>(*fix_seed);
+    fo.control = !opt.has("no-control");
+    std::optional<rs::FixResult> fixed;
+    std::string written;
+    if (opt.has("fix")) {
+      fixed = rs::fix(model, inputs, d, a.attribution, fo);
+      std::printf("\nfix: %s%s\n", fixed->status.c_str(),
+                  fixed->augmentation ? (": " + fixed->augmentation->description).c_str() : "");
+      const rs::HeldOutError& e = fixed->changed ? fixed->after : fixed->before;
+      std::printf("held-out 1-step RMSE (%ld rows)   %-10s %11s %11s %11s   LB p before/after\n", fixed->before.samples,
+                  "channel", "before", "fine-tune", "after");
+      for (std::size_t c = 0; c < e.channels.size(); ++c) {
+        const auto i = static_cast<Eigen::Index>(c);
+        const bool old = c < fixed->before.channels.size();
+        std::printf("                                  %-10s %11.4g %11.4g %11.4g   %.2g / %.2g\n", e.channels[c].c_str(),
+                    old ? fixed->before.rmse(i) : NAN, fixed->control && old ? fixed->control->rmse(i) : NAN,
+                    fixed->changed ? fixed->after.rmse(i) : NAN,
+                    old ? fixed->before.whiteness[c].ljung_box.p_value : NAN,
+                    fixed->changed ? fixed->after.whiteness[c].ljung_box.p_value : NAN);
+      }
+      if (fixed->changed) std::printf("verdict after: %s\n", fixed->after.verdict.c_str());
+      if (fixed->changed && opt.has("out")) {
+        written = opt.get("out");
+        trainer::save_model(written, fixed->model);
+        std::fprintf(stderr, "wrote %s\n", written.c_str());
+      } else if (opt.has("out")) {
+        std::fprintf(stderr, "nothing fixed: %s not written\n", opt.get("out").c_str());
+      }
+      j["fix"] = fix_json(*fixed, fo);
+      if (!written.empty()) j["fix"]["model"] = written;
+    }
     auto write_json = [&](const std::string& path) {
       std::ofstream out(path);
       if (!out) throw std::runtime_error(path + ": cannot write");
@@ -505,6 +635,7 @@ int run_residual(int argc, char** argv) {
       std::ofstream md(md_path);
       if (!md) throw std::runtime_error(md_path + ": cannot write");
       md << markdown(a, model_path, pb_choice, pngs);
+      if (fixed) md << fix_markdown(*fixed, fo, written);
       std::fprintf(stderr, "wrote %s\n", md_path.c_str());
     }
   } catch (const std::exception& e) {

@@ -5,7 +5,8 @@
 # must compile without warnings, link no heap or exceptions and fit each
 # board's memory), then the release suite under CTest, which also runs the
 # images under QEMU (test/boards/), then the same host suite under
-# ASan + UBSan (debug preset).
+# ASan + UBSan (debug preset), without the tests labelled `slow` (model
+# fine-tuning; they ran in release already).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

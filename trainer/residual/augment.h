@@ -1,0 +1,109 @@
+// The second half of the residual loop (docs/residual.md, "--fix"): add the
+// attribution's winning effect to the model, fine-tune it, and measure the
+// error before and after on held-out data.
+//
+// Implemented augmentations (both keep the network's structure, so codegen and
+// the firmware accept the result; see docs/residual.md for why the others are
+// not done yet):
+//   sensor-delay  time alignment. The delayed channels C (the winner's family,
+//                 all with the same delay d) are shifted d steps earlier in the
+//                 data, y'_c(s) = y_c(s + d), and the model is fine-tuned on
+//                 the aligned logs: it predicts the true-time signal. The
+//                 delay is an output transform stated in the model file
+//                 (provenance "output_delay"): the measured y_c(t) is the
+//                 model's y'_c(t - d). Same dims and weights layout.
+//   aux-channel   the aux_* column becomes an observed channel: appended to y
+//                 (and so to x, as an input of the encoder). The encoder gets a
+//                 zero column for it and the decoder a zero row (the new output
+//                 starts at the channel's mean), then the model is fine-tuned.
+//                 dims.x and dims.y grow by one.
+//
+// Held out by time: the first `train_fraction` of each log's rows are the only
+// data fine-tuning sees; every number is reported on the remaining rows.
+// A causal 1-step prediction of a measured row t in both frames: the model
+// starts from frame row t - d - 1 (all of it is known at t - 1: a delayed
+// channel's true value at t - d - 1 is its measurement at t - 1) and runs
+// d + 1 steps with the logged commands; a delayed channel's measured y_c(t) is
+// its first step, every other channel its last. With d = 0 this is the plain
+// 1-step prediction of compute_residuals.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "trainer/hadynet_model.h"
+#include "trainer/residual/attribution.h"
+#include "trainer/residual/residuals.h"
+#include "trainer/residual/whiteness.h"
+
+namespace hadynet::trainer::residual {
+
+struct FixOptions {
+  double train_fraction = 0.6;  // of each log's rows, from its start: what fine-tuning sees
+  int epochs = 20;              // fine-tuning epochs from the current weights (batch norm frozen)
+  int batch = 100;
+  double lr = 1e-3;             // Adam
+  std::uint64_t seed = 1;       // window order
+  bool control = true;          // also fine-tune without the augmentation (same data, epochs, seed)
+};
+
+// What --fix adds, from the winner and its family.
+struct Augmentation {
+  EffectKind kind = EffectKind::kSensorDelay;
+  std::string effect;              // library name
+  std::string description;         // e.g. "time-align fc1, fc2, fc6 by 2 steps"
+  std::vector<std::string> channels;  // delayed y channels (delay); the aux channel (aux)
+  int delay = 0;                   // steps (sensor-delay); 0 otherwise
+};
+
+// True for the effects --fix implements (sensor-delay, aux-channel).
+bool fix_supported(EffectKind kind);
+
+// The augmentation of the attribution's winner (sensor-delay: every family
+// member with the winner's delay). None without a winner.
+std::optional<Augmentation> plan_augmentation(const ResidualData& data, const Attribution& attribution);
+
+// Logs in the augmented model's frame: aligned (delayed channels shifted d
+// rows earlier, the last d rows dropped); unchanged otherwise.
+std::vector<LogInput> augmented_logs(const std::vector<LogInput>& logs, const Augmentation& a);
+
+// The model with the augmentation's structural change (aux: one more y and x
+// channel, standardisation fitted on `train_seqs`, which must hold the aux
+// column as a y channel) and the provenance keys "residual_fix" and
+// "output_delay" (delay). Weights otherwise unchanged; detection statistics
+// are dropped (they belong to the old weights) and ranges must be re-measured.
+HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
+                             const std::vector<LogSequence>& train_seqs);
+
+// Error of one model on the held-out rows, per channel (physical units).
+struct HeldOutError {
+  std::vector<std::string> channels;  // the model's y channels
+  Eigen::VectorXd rmse;               // sqrt(mean (y - y_hat)^2)
+  Eigen::VectorXd fit;                // 100 (1 - ||y - y_hat|| / ||y - mean(y)||), percent
+  std::vector<Whiteness> whiteness;   // Ljung-Box etc. of the held-out 1-step residual, per channel
+  std::vector<int> inputs_outside;    // lags -L..L outside the 99 % bound, summed over the inputs
+  long samples = 0;                   // held-out rows (all logs)
+  std::string verdict;                // attribution on the model's own frame (empty: not run)
+};
+
+struct FixResult {
+  std::string status;  // "no significant effect", "not supported: ...", "fixed"
+  std::optional<Augmentation> augmentation;
+  bool changed = false;        // a new model was produced
+  HadynetModel model;          // the augmented, fine-tuned model (the input model if !changed)
+  HeldOutError before, after;  // after: the augmented model (empty if !changed)
+  std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
+  std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
+  long train_windows = 0;
+};
+
+// The whole --fix step for the analysed `logs` (`data` and `attribution` are
+// the analysis of `model` on them, as `hadynet residual` computes them).
+// Throws std::runtime_error for logs too short for the split.
+FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, const ResidualData& data,
+              const Attribution& attribution, const FixOptions& options);
+
+}  // namespace hadynet::trainer::residual
