@@ -383,6 +383,10 @@ json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
   if (f.augmentation) {
     j["augmentation"] = {{"effect", f.augmentation->effect}, {"description", f.augmentation->description},
                          {"channels", f.augmentation->channels}, {"delay_steps", f.augmentation->delay}};
+    if (f.augmentation->kind == rs::EffectKind::kCrosstalk) {
+      j["augmentation"]["source"] = f.augmentation->source;
+      j["augmentation"]["gain"] = f.augmentation->gain;
+    }
   }
   if (f.control) j["control"] = held_out_json(*f.control);
   if (f.changed) {
@@ -477,8 +481,9 @@ int run_residual(int argc, char** argv) {
   opt.flag("all-sources", "cross-talk sources from every observed group (default: the target's group)");
   opt.value("report", "DIR", "write DIR/REPORT.md with PNG plots (gnuplot) and DIR/residual.json");
   opt.value("json", "FILE", "write every number as JSON");
-  opt.flag("fix", "add the winning effect (sensor-delay: time alignment; aux-channel: as an input), fine-tune on the\n"
-                  "first --train-fraction of each log and report before/after on the rest");
+  opt.flag("fix", "add the winning effect (sensor-delay: time alignment; aux-channel: as an input; crosstalk: removed\n"
+                  "from the data), fine-tune on the first --train-fraction of each log and report before/after on\n"
+                  "the rest");
   opt.value("out", "FILE", "with --fix: write the augmented model (only when something was fixed)");
   opt.value("fix-epochs", "N", "with --fix: fine-tuning epochs", "20");
   opt.value("fix-lr", "X", "with --fix: Adam learning rate", "0.001");

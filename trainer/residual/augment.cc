@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
@@ -90,10 +91,20 @@ std::vector<double> fine_tune(HadynetModel& model, const std::vector<LogSequence
   return history;
 }
 
+// How the model's frame maps to the measured channels (see the header).
+struct OutputMap {
+  std::vector<bool> delayed;  // per y channel: reported d steps late
+  int d = 0;
+  int xt_target = -1, xt_source = -1;  // crosstalk: measured y_c = y'_c + gain y_s
+  double gain = 0;
+};
+
 // Physical predictions of the measured rows of one log (y x T_raw, NaN where
 // there is none): see the header for the frame and the d + 1 steps.
 Eigen::MatrixXd measured_predictions(const HadynetModel& model, const LogSequence& frame, const Eigen::VectorXf& pb,
-                                     const std::vector<bool>& delayed, int d, int rows_raw) {
+                                     const OutputMap& map, int rows_raw) {
+  const std::vector<bool>& delayed = map.delayed;
+  const int d = map.d;
   const Eigen::MatrixXd p = predict_windows(model, frame, pb, d + 1);
   const Eigen::Index B = p.cols() / (d + 1);
   Eigen::MatrixXd out = Eigen::MatrixXd::Constant(p.rows(), rows_raw, std::numeric_limits<double>::quiet_NaN());
@@ -104,6 +115,7 @@ Eigen::MatrixXd measured_predictions(const HadynetModel& model, const LogSequenc
       const Eigen::Index k = delayed[static_cast<std::size_t>(c)] ? 0 : d;
       out(c, t) = p(c, k * B + b);
     }
+    if (map.xt_target >= 0) out(map.xt_target, t) += map.gain * p(map.xt_source, b);
   }
   return out;
 }
@@ -115,8 +127,7 @@ struct EvalLog {
   int first = 0, end = 0;  // held-out rows [first, end)
 };
 
-HeldOutError held_out_error(const HadynetModel& model, const std::vector<EvalLog>& logs,
-                            const std::vector<bool>& delayed, int d) {
+HeldOutError held_out_error(const HadynetModel& model, const std::vector<EvalLog>& logs, const OutputMap& map) {
   HeldOutError e;
   e.channels = model.layout.y_names;
   const auto ny = static_cast<Eigen::Index>(e.channels.size());
@@ -124,7 +135,7 @@ HeldOutError held_out_error(const HadynetModel& model, const std::vector<EvalLog
   Eigen::VectorXd sum_y = Eigen::VectorXd::Zero(ny), sum_yy = sum_y, sum_ee = sum_y;
   std::vector<Segments> res(static_cast<std::size_t>(ny)), inp(static_cast<std::size_t>(nu));
   for (const auto& log : logs) {
-    const Eigen::MatrixXd p = measured_predictions(model, log.frame, log.pb, delayed, d, log.measured.steps());
+    const Eigen::MatrixXd p = measured_predictions(model, log.frame, log.pb, map, log.measured.steps());
     const int n = log.end - log.first;
     const Eigen::MatrixXd y = log.measured.y.middleCols(log.first, n);
     const Eigen::MatrixXd r = y - p.middleCols(log.first, n);
@@ -161,7 +172,9 @@ std::string verdict_of(const Attribution& a) {
 
 }  // namespace
 
-bool fix_supported(EffectKind kind) { return kind == EffectKind::kSensorDelay || kind == EffectKind::kAuxChannel; }
+bool fix_supported(EffectKind kind) {
+  return kind == EffectKind::kSensorDelay || kind == EffectKind::kAuxChannel || kind == EffectKind::kCrosstalk;
+}
 
 std::optional<Augmentation> plan_augmentation(const ResidualData& data, const Attribution& attribution) {
   const auto w = attribution.winner();
@@ -182,6 +195,16 @@ std::optional<Augmentation> plan_augmentation(const ResidualData& data, const At
       a.channels = {data.aux_names[static_cast<std::size_t>(h.source)]};
       a.description = "use " + a.channels[0] + " as an observed channel (input of x, predicted in y)";
       break;
+    case EffectKind::kCrosstalk: {
+      a.channels = {data.y_names[static_cast<std::size_t>(h.target)]};
+      a.source = data.y_names[static_cast<std::size_t>(h.source)];
+      a.gain = w->parameter;
+      char gain[32];
+      std::snprintf(gain, sizeof gain, "%.4g", a.gain);
+      a.description = "remove the crosstalk " + a.source + " -> " + a.channels[0] + " (train on " + a.channels[0] +
+                      " - " + gain + " " + a.source + "; output_crosstalk adds it back)";
+      break;
+    }
     default:
       a.description = effect_info(h.kind).augmentation;
       break;
@@ -189,7 +212,26 @@ std::optional<Augmentation> plan_augmentation(const ResidualData& data, const At
   return a;
 }
 
+namespace {
+
+// The crosstalk frame: the target column minus gain times the source column, every row.
+std::vector<LogInput> crosstalk_removed(const std::vector<LogInput>& logs, const Augmentation& a) {
+  std::vector<LogInput> out = logs;
+  for (auto& in : out) {
+    auto& t = in.table;
+    const auto c = t.column_index(a.channels.at(0));
+    const auto s = t.column_index(a.source);
+    if (!c || !s) throw std::runtime_error(in.file + ": no column '" + (c ? a.source : a.channels.at(0)) + "'");
+    const std::size_t cols = t.columns.size();
+    for (std::size_t r = 0; r < t.rows(); ++r) t.values[r * cols + *c] -= a.gain * t.values[r * cols + *s];
+  }
+  return out;
+}
+
+}  // namespace
+
 std::vector<LogInput> augmented_logs(const std::vector<LogInput>& logs, const Augmentation& a) {
+  if (a.kind == EffectKind::kCrosstalk) return crosstalk_removed(logs, a);
   if (a.kind != EffectKind::kSensorDelay || a.delay == 0) return logs;
   std::vector<LogInput> out;
   for (const auto& in : logs) {
@@ -221,6 +263,13 @@ HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
   m.provenance["residual_fix"] = a.effect + ": " + a.description;
   if (a.kind == EffectKind::kSensorDelay) {
     m.provenance["output_delay"] = join(a.channels) + ": " + std::to_string(a.delay) + " steps";
+    return m;
+  }
+  if (a.kind == EffectKind::kCrosstalk) {
+    char gain[32];
+    std::snprintf(gain, sizeof gain, "%.6g", a.gain);
+    m.provenance["output_crosstalk"] = a.channels.at(0) + " += " + gain + " * " + a.source +
+                                       " (inputs: " + a.channels.at(0) + " -= " + gain + " * " + a.source + ")";
     return m;
   }
   if (a.kind != EffectKind::kAuxChannel) throw std::invalid_argument("--fix: " + a.effect + " is not implemented");
@@ -311,8 +360,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   };
   std::vector<Eigen::VectorXf> before_pbs;
   for (const auto& log : data.logs) before_pbs.push_back(log.pb);
-  const std::vector<bool> none(model.layout.y_names.size(), false);
-  result.before = held_out_error(model, eval_logs(model, logs, before_pbs), none, 0);
+  OutputMap none;
+  none.delayed.assign(model.layout.y_names.size(), false);
+  result.before = held_out_error(model, eval_logs(model, logs, before_pbs), none);
   result.before.verdict = verdict_of(attribution);
 
   if (aug == nullptr) {
@@ -344,7 +394,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     const auto seqs = training_part(logs, c.layout, 0);
     const auto rows = ensure_states(c, seqs, before_pbs);
     fine_tune(c, seqs, rows, options, nullptr);
-    result.control = held_out_error(c, eval_logs(c, logs, state_pbs(c)), none, 0);
+    result.control = held_out_error(c, eval_logs(c, logs, state_pbs(c)), none);
   }
 
   // The augmented layout first (aux adds a channel), then its training data.
@@ -360,12 +410,20 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.loss_history = fine_tune(after, seqs, rows, options, &result.train_windows);
   after.check_consistent();
 
-  std::vector<bool> delayed(after.layout.y_names.size(), false);
+  OutputMap map;
+  map.delayed.assign(after.layout.y_names.size(), false);
+  map.d = d;
   for (const auto& name : aug->channels) {
     const int c = index_of(after.layout.y_names, name);
-    if (c >= 0 && aug->kind == EffectKind::kSensorDelay) delayed[static_cast<std::size_t>(c)] = true;
+    if (c >= 0 && aug->kind == EffectKind::kSensorDelay) map.delayed[static_cast<std::size_t>(c)] = true;
   }
-  result.after = held_out_error(after, eval_logs(after, frame_logs, state_pbs(after)), delayed, d);
+  if (aug->kind == EffectKind::kCrosstalk) {
+    map.xt_target = index_of(after.layout.y_names, aug->channels.at(0));
+    map.xt_source = index_of(after.layout.y_names, aug->source);
+    if (map.xt_target < 0 || map.xt_source < 0) throw std::logic_error("--fix: crosstalk channels not in the model");
+    map.gain = aug->gain;
+  }
+  result.after = held_out_error(after, eval_logs(after, frame_logs, state_pbs(after)), map);
   // The residual analysis of the augmented model in its own frame.
   ResidualData again = compute_residuals(after, frame_logs, "state");
   // An aux column the model now predicts is no longer an unused channel.

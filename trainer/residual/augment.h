@@ -2,7 +2,7 @@
 // attribution's winning effect to the model, fine-tune it, and measure the
 // error before and after on held-out data.
 //
-// Implemented augmentations (both keep the network's structure, so codegen and
+// Implemented augmentations (all keep the network's structure, so codegen and
 // the firmware accept the result; see docs/residual.md for why the others are
 // not done yet):
 //   sensor-delay  time alignment. The delayed channels C (the winner's family,
@@ -17,6 +17,16 @@
 //                 zero column for it and the decoder a zero row (the new output
 //                 starts at the channel's mean), then the model is fine-tuned.
 //                 dims.x and dims.y grow by one.
+//   crosstalk     removal of the cross-talk from the data. The winner's target
+//                 c picks up k times source s (the fitted gain): the c column
+//                 is replaced by y'_c = y_c - k y_s in every row (so in y and
+//                 in x), and the model is fine-tuned on these logs: it
+//                 predicts the channel without the cross-talk. The cross-talk
+//                 is an output transform stated in the model file (provenance
+//                 "output_crosstalk"): the measured y_c(t) is the model's
+//                 y'_c(t) + k y_s(t), with y_s the model's own prediction of
+//                 the source; the inputs get y_c - k y_s. Same dims and
+//                 weights layout.
 //
 // Held out by time: the first `train_fraction` of each log's rows are the only
 // data fine-tuning sees; every number is reported on the remaining rows.
@@ -25,7 +35,9 @@
 // channel's true value at t - d - 1 is its measurement at t - 1) and runs
 // d + 1 steps with the logged commands; a delayed channel's measured y_c(t) is
 // its first step, every other channel its last. With d = 0 this is the plain
-// 1-step prediction of compute_residuals.
+// 1-step prediction of compute_residuals. For crosstalk (d = 0) the measured
+// target is the model's y'_c(t) plus k times its prediction of y_s(t), both
+// from the same step.
 #pragma once
 
 #include <Eigen/Core>
@@ -55,11 +67,13 @@ struct Augmentation {
   EffectKind kind = EffectKind::kSensorDelay;
   std::string effect;              // library name
   std::string description;         // e.g. "time-align fc1, fc2, fc6 by 2 steps"
-  std::vector<std::string> channels;  // delayed y channels (delay); the aux channel (aux)
+  std::vector<std::string> channels;  // delayed y channels (delay); the aux channel (aux); the target (crosstalk)
   int delay = 0;                   // steps (sensor-delay); 0 otherwise
+  std::string source;              // crosstalk: the source y channel; empty otherwise
+  double gain = 0;                 // crosstalk: fitted gain k (target units per source unit); 0 otherwise
 };
 
-// True for the effects --fix implements (sensor-delay, aux-channel).
+// True for the effects --fix implements (sensor-delay, aux-channel, crosstalk).
 bool fix_supported(EffectKind kind);
 
 // The augmentation of the attribution's winner (sensor-delay: every family
@@ -67,13 +81,14 @@ bool fix_supported(EffectKind kind);
 std::optional<Augmentation> plan_augmentation(const ResidualData& data, const Attribution& attribution);
 
 // Logs in the augmented model's frame: aligned (delayed channels shifted d
-// rows earlier, the last d rows dropped); unchanged otherwise.
+// rows earlier, the last d rows dropped); crosstalk: the target column
+// replaced by y_c - k y_s (same rows); unchanged otherwise.
 std::vector<LogInput> augmented_logs(const std::vector<LogInput>& logs, const Augmentation& a);
 
 // The model with the augmentation's structural change (aux: one more y and x
 // channel, standardisation fitted on `train_seqs`, which must hold the aux
 // column as a y channel) and the provenance keys "residual_fix" and
-// "output_delay" (delay). Weights otherwise unchanged; detection statistics
+// "output_delay" (delay) or "output_crosstalk" (crosstalk). Weights otherwise unchanged; detection statistics
 // are dropped (they belong to the old weights) and ranges must be re-measured.
 HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
                              const std::vector<LogSequence>& train_seqs);
