@@ -202,14 +202,13 @@ int run_replay(int argc, char** argv) {
         }
         stream = std::make_unique<tools::FdStream>(tools::FdStream::open_serial(opt.get("device"), static_cast<int>(*baud)));
       } else {
-        const std::string hp = opt.get("tcp");
-        const auto colon = hp.rfind(':');
-        if (colon == std::string::npos || colon == 0) {
-          std::fprintf(stderr, "hadynet replay: --tcp needs HOST:PORT, not '%s'\n", hp.c_str());
+        const auto host_port = tools::parse_host_port(opt.get("tcp"));
+        if (!host_port) {
+          std::fprintf(stderr, "hadynet replay: --tcp needs HOST:PORT, not '%s'\n", opt.get("tcp").c_str());
           return 2;
         }
         stream = std::make_unique<tools::FdStream>(
-            tools::FdStream::connect_tcp(hp.substr(0, colon), std::atoi(hp.c_str() + colon + 1), 5000));
+            tools::FdStream::connect_tcp(host_port->first, host_port->second, 5000));
       }
       ro.target = hostsim::ReplayTarget::kStream;
       ro.stream = stream.get();

@@ -3,6 +3,7 @@
 #include <arpa/inet.h>
 #include <cerrno>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
 #include <netdb.h>
@@ -35,6 +36,12 @@ speed_t baud_constant(int baud) {
 std::string errno_text() { return std::strerror(errno); }
 
 }  // namespace
+
+std::optional<std::pair<std::string, int>> parse_host_port(const std::string& text) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0) return std::nullopt;
+  return std::make_pair(text.substr(0, colon), std::atoi(text.c_str() + colon + 1));
+}
 
 FdStream FdStream::open_serial(const std::string& device, int baud) {
   const speed_t speed = baud_constant(baud);

@@ -2,11 +2,17 @@
 // connected TCP socket.
 #pragma once
 
+#include <optional>
 #include <string>
+#include <utility>
 
 #include "tools/link/byte_stream.h"
 
 namespace hadynet::tools {
+
+// "HOST:PORT" split at its last colon (so "[::1]:4000"-style hosts keep
+// theirs); nullopt if there is no colon or no host.
+std::optional<std::pair<std::string, int>> parse_host_port(const std::string& text);
 
 class FdStream : public ByteStream {
  public:
