@@ -17,6 +17,7 @@
 #include <utility>
 
 #include "firmware/core/fixed_point.h"
+#include "trainer/derived_inputs.h"
 #include "trainer/deploy_prep.h"
 #include "trainer/log_dataset.h"
 #include "trainer/model_file.h"
@@ -260,10 +261,16 @@ std::vector<firmware::LossClass> loss_classes(const HadynetModel& model, const C
 // kControlActive: which u channels the stabiliser may change.
 std::vector<bool> active_commands(const HadynetModel& model, const ControlOptions& c) {
   const std::vector<std::string>& u = model.layout.u_names;
-  std::vector<bool> active(u.size(), c.commands.empty());
+  // A derived input (sign_u0, hyst_u0: trainer/derived_inputs.h) is computed
+  // from a command, so it is never one the stabiliser sets.
+  std::vector<bool> active(u.size(), false);
+  if (c.commands.empty())
+    for (std::size_t i = 0; i < u.size(); ++i) active[i] = !trainer::parse_derived_input(u[i]).has_value();
   for (const std::string& name : c.commands) {
     const auto it = std::find(u.begin(), u.end(), name);
     if (it == u.end()) reject("control command '" + name + "' is not a u channel of the model");
+    if (trainer::parse_derived_input(name))
+      reject("control command '" + name + "' is computed from another command (a derived input), not set by the stabiliser");
     active[static_cast<std::size_t>(it - u.begin())] = true;
   }
   return active;

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "datalog/log_reader.h"
+#include "trainer/derived_inputs.h"
 
 namespace hadynet::trainer {
 
@@ -95,10 +96,17 @@ FeatureLayout feature_layout_from_names(std::vector<std::string> y_names,
 
 LogSequence log_sequence(const datalog::LogTable& table, const std::string& file,
                          const FeatureLayout& layout) {
-  const auto columns_of = [&](const std::vector<std::string>& names) {
+  // Column of each name; a command channel the log lacks may be derived from
+  // another command (derived_inputs.h): kDerived, filled below.
+  constexpr std::size_t kDerived = static_cast<std::size_t>(-1);
+  const auto columns_of = [&](const std::vector<std::string>& names, bool allow_derived) {
     std::vector<std::size_t> cols;
     for (const std::string& n : names) {
       const auto c = table.column_index(n);
+      if (!c && allow_derived && derived_input_column(table, n)) {
+        cols.push_back(kDerived);
+        continue;
+      }
       if (!c) {
         throw std::runtime_error(file + ": no column '" + n +
                                  "'; the model's channels must all be in the log");
@@ -107,8 +115,8 @@ LogSequence log_sequence(const datalog::LogTable& table, const std::string& file
     }
     return cols;
   };
-  const std::vector<std::size_t> y_cols = columns_of(layout.y_names);
-  const std::vector<std::size_t> u_cols = columns_of(layout.u_names);
+  const std::vector<std::size_t> y_cols = columns_of(layout.y_names, false);
+  const std::vector<std::size_t> u_cols = columns_of(layout.u_names, true);
   const Eigen::Index T = static_cast<Eigen::Index>(table.rows());
 
   LogSequence seq;
@@ -122,7 +130,12 @@ LogSequence log_sequence(const datalog::LogTable& table, const std::string& file
     for (std::size_t i = 0; i < y_cols.size(); ++i)
       seq.y(static_cast<Eigen::Index>(i), t) = table.at(row, y_cols[i]);
     for (std::size_t i = 0; i < u_cols.size(); ++i)
-      seq.u(static_cast<Eigen::Index>(i), t) = table.at(row, u_cols[i]);
+      if (u_cols[i] != kDerived) seq.u(static_cast<Eigen::Index>(i), t) = table.at(row, u_cols[i]);
+  }
+  for (std::size_t i = 0; i < u_cols.size(); ++i) {
+    if (u_cols[i] != kDerived) continue;
+    const std::vector<double> v = *derived_input_column(table, layout.u_names[i]);
+    for (Eigen::Index t = 0; t < T; ++t) seq.u(static_cast<Eigen::Index>(i), t) = v[static_cast<std::size_t>(t)];
   }
   return seq;
 }

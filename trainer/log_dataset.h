@@ -60,8 +60,10 @@ struct LogSequence {
   int steps() const { return static_cast<int>(y.cols()); }
 };
 
-// Extracts y and u of `layout` from a log, by column name. Throws
-// std::runtime_error naming the file and the first missing channel.
+// Extracts y and u of `layout` from a log, by column name; a command channel
+// the log lacks is computed when its name states a derivation from a logged
+// command (sign_u0, hyst_u0: derived_inputs.h). Throws std::runtime_error
+// naming the file and the first missing channel.
 LogSequence log_sequence(const datalog::LogTable& table, const std::string& file,
                          const FeatureLayout& layout);
 

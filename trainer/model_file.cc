@@ -1,5 +1,6 @@
 #include "trainer/model_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
@@ -102,6 +103,12 @@ void HadynetModel::check_consistent() const {
          "detection statistics sizes");
     need(std::isfinite(c.threshold) && c.threshold > 0, "detection threshold not positive");
   }
+  for (const OutputClip& c : output_clips) {
+    need(std::find(layout.y_names.begin(), layout.y_names.end(), c.channel) != layout.y_names.end(),
+         "output clip on '" + c.channel + "', not a y channel");
+    need(c.side == 1 || c.side == -1, "output clip side must be +1 or -1");
+    need(std::isfinite(c.rail), "output clip rail not finite");
+  }
   if (ranges) {
     for (const ValueRangeField& f : kValueRangeFields) {
       const double v = (*ranges).*f.member;
@@ -164,6 +171,12 @@ st::File model_to_safetensors(const HadynetModel& model) {
     r["windows"] = model.ranges->windows;
     r["source"] = model.ranges->source;
     file.metadata["ranges"] = r.dump();
+  }
+  if (!model.output_clips.empty()) {
+    json clips = json::array();
+    for (const OutputClip& c : model.output_clips)
+      clips.push_back({{"channel", c.channel}, {"side", c.side}, {"rail", c.rail}});
+    file.metadata["output_clips"] = clips.dump();
   }
   return file;
 }
@@ -284,6 +297,15 @@ HadynetModel model_from_safetensors(const st::File& file, const std::string& ori
       ranges.windows = json_get<long>(r, "windows", "ranges", origin);
       ranges.source = json_get<std::string>(r, "source", "ranges", origin);
       model.ranges = std::move(ranges);
+    }
+
+    if (file.metadata.count("output_clips") != 0) {
+      const json clips = parse_metadata_json(file, "output_clips", origin);
+      if (!clips.is_array()) fail(origin, "metadata 'output_clips' is not an array");
+      for (const json& c : clips)
+        model.output_clips.push_back({json_get<std::string>(c, "channel", "output_clips", origin),
+                                      json_get<int>(c, "side", "output_clips", origin),
+                                      json_get<double>(c, "rail", "output_clips", origin)});
     }
 
     for (const auto& [name, tensor] : file.tensors) {

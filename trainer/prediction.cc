@@ -3,6 +3,7 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "trainer/output_clip.h"
 #include "trainer/window_dataset.h"
 
 namespace hadynet::trainer {
@@ -23,6 +24,7 @@ Eigen::MatrixXd simulate(const HadynetModel& model, const Eigen::VectorXd& x0,
   const Matrix<float>& y_hat = net.forward(model.params, batch, BnMode::kEval);
   Eigen::MatrixXd y = y_hat.cast<double>();
   for (Eigen::Index k = 0; k < y.cols(); ++k) y.col(k) = model.norm.y.physical(y.col(k));
+  apply_output_clips(model, y);
   return y;
 }
 
@@ -39,7 +41,8 @@ Eigen::MatrixXd prediction_errors(const HadynetModel& model, const LogSequence& 
   data.gather(ids, batch, y);
   batch.pb = pb.replicate(1, data.size());
   HadynetNetwork<float> net;
-  const Matrix<float>& y_hat = net.forward(model.params, batch, BnMode::kEval);
+  Matrix<float> y_hat = net.forward(model.params, batch, BnMode::kEval);
+  clip_standardised(model, y_hat);
   const Eigen::Index B = data.size();
   errors = (y_hat.rightCols(B) - y.rightCols(B)).cast<double>();  // last step of each window
   return errors;

@@ -60,6 +60,8 @@ HadynetModel sample_model(bool with_detection) {
     r.windows = 321;
     r.source = "spring logs \"a\" (data_hash 0123)";
     m.ranges = r;
+    // And output clips (hadynet residual --fix for a saturation).
+    m.output_clips = {{m.layout.y_names.front(), 1, 0.1875}, {m.layout.y_names.back(), -1, -2.5}};
   }
   return m;
 }
@@ -104,6 +106,7 @@ void expect_same_model(const HadynetModel& got, const HadynetModel& want) {
     EXPECT_EQ(g.samples, w.samples);
     EXPECT_EQ(g.source, w.source);
   }
+  EXPECT_EQ(got.output_clips, want.output_clips);
   ASSERT_EQ(got.ranges.has_value(), want.ranges.has_value());
   if (want.ranges) {
     EXPECT_EQ(*got.ranges, *want.ranges);  // doubles exactly (JSON round trip)
@@ -211,6 +214,18 @@ class ModelFileRejects : public ::testing::Test {
     value.replace(pos, from.size(), to);
   }
 };
+
+TEST_F(ModelFileRejects, OutputClipOnAnUnknownChannelOrSide) {
+  st::File f = good_;
+  edit_metadata(f, "output_clips", "\"side\":-1", "\"side\":0");
+  expect_rejected(f, "output clip side");
+  f = good_;
+  edit_metadata(f, "output_clips", "\"channel\":\"", "\"channel\":\"no_");
+  expect_rejected(f, "not a y channel");
+  f = good_;
+  edit_metadata(f, "output_clips", "\"rail\"", "\"rial\"");
+  expect_rejected(f, "rail");
+}
 
 TEST_F(ModelFileRejects, TheUnmodifiedFileLoads) {
   st::write_file(path_, good_);

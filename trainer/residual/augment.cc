@@ -8,6 +8,8 @@
 #include <stdexcept>
 
 #include "trainer/deploy_prep.h"
+#include "trainer/derived_inputs.h"
+#include "trainer/output_clip.h"
 #include "trainer/hadynet_network.h"
 #include "trainer/optim.h"
 #include "trainer/training.h"
@@ -64,7 +66,7 @@ std::vector<double> fine_tune(HadynetModel& model, const std::vector<LogSequence
   HadynetNetwork<float> net;
   HadynetGrads<float> grads;
   WindowBatch<float> batch;
-  Matrix<float> y, d_y;
+  Matrix<float> y, y_hat, d_y;
   std::vector<double> history;
   const auto batch_size = static_cast<std::size_t>(std::max(1, o.batch));
   for (int epoch = 1; epoch <= o.epochs; ++epoch) {
@@ -74,8 +76,11 @@ std::vector<double> fine_tune(HadynetModel& model, const std::vector<LogSequence
     for (std::size_t begin = 0; begin < order.size(); begin += batch_size) {
       const std::size_t n = std::min(batch_size, order.size() - begin);
       data.gather(std::span<const int>(order).subspan(begin, n), batch, y);
-      const Matrix<float>& y_hat = net.forward(model.params, batch, BnMode::kEval);
+      // The loss of the clipped output (saturation; no clips: the plain loss).
+      y_hat = net.forward(model.params, batch, BnMode::kEval);
+      clip_standardised(model, y_hat);
       sum += static_cast<double>(mse_loss(y_hat, y, &d_y));
+      clip_standardised(model, y_hat, &d_y);  // zero gradient where clipped
       net.backward(model.params, d_y, grads);
       adam.step(model.params, grads.params);
       ++batches;
@@ -97,12 +102,13 @@ struct OutputMap {
   int d = 0;
   int xt_target = -1, xt_source = -1;  // crosstalk: measured y_c = y'_c + gain y_s
   double gain = 0;
+  std::vector<std::pair<int, DriftState>> drifts;  // y row, drift: measured y_c = y'_c + b_c
 };
 
 // Physical predictions of the measured rows of one log (y x T_raw, NaN where
 // there is none): see the header for the frame and the d + 1 steps.
 Eigen::MatrixXd measured_predictions(const HadynetModel& model, const LogSequence& frame, const Eigen::VectorXf& pb,
-                                     const OutputMap& map, int rows_raw) {
+                                     const OutputMap& map, const LogInput& measured, int rows_raw) {
   const std::vector<bool>& delayed = map.delayed;
   const int d = map.d;
   const Eigen::MatrixXd p = predict_windows(model, frame, pb, d + 1);
@@ -117,10 +123,23 @@ Eigen::MatrixXd measured_predictions(const HadynetModel& model, const LogSequenc
     }
     if (map.xt_target >= 0) out(map.xt_target, t) += map.gain * p(map.xt_source, b);
   }
+  // Drift: the bias state is known up to row t - 1 from the measurements; its
+  // last increment is estimated from the prediction itself (causal).
+  const double dt = log_dt(measured);
+  for (const auto& [c, drift] : map.drifts) {
+    const std::vector<double> driver = drift_driver(measured, drift);
+    for (int t = d + 2; t < rows_raw; ++t) {
+      if (std::isnan(out(c, t))) continue;
+      const double known = drift.rate * driver[static_cast<std::size_t>(t - 1)];
+      const double increment = drift.load ? std::abs(out(c, t) + known) * dt : dt;
+      out(c, t) += known + drift.rate * increment;
+    }
+  }
   return out;
 }
 
 struct EvalLog {
+  const LogInput* raw = nullptr;  // the measured log
   LogSequence measured;  // raw log in the model's layout
   LogSequence frame;     // the log in the model's frame (aligned for a delay)
   Eigen::VectorXf pb;
@@ -135,7 +154,7 @@ HeldOutError held_out_error(const HadynetModel& model, const std::vector<EvalLog
   Eigen::VectorXd sum_y = Eigen::VectorXd::Zero(ny), sum_yy = sum_y, sum_ee = sum_y;
   std::vector<Segments> res(static_cast<std::size_t>(ny)), inp(static_cast<std::size_t>(nu));
   for (const auto& log : logs) {
-    const Eigen::MatrixXd p = measured_predictions(model, log.frame, log.pb, map, log.measured.steps());
+    const Eigen::MatrixXd p = measured_predictions(model, log.frame, log.pb, map, *log.raw, log.measured.steps());
     const int n = log.end - log.first;
     const Eigen::MatrixXd y = log.measured.y.middleCols(log.first, n);
     const Eigen::MatrixXd r = y - p.middleCols(log.first, n);
@@ -172,9 +191,7 @@ std::string verdict_of(const Attribution& a) {
 
 }  // namespace
 
-bool fix_supported(EffectKind kind) {
-  return kind == EffectKind::kSensorDelay || kind == EffectKind::kAuxChannel || kind == EffectKind::kCrosstalk;
-}
+bool fix_supported(EffectKind kind) { return kind != EffectKind::kInputDelay; }
 
 std::optional<Augmentation> plan_augmentation(const ResidualData& data, const Attribution& attribution) {
   const auto w = attribution.winner();
@@ -205,6 +222,44 @@ std::optional<Augmentation> plan_augmentation(const ResidualData& data, const At
                       " - " + gain + " " + a.source + "; output_crosstalk adds it back)";
       break;
     }
+    case EffectKind::kFriction: {
+      std::vector<std::string> muscles;
+      for (const auto& r : attribution.winner_family()) {
+        a.channels.push_back(data.y_names[static_cast<std::size_t>(r.hypothesis.target)]);
+        const std::string& m = data.u_names[static_cast<std::size_t>(r.hypothesis.source)];
+        if (std::find(muscles.begin(), muscles.end(), m) == muscles.end()) muscles.push_back(m);
+      }
+      for (const auto& m : muscles)
+        for (const DerivedKind k : {DerivedKind::kSign, DerivedKind::kHysteresis})
+          a.inputs.push_back(derived_input_name({k, m}));
+      a.description = "add the hysteresis state of " + join(muscles) + " as inputs (" + join(a.inputs) +
+                      "; friction on " + join(a.channels) + ")";
+      break;
+    }
+    case EffectKind::kSaturation: {
+      std::vector<std::string> rails;
+      for (const auto& r : attribution.winner_family()) {
+        const auto& hr = r.hypothesis;
+        a.channels.push_back(data.y_names[static_cast<std::size_t>(hr.target)]);
+        a.clips.push_back({a.channels.back(), hr.side, hr.rail});
+        char text[96];
+        std::snprintf(text, sizeof text, "%s %s %.4g", a.channels.back().c_str(), hr.side > 0 ? "<=" : ">=", hr.rail);
+        rails.push_back(text);
+      }
+      a.description = "clip the prediction at the measured rail: " + join(rails) + " (trained on the clipped output)";
+      break;
+    }
+    case EffectKind::kDriftLoad:
+    case EffectKind::kDriftTime: {
+      for (const auto& r : attribution.winner_family()) {
+        a.channels.push_back(data.y_names[static_cast<std::size_t>(r.hypothesis.target)]);
+        a.drifts.push_back({a.channels.back(), h.kind == EffectKind::kDriftLoad, r.parameter});
+      }
+      a.description = std::string("a bias state growing with ") +
+                      (h.kind == EffectKind::kDriftLoad ? "the accumulated load" : "time") + " on " +
+                      join(a.channels) + ", removed from the data and added to the prediction";
+      break;
+    }
     default:
       a.description = effect_info(h.kind).augmentation;
       break;
@@ -212,48 +267,72 @@ std::optional<Augmentation> plan_augmentation(const ResidualData& data, const At
   return a;
 }
 
+std::vector<LogInput> augmented_logs(const std::vector<LogInput>& logs, const Augmentation& a) {
+  switch (a.kind) {
+    case EffectKind::kSensorDelay:
+      return time_aligned(logs, a.channels, a.delay);
+    case EffectKind::kCrosstalk:
+      return crosstalk_removed(logs, a.channels.at(0), a.source, a.gain);
+    case EffectKind::kDriftLoad:
+    case EffectKind::kDriftTime:
+      return drift_removed(logs, a.drifts);
+    default:
+      return logs;
+  }
+}
+
 namespace {
 
-// The crosstalk frame: the target column minus gain times the source column, every row.
-std::vector<LogInput> crosstalk_removed(const std::vector<LogInput>& logs, const Augmentation& a) {
-  std::vector<LogInput> out = logs;
-  for (auto& in : out) {
-    auto& t = in.table;
-    const auto c = t.column_index(a.channels.at(0));
-    const auto s = t.column_index(a.source);
-    if (!c || !s) throw std::runtime_error(in.file + ": no column '" + (c ? a.source : a.channels.at(0)) + "'");
-    const std::size_t cols = t.columns.size();
-    for (std::size_t r = 0; r < t.rows(); ++r) t.values[r * cols + *c] -= a.gain * t.values[r * cols + *s];
+// Mean and population std of row `row` over the training sequences' `Eigen::MatrixXd LogSequence::*` rows.
+std::pair<double, double> row_moments(const std::vector<LogSequence>& seqs, Eigen::MatrixXd LogSequence::*part,
+                                      Eigen::Index row, const std::string& name) {
+  double sum = 0, sum_sq = 0;
+  long n = 0;
+  for (const auto& s : seqs) {
+    if ((s.*part).rows() <= row) throw std::invalid_argument("--fix: training logs lack " + name);
+    sum += (s.*part).row(row).sum();
+    sum_sq += (s.*part).row(row).squaredNorm();
+    n += s.steps();
   }
-  return out;
+  if (n == 0) throw std::invalid_argument("--fix: no training rows");
+  const double mean = sum / static_cast<double>(n);
+  const double sd = std::sqrt(std::max(0.0, sum_sq / static_cast<double>(n) - mean * mean));
+  return {mean, sd > 0 ? sd : 1.0};
+}
+
+void append(Eigen::VectorXd& v, double value) {
+  v.conservativeResize(v.size() + 1);
+  v(v.size() - 1) = value;
+}
+
+// `m` (a copy of `model`) with the derived command channels `inputs` appended
+// to u: standardisation from the training rows (whose u holds them, last),
+// zero LSTM input weights (inputs are [u ; p]).
+HadynetModel with_derived_inputs(const HadynetModel& model, HadynetModel m, const std::vector<std::string>& inputs,
+                                 const std::vector<LogSequence>& train_seqs) {
+  std::vector<std::string> u = model.layout.u_names;
+  u.insert(u.end(), inputs.begin(), inputs.end());
+  m.layout = feature_layout_from_names(model.layout.y_names, u, model.layout.delta_groups);
+  const auto u_old = static_cast<Eigen::Index>(model.layout.u_names.size());
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const auto [mean, sd] = row_moments(train_seqs, &LogSequence::u, u_old + static_cast<Eigen::Index>(i), inputs[i]);
+    append(m.norm.u.mean, mean);
+    append(m.norm.u.std, sd);
+  }
+  auto& p = m.params;
+  const auto k = static_cast<Eigen::Index>(inputs.size());
+  const Eigen::Index pb = p.dims.pb;
+  RowMatrix<float> ih(p.lstm_weight_ih.rows(), u_old + k + pb);
+  ih.setZero();
+  ih.leftCols(u_old) = p.lstm_weight_ih.leftCols(u_old);
+  ih.rightCols(pb) = p.lstm_weight_ih.rightCols(pb);
+  p.lstm_weight_ih = ih;
+  p.dims.u += static_cast<int>(k);
+  p.check_shapes();
+  return m;
 }
 
 }  // namespace
-
-std::vector<LogInput> augmented_logs(const std::vector<LogInput>& logs, const Augmentation& a) {
-  if (a.kind == EffectKind::kCrosstalk) return crosstalk_removed(logs, a);
-  if (a.kind != EffectKind::kSensorDelay || a.delay == 0) return logs;
-  std::vector<LogInput> out;
-  for (const auto& in : logs) {
-    const auto& t = in.table;
-    const std::size_t T = t.rows(), cols = t.columns.size(), d = static_cast<std::size_t>(a.delay);
-    if (T <= d) throw std::runtime_error(in.file + ": fewer rows than the delay");
-    std::vector<bool> shifted(cols, false);
-    for (const auto& name : a.channels) {
-      const auto c = t.column_index(name);
-      if (!c) throw std::runtime_error(in.file + ": no column '" + name + "'");
-      shifted[*c] = true;
-    }
-    LogInput aligned{datalog::LogTable{}, in.file};
-    aligned.table.metadata = t.metadata;
-    aligned.table.columns = t.columns;
-    aligned.table.values.reserve((T - d) * cols);
-    for (std::size_t r = 0; r + d < T; ++r)
-      for (std::size_t c = 0; c < cols; ++c) aligned.table.values.push_back(t.at(shifted[c] ? r + d : r, c));
-    out.push_back(std::move(aligned));
-  }
-  return out;
-}
 
 HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
                              const std::vector<LogSequence>& train_seqs) {
@@ -272,6 +351,27 @@ HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
                                        " (inputs: " + a.channels.at(0) + " -= " + gain + " * " + a.source + ")";
     return m;
   }
+  if (a.kind == EffectKind::kSaturation) {
+    for (const OutputClip& c : a.clips) {
+      const auto it = std::find_if(m.output_clips.begin(), m.output_clips.end(),
+                                   [&](const OutputClip& o) { return o.channel == c.channel && o.side == c.side; });
+      if (it != m.output_clips.end()) *it = c;
+      else m.output_clips.push_back(c);
+    }
+    return m;
+  }
+  if (a.kind == EffectKind::kDriftLoad || a.kind == EffectKind::kDriftTime) {
+    std::string text;
+    for (const DriftState& d : a.drifts) {
+      char item[160];
+      std::snprintf(item, sizeof item, "%s%s += %.6g * %s", text.empty() ? "" : "; ", d.channel.c_str(), d.rate,
+                    d.load ? ("sum |" + d.channel + "| dt").c_str() : "t");
+      text += item;
+    }
+    m.provenance["output_drift"] = text + " (inputs: the same bias subtracted; sums and t from the log's start)";
+    return m;
+  }
+  if (a.kind == EffectKind::kFriction) return with_derived_inputs(model, m, a.inputs, train_seqs);
   if (a.kind != EffectKind::kAuxChannel) throw std::invalid_argument("--fix: " + a.effect + " is not implemented");
   const std::string& aux = a.channels.at(0);
   std::vector<std::string> y = model.layout.y_names;
@@ -281,23 +381,8 @@ HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
   if (m.layout.x_names.back() != aux || m.layout.x_names.size() != model.layout.x_names.size() + 1)
     throw std::logic_error("--fix: unexpected x layout for " + aux);
   // Standardisation of the new channel over the training rows (population std).
-  double sum = 0, sum_sq = 0;
-  long n = 0;
   const auto row = static_cast<Eigen::Index>(y.size() - 1);
-  for (const auto& s : train_seqs) {
-    if (s.y.rows() != row + 1) throw std::invalid_argument("--fix: training logs lack " + aux);
-    sum += s.y.row(row).sum();
-    sum_sq += s.y.row(row).squaredNorm();
-    n += s.steps();
-  }
-  if (n == 0) throw std::invalid_argument("--fix: no training rows");
-  const double mean = sum / static_cast<double>(n);
-  double sd = std::sqrt(std::max(0.0, sum_sq / static_cast<double>(n) - mean * mean));
-  if (!(sd > 0)) sd = 1.0;
-  auto append = [](Eigen::VectorXd& v, double value) {
-    v.conservativeResize(v.size() + 1);
-    v(v.size() - 1) = value;
-  };
+  const auto [mean, sd] = row_moments(train_seqs, &LogSequence::y, row, aux);
   append(m.norm.y.mean, mean);
   append(m.norm.y.std, sd);
   append(m.norm.x.mean, mean);
@@ -344,6 +429,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     std::vector<EvalLog> out;
     for (std::size_t i = 0; i < logs.size(); ++i) {
       EvalLog e;
+      e.raw = &logs[i];
       e.measured = log_sequence(logs[i].table, logs[i].file, m.layout);
       e.frame = log_sequence(frame_logs[i].table, frame_logs[i].file, m.layout);
       e.pb = pbs[i];
@@ -374,6 +460,58 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     return result;
   }
 
+  auto output_map = [&](const HadynetModel& m, const Augmentation& a) {
+    OutputMap map;
+    map.delayed.assign(m.layout.y_names.size(), false);
+    map.d = d;
+    for (const auto& name : a.channels) {
+      const int c = index_of(m.layout.y_names, name);
+      if (c >= 0 && a.kind == EffectKind::kSensorDelay) map.delayed[static_cast<std::size_t>(c)] = true;
+    }
+    if (a.kind == EffectKind::kCrosstalk) {
+      map.xt_target = index_of(m.layout.y_names, a.channels.at(0));
+      map.xt_source = index_of(m.layout.y_names, a.source);
+      if (map.xt_target < 0 || map.xt_source < 0) throw std::logic_error("--fix: crosstalk channels not in the model");
+      map.gain = a.gain;
+    }
+    for (const DriftState& drift : a.drifts) map.drifts.emplace_back(index_of(m.layout.y_names, drift.channel), drift);
+    return map;
+  };
+
+  // Drift rates: the attribution's fit is low (the model carries part of a
+  // bias over from x_t). Each channel's rate is re-estimated as the one, on a
+  // grid of 0..5x the fitted rate in steps of 0.1x, that minimises the
+  // unchanged model's 1-step RMSE of that channel in the measured frame on
+  // the training rows (the bias removed from the inputs, added to the
+  // prediction). Channels in family order, each with the others' rates so far.
+  if (!aug->drifts.empty()) {
+    Augmentation& a = *result.augmentation;
+    for (std::size_t k = 0; k < a.drifts.size(); ++k) {
+      result.fitted_rates.push_back(a.drifts[k].rate);
+      const double fitted = a.drifts[k].rate;
+      const auto c = static_cast<Eigen::Index>(index_of(model.layout.y_names, a.drifts[k].channel));
+      double best_rate = fitted, best_rmse = std::numeric_limits<double>::infinity();
+      for (int step = 0; step <= 50; ++step) {
+        a.drifts[k].rate = fitted * 0.1 * step;
+        std::vector<EvalLog> train = eval_logs(model, augmented_logs(logs, a), before_pbs);
+        for (std::size_t i = 0; i < train.size(); ++i) {
+          train[i].end = train[i].first;
+          train[i].first = ResidualLog::kFirstRow;
+        }
+        const double rmse = held_out_error(model, train, output_map(model, a)).rmse(c);
+        if (rmse < best_rmse) best_rmse = rmse, best_rate = a.drifts[k].rate;
+      }
+      a.drifts[k].rate = best_rate;
+    }
+    char text[64];
+    std::string rates;
+    for (const DriftState& drift : a.drifts) {
+      std::snprintf(text, sizeof text, "%s%s %.4g", rates.empty() ? "" : ", ", drift.channel.c_str(), drift.rate);
+      rates += text;
+    }
+    a.description += "; rates re-estimated: " + rates;
+  }
+
   // Training parts: raw rows [0, first) in the measured frame; the aligned frame
   // holds them in rows [0, first - d).
   const std::vector<LogInput> frame_logs = augmented_logs(logs, *aug);
@@ -397,12 +535,17 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     result.control = held_out_error(c, eval_logs(c, logs, state_pbs(c)), none);
   }
 
-  // The augmented layout first (aux adds a channel), then its training data.
+  // The augmented layout first (aux adds a channel, friction commands), then its training data.
   FeatureLayout layout = model.layout;
   if (aug->kind == EffectKind::kAuxChannel) {
     std::vector<std::string> y = layout.y_names;
     y.push_back(aug->channels.at(0));
     layout = feature_layout_from_names(y, layout.u_names, layout.delta_groups);
+  }
+  if (!aug->inputs.empty()) {
+    std::vector<std::string> u = layout.u_names;
+    u.insert(u.end(), aug->inputs.begin(), aug->inputs.end());
+    layout = feature_layout_from_names(layout.y_names, u, layout.delta_groups);
   }
   const auto seqs = training_part(frame_logs, layout, d);
   HadynetModel after = augmented_model(model, *aug, seqs);
@@ -410,19 +553,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.loss_history = fine_tune(after, seqs, rows, options, &result.train_windows);
   after.check_consistent();
 
-  OutputMap map;
-  map.delayed.assign(after.layout.y_names.size(), false);
-  map.d = d;
-  for (const auto& name : aug->channels) {
-    const int c = index_of(after.layout.y_names, name);
-    if (c >= 0 && aug->kind == EffectKind::kSensorDelay) map.delayed[static_cast<std::size_t>(c)] = true;
-  }
-  if (aug->kind == EffectKind::kCrosstalk) {
-    map.xt_target = index_of(after.layout.y_names, aug->channels.at(0));
-    map.xt_source = index_of(after.layout.y_names, aug->source);
-    if (map.xt_target < 0 || map.xt_source < 0) throw std::logic_error("--fix: crosstalk channels not in the model");
-    map.gain = aug->gain;
-  }
+  const OutputMap map = output_map(after, *aug);
   result.after = held_out_error(after, eval_logs(after, frame_logs, state_pbs(after)), map);
   // The residual analysis of the augmented model in its own frame.
   ResidualData again = compute_residuals(after, frame_logs, "state");

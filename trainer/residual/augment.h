@@ -2,9 +2,7 @@
 // attribution's winning effect to the model, fine-tune it, and measure the
 // error before and after on held-out data.
 //
-// Implemented augmentations (all keep the network's structure, so codegen and
-// the firmware accept the result; see docs/residual.md for why the others are
-// not done yet):
+// Implemented augmentations (docs/residual.md says for each why this one):
 //   sensor-delay  time alignment. The delayed channels C (the winner's family,
 //                 all with the same delay d) are shifted d steps earlier in the
 //                 data, y'_c(s) = y_c(s + d), and the model is fine-tuned on
@@ -27,6 +25,27 @@
 //                 y'_c(t) + k y_s(t), with y_s the model's own prediction of
 //                 the source; the inputs get y_c - k y_s. Same dims and
 //                 weights layout.
+//   friction      a hysteresis state as an input. For every muscle m of the
+//                 winner's family, two derived command channels sign_<m>
+//                 (direction of motion) and hyst_<m> (sign of the last
+//                 non-zero command; trainer/derived_inputs.h) are appended to
+//                 u. The LSTM gets zero input columns for them (the model
+//                 starts as before), then it is fine-tuned. dims.u grows by
+//                 two per muscle; a log needs no new column (they are computed
+//                 from the commands).
+//   saturation    clipping: every family channel's prediction passes through
+//                 min(., R) (max for a lower rail) with its measured rail R
+//                 (HadynetModel::output_clips, applied by every prediction),
+//                 and the model is fine-tuned on the clipped output (the loss
+//                 gradient of a clipped element is 0). Same dims.
+//   drift-load,   a drift/bias state b_c(t) = rate * D_c(t) per family channel
+//   drift-time    (D: accumulated load sum |y_c| dt, or time), removed from
+//                 the data, y'_c = y_c - b_c (in y and x), and added back to the
+//                 prediction; the rate is re-estimated before fine-tuning
+//                 (refine_drift_rates: the attribution's fitted rate is low,
+//                 since the model carries part of a bias over from x_t).
+//                 Stated in the model file (provenance "output_drift"). Same
+//                 dims.
 //
 // Held out by time: the first `train_fraction` of each log's rows are the only
 // data fine-tuning sees; every number is reported on the remaining rows.
@@ -48,6 +67,7 @@
 
 #include "trainer/hadynet_model.h"
 #include "trainer/residual/attribution.h"
+#include "trainer/residual/frame_transforms.h"
 #include "trainer/residual/residuals.h"
 #include "trainer/residual/whiteness.h"
 
@@ -67,13 +87,18 @@ struct Augmentation {
   EffectKind kind = EffectKind::kSensorDelay;
   std::string effect;              // library name
   std::string description;         // e.g. "time-align fc1, fc2, fc6 by 2 steps"
-  std::vector<std::string> channels;  // delayed y channels (delay); the aux channel (aux); the target (crosstalk)
+  // The affected y channels: delayed (delay), the aux channel (aux), the
+  // target (crosstalk), the friction targets, the clipped (saturation) or
+  // drifting (drift) channels.
+  std::vector<std::string> channels;
   int delay = 0;                   // steps (sensor-delay); 0 otherwise
   std::string source;              // crosstalk: the source y channel; empty otherwise
   double gain = 0;                 // crosstalk: fitted gain k (target units per source unit); 0 otherwise
+  std::vector<std::string> inputs;  // friction: derived u channels added (sign_u0, hyst_u0, ...)
+  std::vector<OutputClip> clips;    // saturation: one per channel
+  std::vector<DriftState> drifts;   // drift: one per channel (rates refined by fix())
 };
-
-// True for the effects --fix implements (sensor-delay, aux-channel, crosstalk).
+// True for the effects --fix implements (all but input-delay).
 bool fix_supported(EffectKind kind);
 
 // The augmentation of the attribution's winner (sensor-delay: every family
@@ -82,14 +107,17 @@ std::optional<Augmentation> plan_augmentation(const ResidualData& data, const At
 
 // Logs in the augmented model's frame: aligned (delayed channels shifted d
 // rows earlier, the last d rows dropped); crosstalk: the target column
-// replaced by y_c - k y_s (same rows); unchanged otherwise.
+// replaced by y_c - k y_s (same rows); drift: y_c - b_c (same rows);
+// unchanged otherwise (friction's inputs are derived from the commands).
 std::vector<LogInput> augmented_logs(const std::vector<LogInput>& logs, const Augmentation& a);
 
 // The model with the augmentation's structural change (aux: one more y and x
-// channel, standardisation fitted on `train_seqs`, which must hold the aux
-// column as a y channel) and the provenance keys "residual_fix" and
-// "output_delay" (delay) or "output_crosstalk" (crosstalk). Weights otherwise unchanged; detection statistics
-// are dropped (they belong to the old weights) and ranges must be re-measured.
+// channel; friction: the derived u channels; standardisation of a new channel
+// fitted on `train_seqs`, which must hold it), its output clips (saturation)
+// and the provenance keys "residual_fix" and "output_delay" (delay),
+// "output_crosstalk" (crosstalk) or "output_drift" (drift). Weights otherwise
+// unchanged (new inputs get zero weights); detection statistics are dropped
+// (they belong to the old weights) and ranges must be re-measured.
 HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
                              const std::vector<LogSequence>& train_seqs);
 
@@ -112,6 +140,7 @@ struct FixResult {
   HeldOutError before, after;  // after: the augmented model (empty if !changed)
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
+  std::vector<double> fitted_rates;     // drift: the attribution's rate per channel, before refinement
   long train_windows = 0;
 };
 

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "trainer/hadynet_network.h"
+#include "trainer/output_clip.h"
 #include "trainer/pb_adaptation.h"
 #include "trainer/window_dataset.h"
 
@@ -82,6 +83,7 @@ Eigen::MatrixXd predict_windows(const HadynetModel& model, const LogSequence& se
   HadynetNetwork<float> net;
   Eigen::MatrixXd y = net.forward(model.params, batch, BnMode::kEval).cast<double>();
   y = (y.array().colwise() * model.norm.y.std.array()).colwise() + model.norm.y.mean.array();
+  apply_output_clips(model, y);
   return y;
 }
 

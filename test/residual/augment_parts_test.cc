@@ -1,0 +1,127 @@
+// The parts --fix builds on (docs/residual.md, "--fix"), against hand-computed
+// answers: derived command channels, output clips (physical and on the
+// training loss), and the frame transforms (alignment, cross-talk and drift
+// removal). All exact: integer-valued or closed-form cases, tolerance 1e-12.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "trainer/derived_inputs.h"
+#include "trainer/log_dataset.h"
+#include "trainer/output_clip.h"
+#include "trainer/residual/frame_transforms.h"
+
+namespace hadynet::test {
+namespace {
+
+using namespace trainer;
+using namespace trainer::residual;
+
+datalog::LogTable table(const std::vector<std::string>& columns, const std::vector<std::vector<double>>& rows) {
+  datalog::LogTable t;
+  t.columns = columns;
+  for (const auto& r : rows) t.append_row(r);
+  return t;
+}
+
+TEST(DerivedInputs, SignAndHysteresisOfACommand) {
+  const auto t = table({"y0", "u0"}, {{0, 0}, {0, 0.5}, {0, 0}, {0, -2}, {0, 0}, {0, 0}, {0, 3}});
+  EXPECT_EQ(*derived_input_column(t, "sign_u0"), (std::vector<double>{0, 1, 0, -1, 0, 0, 1}));
+  // 0 before the first non-zero command, then the last non-zero command's sign.
+  EXPECT_EQ(*derived_input_column(t, "hyst_u0"), (std::vector<double>{0, 1, 1, -1, -1, -1, 1}));
+  EXPECT_FALSE(derived_input_column(t, "hyst_u7").has_value());  // no base column
+  EXPECT_FALSE(derived_input_column(t, "u0").has_value());       // not a derived name
+  EXPECT_FALSE(parse_derived_input("hyst_").has_value());
+  const auto d = parse_derived_input("sign_u12");
+  ASSERT_TRUE(d.has_value());
+  EXPECT_EQ(d->base, "u12");
+  EXPECT_EQ(derived_input_name(*d), "sign_u12");
+}
+
+TEST(DerivedInputs, LogSequenceComputesTheMissingColumnOnly) {
+  const auto t = table({"y0", "u0"}, {{1, 0}, {2, -1}, {3, 0}});
+  const FeatureLayout layout = feature_layout_from_names({"y0"}, {"u0", "hyst_u0"}, {});
+  const LogSequence s = log_sequence(t, "t.csv", layout);
+  EXPECT_EQ(s.u.row(1), Eigen::RowVector3d(0, -1, -1));
+  // A derived name of a missing base is still a missing column, named.
+  const FeatureLayout bad = feature_layout_from_names({"y0"}, {"u0", "hyst_u3"}, {});
+  try {
+    log_sequence(t, "t.csv", bad);
+    ADD_FAILURE() << "accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("t.csv: no column 'hyst_u3'"), std::string::npos) << e.what();
+  }
+  // y channels are never derived.
+  EXPECT_THROW(log_sequence(t, "t.csv", feature_layout_from_names({"sign_u0"}, {"u0"}, {})), std::runtime_error);
+}
+
+HadynetModel clip_model() {
+  HadynetModel m;
+  m.layout = feature_layout_from_names({"a0", "a1"}, {"u0"}, {});
+  m.norm.y.mean.resize(2);
+  m.norm.y.mean << 1.0, 0.0;
+  m.norm.y.std.resize(2);
+  m.norm.y.std << 2.0, 1.0;
+  m.output_clips = {{"a0", 1, 3.0}, {"a1", -1, -0.5}};
+  return m;
+}
+
+TEST(OutputClip, PhysicalAndStandardisedAgree) {
+  const HadynetModel m = clip_model();
+  Eigen::MatrixXd y(2, 3);
+  y << 2.0, 3.5, 10.0, -1.0, 0.0, -0.5;
+  apply_output_clips(m, y);
+  Eigen::MatrixXd want(2, 3);
+  want << 2.0, 3.0, 3.0, -0.5, 0.0, -0.5;
+  EXPECT_EQ(y, want);
+  // Standardised: a0's rail (3 - 1) / 2 = 1, a1's -0.5; clipped elements have
+  // no gradient.
+  Matrix<float> s(2, 3), grad = Matrix<float>::Ones(2, 3);
+  s << 0.5f, 1.25f, 4.5f, -1.0f, 0.0f, -0.5f;
+  EXPECT_EQ(clip_standardised(m, s, &grad), 3);
+  Matrix<float> want_s(2, 3), want_g(2, 3);
+  want_s << 0.5f, 1.0f, 1.0f, -0.5f, 0.0f, -0.5f;
+  want_g << 1, 0, 0, 0, 1, 1;  // exactly at the rail: not clipped
+  EXPECT_EQ(s, want_s);
+  EXPECT_EQ(grad, want_g);
+}
+
+LogInput drift_log() {
+  LogInput in{table({"fc0", "fc1", "u0"}, {{1, 5, 0}, {-2, 5, 0}, {3, 5, 0}, {0, 5, 0}}), "d.csv"};
+  in.table.metadata.set("dt_s", "0.5");
+  return in;
+}
+
+TEST(FrameTransforms, DriftDriverAndRemoval) {
+  const LogInput in = drift_log();
+  // Load: sum_{s<=t} |fc0(s)| dt = 0.5, 1.5, 3.0, 3.0; time: t dt.
+  EXPECT_EQ(drift_driver(in, {"fc0", true, 0.1}), (std::vector<double>{0.5, 1.5, 3.0, 3.0}));
+  EXPECT_EQ(drift_driver(in, {"fc0", false, 0.1}), (std::vector<double>{0.0, 0.5, 1.0, 1.5}));
+  const auto out = drift_removed({in}, {{"fc0", true, 0.1}, {"fc1", false, 2.0}});
+  const double want0[] = {1 - 0.05, -2 - 0.15, 3 - 0.3, 0 - 0.3};
+  const double want1[] = {5, 4, 3, 2};
+  for (std::size_t r = 0; r < 4; ++r) {
+    EXPECT_NEAR(out[0].table.at(r, 0), want0[r], 1e-12);
+    EXPECT_NEAR(out[0].table.at(r, 1), want1[r], 1e-12);
+  }
+  EXPECT_EQ(in.table.at(0, 0), 1);  // the input is untouched
+  LogInput bad = in;
+  bad.table.metadata.set("dt_s", "fast");
+  EXPECT_THROW(drift_driver(bad, {"fc0", true, 0.1}), std::runtime_error);
+  EXPECT_THROW(drift_removed({in}, {{"fc9", true, 0.1}}), std::runtime_error);
+}
+
+TEST(FrameTransforms, AlignmentAndCrosstalkRemoval) {
+  const LogInput in = drift_log();
+  const auto aligned = time_aligned({in}, {"fc0"}, 2);
+  ASSERT_EQ(aligned[0].table.rows(), 2u);
+  EXPECT_EQ(aligned[0].table.at(0, 0), 3);   // fc0 two rows earlier
+  EXPECT_EQ(aligned[0].table.at(1, 0), 0);
+  EXPECT_EQ(aligned[0].table.at(1, 1), 5);   // fc1 unchanged
+  const auto removed = crosstalk_removed({in}, "fc0", "fc1", 0.2);
+  EXPECT_NEAR(removed[0].table.at(1, 0), -3.0, 1e-12);
+  EXPECT_THROW(time_aligned({in}, {"fc0"}, 4), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace hadynet::test

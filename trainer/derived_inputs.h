@@ -1,0 +1,36 @@
+// Command channels computed from other command channels, so that a model
+// can use them without them being logged (docs/residual.md, friction --fix).
+// A model's u channel named
+//   sign_<c>   is sign(u_c(t))                         (-1, 0 or +1)
+//   hyst_<c>   is the hysteresis state of u_c at t:     the sign of the last
+//              non-zero u_c(s), s <= t; 0 before the first one
+// for a command column <c> of the log. Both are causal: row t uses rows <= t
+// only, so a host (or the firmware) can compute them from the commands it has
+// sent. log_sequence() computes them when a log lacks the column.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "datalog/log_table.h"
+
+namespace hadynet::trainer {
+
+enum class DerivedKind { kSign, kHysteresis };
+
+struct DerivedInput {
+  DerivedKind kind;
+  std::string base;  // the command column it is computed from, e.g. "u0"
+};
+
+// The derivation a channel name states ("sign_u0", "hyst_u0"); none for any
+// other name.
+std::optional<DerivedInput> parse_derived_input(const std::string& name);
+std::string derived_input_name(const DerivedInput& d);
+
+// The channel's value in every row of `table`; none if `name` is not a
+// derived name or the table has no column `base`.
+std::optional<std::vector<double>> derived_input_column(const datalog::LogTable& table, const std::string& name);
+
+}  // namespace hadynet::trainer
