@@ -92,7 +92,7 @@ int run_adapt(int argc, char** argv) {
   try {
     const trainer::HadynetModel model = trainer::load_model(opt.positional().front());
     const std::vector<std::string> log_args(opt.positional().begin() + 1, opt.positional().end());
-    std::vector<trainer::LogSequence> logs = read_sequences(log_args, model.layout);
+    std::vector<trainer::LogSequence> logs = read_sequences(log_args, model);
     const Eigen::VectorXf start = parse_pb(model, opt.get("start"));
     if (opt.has("online")) {
       trainer::OnlinePbAdapter::Options online;

@@ -48,7 +48,7 @@ int run_calibrate_detect(int argc, char** argv) {
                                " exceeds the model's N_train " + std::to_string(model.train_steps));
     }
     const std::vector<std::string> log_args(opt.positional().begin() + 1, opt.positional().end());
-    std::vector<trainer::LogSequence> logs = read_sequences(log_args, model.layout);
+    std::vector<trainer::LogSequence> logs = read_sequences(log_args, model);
     Eigen::VectorXf pb;
     std::string source = std::to_string(logs.size()) + " logs";
     if (opt.get("pb") == "adapt") {

@@ -88,7 +88,7 @@ int run_detect(int argc, char** argv) {
     std::vector<Trace> traces;
     std::printf("C_detect %.3f, N_detect %d, PB %s\n", cal.threshold, cal.steps, opt.get("pb").c_str());
     std::printf("%-40s %-11s %7s %9s %9s %9s\n", "log", "object", "steps", "flagged", "median d", "max d");
-    for (const auto& seq : read_sequences(log_args, model.layout)) {
+    for (const auto& seq : read_sequences(log_args, model)) {
       const Eigen::VectorXd d = trainer::detection_distances(model, cal, seq, pb);
       std::vector<double> v(d.data(), d.data() + d.size());
       const long flagged = (d.array() > cal.threshold).count();

@@ -60,7 +60,7 @@ int run_recognize(int argc, char** argv) {
     const trainer::HadynetModel model = trainer::load_model(opt.positional().front());
     const std::vector<std::string> log_args(opt.positional().begin() + 1, opt.positional().end());
     const std::vector<AdaptedState> adapted =
-        adapt_each_state(model, group_by_state(read_sequences(log_args, model.layout)),
+        adapt_each_state(model, group_by_state(read_sequences(log_args, model)),
                          parse_pb(model, opt.get("start")), *adapt);
 
     std::printf("%-22s %-11s %-11s %-22s %8s  %s\n", "state", "true", "recognised", "nearest state",

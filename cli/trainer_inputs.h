@@ -12,10 +12,19 @@
 
 namespace hadynet::cli {
 
-// Reads every log under `args` (files or folders) for the model's channels.
-// Throws (LogError / std::runtime_error) naming the file on any problem.
+// Reads every log under `args` (files or folders) for the layout's channels,
+// as they are (training data). Throws (LogError / std::runtime_error) naming
+// the file on any problem.
 std::vector<trainer::LogSequence> read_sequences(const std::vector<std::string>& args,
                                                  const trainer::FeatureLayout& layout);
+
+// The same for a trained model: each log moved into the model's frame (its
+// sensor model, trainer/sensor_model.h; a model fixed by `hadynet residual
+// --fix` may predict e.g. the channels without cross-talk).
+std::vector<trainer::LogSequence> read_sequences(const std::vector<std::string>& args,
+                                                 const trainer::HadynetModel& model);
+trainer::LogSequence model_sequence(const trainer::HadynetModel& model, const datalog::LogTable& table,
+                                    const std::string& path);
 
 // Sequences grouped by state id, groups in first-appearance order.
 struct StateGroup {

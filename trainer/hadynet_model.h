@@ -13,6 +13,7 @@
 #include "trainer/hadynet_params.h"
 #include "trainer/log_dataset.h"
 #include "trainer/normalization.h"
+#include "trainer/sensor_model.h"
 
 namespace hadynet::trainer {
 
@@ -74,18 +75,6 @@ inline constexpr ValueRangeField kValueRangeFields[] = {
     {"dec_bias", &ValueRanges::dec_bias},
 };
 
-// A rail the measured channel is clipped at (hadynet residual --fix for a
-// saturation, docs/residual.md): every prediction of `channel` is passed
-// through min(., rail) (side +1) or max(., rail) (side -1), in physical units.
-// The network is trained on the clipped output.
-struct OutputClip {
-  std::string channel;  // a y channel
-  int side = 1;         // +1 upper rail, -1 lower rail
-  double rail = 0;      // physical units
-
-  bool operator==(const OutputClip&) const = default;
-};
-
 struct HadynetModel {
   FeatureLayout layout;
   Normalization norm;
@@ -95,7 +84,7 @@ struct HadynetModel {
   long bn_batches_tracked = 0;  // enc_bn.num_batches_tracked (PyTorch buffer)
   std::optional<DetectionCalibration> detection;
   std::optional<ValueRanges> ranges;  // measured value ranges (needed by codegen)
-  std::vector<OutputClip> output_clips;  // applied to every prediction (trainer/output_clip.h)
+  SensorModel sensor;  // measured channels from the network's (sensor_model.h); empty: the same
   std::map<std::string, std::string> hyper_parameters;  // e.g. "lr" -> "0.001"
   std::map<std::string, std::string> provenance;        // data_hash, git_commit, logs, ...
 

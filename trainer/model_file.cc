@@ -66,6 +66,51 @@ Eigen::MatrixXd read_matrix(const st::File& file, const std::string& name, std::
       v.data(), static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
 }
 
+// The sensor model (sensor_model.h) as metadata "sensor":
+//   {"delays": [{"channel", "steps"}], "crosstalk": [{"target", "source", "gain"}],
+//    "drifts": [{"channel", "driver": "load"|"time", "rate"}], "clips": [{"channel", "side", "rail"}]}
+json sensor_json(const SensorModel& s) {
+  json j = json::object();
+  j["delays"] = json::array();
+  for (const auto& d : s.delays) j["delays"].push_back({{"channel", d.channel}, {"steps", d.steps}});
+  j["crosstalk"] = json::array();
+  for (const auto& x : s.crosstalk) j["crosstalk"].push_back({{"target", x.target}, {"source", x.source}, {"gain", x.gain}});
+  j["drifts"] = json::array();
+  for (const auto& d : s.drifts)
+    j["drifts"].push_back({{"channel", d.channel}, {"driver", d.load ? "load" : "time"}, {"rate", d.rate}});
+  j["clips"] = json::array();
+  for (const auto& c : s.clips) j["clips"].push_back({{"channel", c.channel}, {"side", c.side}, {"rail", c.rail}});
+  return j;
+}
+
+json json_array(const json& j, const std::string& key, const std::string& origin) {
+  const json a = j.is_object() && j.contains(key) ? j.at(key) : json();
+  if (!a.is_array()) fail(origin, "sensor '" + key + "' is not an array");
+  return a;
+}
+
+SensorModel sensor_from_json(const json& j, const std::string& origin) {
+  SensorModel s;
+  for (const json& d : json_array(j, "delays", origin))
+    s.delays.push_back({json_get<std::string>(d, "channel", "sensor delay", origin),
+                        json_get<int>(d, "steps", "sensor delay", origin)});
+  for (const json& x : json_array(j, "crosstalk", origin))
+    s.crosstalk.push_back({json_get<std::string>(x, "target", "sensor crosstalk", origin),
+                           json_get<std::string>(x, "source", "sensor crosstalk", origin),
+                           json_get<double>(x, "gain", "sensor crosstalk", origin)});
+  for (const json& d : json_array(j, "drifts", origin)) {
+    const std::string driver = json_get<std::string>(d, "driver", "sensor drift", origin);
+    if (driver != "load" && driver != "time") fail(origin, "sensor drift driver '" + driver + "' is not load or time");
+    s.drifts.push_back({json_get<std::string>(d, "channel", "sensor drift", origin), driver == "load",
+                        json_get<double>(d, "rate", "sensor drift", origin)});
+  }
+  for (const json& c : json_array(j, "clips", origin))
+    s.clips.push_back({json_get<std::string>(c, "channel", "sensor clip", origin),
+                       json_get<int>(c, "side", "sensor clip", origin),
+                       json_get<double>(c, "rail", "sensor clip", origin)});
+  return s;
+}
+
 const char* const kNormTensors[] = {"norm.x_mean", "norm.x_std", "norm.u_mean",
                                     "norm.u_std",  "norm.y_mean", "norm.y_std"};
 
@@ -103,11 +148,10 @@ void HadynetModel::check_consistent() const {
          "detection statistics sizes");
     need(std::isfinite(c.threshold) && c.threshold > 0, "detection threshold not positive");
   }
-  for (const OutputClip& c : output_clips) {
-    need(std::find(layout.y_names.begin(), layout.y_names.end(), c.channel) != layout.y_names.end(),
-         "output clip on '" + c.channel + "', not a y channel");
-    need(c.side == 1 || c.side == -1, "output clip side must be +1 or -1");
-    need(std::isfinite(c.rail), "output clip rail not finite");
+  try {
+    sensor.check(layout.y_names);
+  } catch (const std::invalid_argument& e) {
+    need(false, e.what());
   }
   if (ranges) {
     for (const ValueRangeField& f : kValueRangeFields) {
@@ -172,12 +216,7 @@ st::File model_to_safetensors(const HadynetModel& model) {
     r["source"] = model.ranges->source;
     file.metadata["ranges"] = r.dump();
   }
-  if (!model.output_clips.empty()) {
-    json clips = json::array();
-    for (const OutputClip& c : model.output_clips)
-      clips.push_back({{"channel", c.channel}, {"side", c.side}, {"rail", c.rail}});
-    file.metadata["output_clips"] = clips.dump();
-  }
+  if (!model.sensor.empty()) file.metadata["sensor"] = sensor_json(model.sensor).dump();
   return file;
 }
 
@@ -299,14 +338,8 @@ HadynetModel model_from_safetensors(const st::File& file, const std::string& ori
       model.ranges = std::move(ranges);
     }
 
-    if (file.metadata.count("output_clips") != 0) {
-      const json clips = parse_metadata_json(file, "output_clips", origin);
-      if (!clips.is_array()) fail(origin, "metadata 'output_clips' is not an array");
-      for (const json& c : clips)
-        model.output_clips.push_back({json_get<std::string>(c, "channel", "output_clips", origin),
-                                      json_get<int>(c, "side", "output_clips", origin),
-                                      json_get<double>(c, "rail", "output_clips", origin)});
-    }
+    if (file.metadata.count("sensor") != 0)
+      model.sensor = sensor_from_json(parse_metadata_json(file, "sensor", origin), origin);
 
     for (const auto& [name, tensor] : file.tensors) {
       if (expected.count(name) != 0) continue;

@@ -17,7 +17,7 @@ Eigen::Index row_of(const HadynetModel& model, const OutputClip& c) {
 }  // namespace
 
 void apply_output_clips(const HadynetModel& model, Eigen::MatrixXd& y) {
-  for (const OutputClip& c : model.output_clips) {
+  for (const OutputClip& c : model.sensor.clips) {
     const Eigen::Index r = row_of(model, c);
     y.row(r) = c.side > 0 ? y.row(r).cwiseMin(c.rail).eval() : y.row(r).cwiseMax(c.rail).eval();
   }
@@ -25,7 +25,7 @@ void apply_output_clips(const HadynetModel& model, Eigen::MatrixXd& y) {
 
 std::vector<StandardisedClip> standardised_clips(const HadynetModel& model) {
   std::vector<StandardisedClip> out;
-  for (const OutputClip& c : model.output_clips) {
+  for (const OutputClip& c : model.sensor.clips) {
     const Eigen::Index r = row_of(model, c);
     out.push_back({r, c.side, static_cast<float>((c.rail - model.norm.y.mean(r)) / model.norm.y.std(r))});
   }

@@ -1,6 +1,6 @@
-// The model's output clips (HadynetModel::output_clips, set by
-// `hadynet residual --fix` for a saturating sensor): the measured channel
-// cannot exceed its rail, so neither may the prediction.
+// The model's output clips (SensorModel::clips, set by `hadynet residual
+// --fix` for a saturating sensor): the measured channel cannot exceed its
+// rail, so neither may the prediction.
 #pragma once
 
 #include <Eigen/Core>

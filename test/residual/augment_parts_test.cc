@@ -1,7 +1,7 @@
 // The parts --fix builds on (docs/residual.md, "--fix"), against hand-computed
 // answers: derived command channels, output clips (physical and on the
-// training loss), and the frame transforms (alignment, cross-talk and drift
-// removal). All exact: integer-valued or closed-form cases, tolerance 1e-12.
+// training loss), and the sensor model's frame transforms (alignment,
+// cross-talk and drift removal). All exact: integer-valued or closed-form cases, tolerance 1e-12.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,13 +9,12 @@
 #include "trainer/derived_inputs.h"
 #include "trainer/log_dataset.h"
 #include "trainer/output_clip.h"
-#include "trainer/residual/frame_transforms.h"
+#include "trainer/sensor_model.h"
 
 namespace hadynet::test {
 namespace {
 
 using namespace trainer;
-using namespace trainer::residual;
 
 datalog::LogTable table(const std::vector<std::string>& columns, const std::vector<std::vector<double>>& rows) {
   datalog::LogTable t;
@@ -62,7 +61,7 @@ HadynetModel clip_model() {
   m.norm.y.mean << 1.0, 0.0;
   m.norm.y.std.resize(2);
   m.norm.y.std << 2.0, 1.0;
-  m.output_clips = {{"a0", 1, 3.0}, {"a1", -1, -0.5}};
+  m.sensor.clips = {{"a0", 1, 3.0}, {"a1", -1, -0.5}};
   return m;
 }
 
@@ -86,41 +85,67 @@ TEST(OutputClip, PhysicalAndStandardisedAgree) {
   EXPECT_EQ(grad, want_g);
 }
 
-LogInput drift_log() {
-  LogInput in{table({"fc0", "fc1", "u0"}, {{1, 5, 0}, {-2, 5, 0}, {3, 5, 0}, {0, 5, 0}}), "d.csv"};
-  in.table.metadata.set("dt_s", "0.5");
-  return in;
+datalog::LogTable drift_log() {
+  datalog::LogTable t = table({"fc0", "fc1", "u0"}, {{1, 5, 0}, {-2, 5, 0}, {3, 5, 0}, {0, 5, 0}});
+  t.metadata.set("dt_s", "0.5");
+  return t;
 }
 
-TEST(FrameTransforms, DriftDriverAndRemoval) {
-  const LogInput in = drift_log();
+TEST(SensorFrame, DriftDriverAndRemoval) {
+  const datalog::LogTable in = drift_log();
   // Load: sum_{s<=t} |fc0(s)| dt = 0.5, 1.5, 3.0, 3.0; time: t dt.
-  EXPECT_EQ(drift_driver(in, {"fc0", true, 0.1}), (std::vector<double>{0.5, 1.5, 3.0, 3.0}));
-  EXPECT_EQ(drift_driver(in, {"fc0", false, 0.1}), (std::vector<double>{0.0, 0.5, 1.0, 1.5}));
-  const auto out = drift_removed({in}, {{"fc0", true, 0.1}, {"fc1", false, 2.0}});
+  EXPECT_EQ(drift_driver(in, "d.csv", {"fc0", true, 0.1}), (std::vector<double>{0.5, 1.5, 3.0, 3.0}));
+  EXPECT_EQ(drift_driver(in, "d.csv", {"fc0", false, 0.1}), (std::vector<double>{0.0, 0.5, 1.0, 1.5}));
+  const auto out = drift_removed(in, "d.csv", {{"fc0", true, 0.1}, {"fc1", false, 2.0}});
   const double want0[] = {1 - 0.05, -2 - 0.15, 3 - 0.3, 0 - 0.3};
   const double want1[] = {5, 4, 3, 2};
   for (std::size_t r = 0; r < 4; ++r) {
-    EXPECT_NEAR(out[0].table.at(r, 0), want0[r], 1e-12);
-    EXPECT_NEAR(out[0].table.at(r, 1), want1[r], 1e-12);
+    EXPECT_NEAR(out.at(r, 0), want0[r], 1e-12);
+    EXPECT_NEAR(out.at(r, 1), want1[r], 1e-12);
   }
-  EXPECT_EQ(in.table.at(0, 0), 1);  // the input is untouched
-  LogInput bad = in;
-  bad.table.metadata.set("dt_s", "fast");
-  EXPECT_THROW(drift_driver(bad, {"fc0", true, 0.1}), std::runtime_error);
-  EXPECT_THROW(drift_removed({in}, {{"fc9", true, 0.1}}), std::runtime_error);
+  EXPECT_EQ(in.at(0, 0), 1);  // the input is untouched
+  datalog::LogTable bad = in;
+  bad.metadata.set("dt_s", "fast");
+  try {
+    drift_driver(bad, "d.csv", {"fc0", true, 0.1});
+    ADD_FAILURE() << "accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("d.csv: metadata dt_s 'fast'"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(drift_removed(in, "d.csv", {{"fc9", true, 0.1}}), std::runtime_error);
 }
 
-TEST(FrameTransforms, AlignmentAndCrosstalkRemoval) {
-  const LogInput in = drift_log();
-  const auto aligned = time_aligned({in}, {"fc0"}, 2);
-  ASSERT_EQ(aligned[0].table.rows(), 2u);
-  EXPECT_EQ(aligned[0].table.at(0, 0), 3);   // fc0 two rows earlier
-  EXPECT_EQ(aligned[0].table.at(1, 0), 0);
-  EXPECT_EQ(aligned[0].table.at(1, 1), 5);   // fc1 unchanged
-  const auto removed = crosstalk_removed({in}, "fc0", "fc1", 0.2);
-  EXPECT_NEAR(removed[0].table.at(1, 0), -3.0, 1e-12);
-  EXPECT_THROW(time_aligned({in}, {"fc0"}, 4), std::runtime_error);
+TEST(SensorFrame, AlignmentCrosstalkAndTheWholeFrame) {
+  const datalog::LogTable in = drift_log();
+  const auto aligned = time_aligned(in, "d.csv", {{"fc0", 2}});
+  ASSERT_EQ(aligned.rows(), 2u);
+  EXPECT_EQ(aligned.at(0, 0), 3);  // fc0 two rows earlier
+  EXPECT_EQ(aligned.at(1, 0), 0);
+  EXPECT_EQ(aligned.at(1, 1), 5);  // fc1 unchanged
+  EXPECT_THROW(time_aligned(in, "d.csv", {{"fc0", 4}}), std::runtime_error);
+  const auto both = time_aligned(in, "d.csv", {{"fc0", 2}, {"fc1", 1}});  // per-channel delays
+  ASSERT_EQ(both.rows(), 2u);
+  EXPECT_EQ(both.at(0, 0), 3);
+  EXPECT_EQ(both.at(0, 1), 5);
+  EXPECT_EQ(both.at(1, 2), 0);  // u0 of row 1
+  const auto removed = crosstalk_removed(in, "d.csv", {{"fc0", "fc1", 0.2}});
+  EXPECT_NEAR(removed.at(1, 0), -3.0, 1e-12);
+  // The whole frame: drift (from the measured fc0), then cross-talk, then the delay.
+  SensorModel s;
+  s.drifts = {{"fc0", true, 0.1}};
+  s.crosstalk = {{"fc0", "fc1", 0.2}};
+  s.delays = {{"fc0", 1}};
+  const auto frame = to_model_frame(s, in, "d.csv");
+  ASSERT_EQ(frame.rows(), 3u);
+  EXPECT_NEAR(frame.at(0, 0), -2 - 0.15 - 1.0, 1e-12);  // row 1's fc0, shifted to row 0
+  EXPECT_NEAR(frame.at(2, 0), 0 - 0.3 - 1.0, 1e-12);
+  EXPECT_EQ(frame.at(2, 1), 5);
+  // Every part checked against the channels.
+  EXPECT_NO_THROW(s.check({"fc0", "fc1"}));
+  EXPECT_THROW(s.check({"fc1"}), std::invalid_argument);
+  EXPECT_EQ(s.describe().size(), 3u);
+  EXPECT_TRUE(SensorModel{}.empty());
+  EXPECT_EQ(to_model_frame(SensorModel{}, in, "d.csv").values, in.values);
 }
 
 }  // namespace

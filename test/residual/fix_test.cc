@@ -97,7 +97,7 @@ void expect_deployable(const trainer::HadynetModel& m) {
   std::filesystem::remove(path);
   EXPECT_TRUE(back.layout == m.layout);
   EXPECT_EQ(back.provenance, m.provenance);
-  EXPECT_EQ(back.output_clips, m.output_clips);
+  EXPECT_TRUE(back.sensor == m.sensor);
 }
 
 TEST(ResidualFix, CleanLogsChangeNothing) {
@@ -116,17 +116,29 @@ TEST(ResidualFix, LatencyIsTimeAlignedAndCutsTheDelayedChannelsError) {
   ASSERT_TRUE(fixed_as(r, EffectKind::kSensorDelay));
   const Augmentation& a = *r.fix.augmentation;
   EXPECT_EQ(a.delay, 2);
-  // Same network: dims and layout unchanged, the delay stated in the model file.
+  // Same network: dims and layout unchanged, the delay in the sensor model.
   EXPECT_TRUE(r.fix.model.params.dims.x == build_model().params.dims.x);
   EXPECT_TRUE(r.fix.model.layout == build_model().layout);
-  EXPECT_NE(r.fix.model.provenance.at("output_delay").find("2 steps"), std::string::npos);
-  // Margins (measured 0.36x on fc1, 0.45x on fc2, 0.81x on fc6; docs/residual.md):
-  // the winner channel's held-out RMSE falls below 0.6x, every aligned
-  // channel's below 0.9x, and the alignment beats fine-tuning alone on the
-  // winner by a factor < 0.6 (measured 0.45), so the cut is the augmentation's.
+  ASSERT_EQ(r.fix.model.sensor.delays.size(), a.channels.size());
+  for (const auto& delay : r.fix.model.sensor.delays) EXPECT_EQ(delay.steps, 2) << delay.channel;
+  // The plant delays every loadcell: the fix aligns all nine (three pass the
+  // floors; the rest join as the same delay in the same group).
+  EXPECT_EQ(a.channels.size(), 9u);
+  for (const auto& ch : a.channels) EXPECT_EQ(ch.rfind("fc", 0), 0u) << ch;
+  // Margins (measured: winner fc1 0.36x before and 0.45x the fine-tune-only
+  // control; the aligned channels 0.34x..0.93x, median 0.61x; docs/residual.md):
+  // the winner below 0.6x before and 0.6x the control (the cut is the
+  // alignment's), no aligned channel worse than 0.97x, and their median
+  // below 0.75x.
   const std::string& c = a.channels.front();
   expect_cut(r.fix, c, 0.6, 0.6);
-  for (const auto& ch : a.channels) expect_cut(r.fix, ch, 0.9);
+  std::vector<double> ratios;
+  for (const auto& ch : a.channels) {
+    expect_cut(r.fix, ch, 0.97);
+    ratios.push_back(rmse_of(r.fix.after, ch) / rmse_of(r.fix.before, ch));
+  }
+  std::nth_element(ratios.begin(), ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2), ratios.end());
+  EXPECT_LT(ratios[ratios.size() / 2], 0.75);
   expect_deployable(r.fix.model);
 }
 
@@ -139,10 +151,12 @@ TEST(ResidualFix, CrosstalkIsRemovedFromTheDataAndCutsTheTargetsError) {
   EXPECT_NE(a.source, a.channels.front());
   EXPECT_GT(a.gain, 0.1);
   EXPECT_LT(a.gain, 0.5);
-  // Same network: dims and layout unchanged, the cross-talk stated in the model file.
+  // Same network: dims and layout unchanged, the cross-talk in the sensor model.
   EXPECT_TRUE(r.fix.model.params.dims.x == build_model().params.dims.x);
   EXPECT_TRUE(r.fix.model.layout == build_model().layout);
-  EXPECT_NE(r.fix.model.provenance.at("output_crosstalk").find(a.source), std::string::npos);
+  ASSERT_EQ(r.fix.model.sensor.crosstalk.size(), 1u);
+  EXPECT_EQ(r.fix.model.sensor.crosstalk.front().source, a.source);
+  EXPECT_EQ(r.fix.model.sensor.crosstalk.front().gain, a.gain);
   // Margins (measured 0.47x before and 0.91x the fine-tune-only control on the
   // target fc2; docs/residual.md): the target's held-out RMSE falls below 0.6x,
   // and below 0.95x of what fine-tuning alone reaches (the control can learn
@@ -186,8 +200,8 @@ TEST(ResidualFix, SaturationClipsThePredictionAndCutsTheRailChannelsError) {
   ASSERT_TRUE(fixed_as(r, EffectKind::kSaturation));
   const Augmentation& a = *r.fix.augmentation;
   const auto& m = r.fix.model;
-  ASSERT_EQ(m.output_clips.size(), a.channels.size());
-  for (const auto& clip : m.output_clips) {
+  ASSERT_EQ(m.sensor.clips.size(), a.channels.size());
+  for (const auto& clip : m.sensor.clips) {
     EXPECT_EQ(clip.side, 1) << clip.channel;
     EXPECT_NEAR(clip.rail, 2.0, 0.1) << clip.channel;  // the measured maximum: noise 20 mN + quantisation
   }
@@ -200,7 +214,7 @@ TEST(ResidualFix, SaturationClipsThePredictionAndCutsTheRailChannelsError) {
   // No prediction of a clipped channel exceeds its rail.
   const auto logs = plant_logs("saturation=2");
   const ResidualData again = compute_residuals(m, logs, "state");
-  for (const auto& clip : m.output_clips) {
+  for (const auto& clip : m.sensor.clips) {
     const auto row = static_cast<Eigen::Index>(
         std::find(again.y_names.begin(), again.y_names.end(), clip.channel) - again.y_names.begin());
     for (const auto& log : again.logs) EXPECT_LE(log.y_hat.row(row).maxCoeff(), clip.rail) << clip.channel;
@@ -219,7 +233,7 @@ TEST(ResidualFix, DriftGetsABiasStateWithTheRightRateAndCutsTheError) {
   // (measured 1.006x; the attribution's fit was 0.42x).
   EXPECT_GT(a.drifts.front().rate, 0.7 * 0.02);
   EXPECT_LT(a.drifts.front().rate, 1.3 * 0.02);
-  EXPECT_NE(r.fix.model.provenance.at("output_drift").find(a.channels.front()), std::string::npos);
+  EXPECT_TRUE(r.fix.model.sensor.drifts == a.drifts);
   EXPECT_TRUE(r.fix.model.layout == build_model().layout);
   // Margins (measured: winner fc3 0.35x before, 0.56x the control; fc6 0.60x
   // before): the winner below 0.5x before and 0.75x fine-tuning alone; every

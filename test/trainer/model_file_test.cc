@@ -60,8 +60,12 @@ HadynetModel sample_model(bool with_detection) {
     r.windows = 321;
     r.source = "spring logs \"a\" (data_hash 0123)";
     m.ranges = r;
-    // And output clips (hadynet residual --fix for a saturation).
-    m.output_clips = {{m.layout.y_names.front(), 1, 0.1875}, {m.layout.y_names.back(), -1, -2.5}};
+    // And a sensor model (hadynet residual --fix) with every part.
+    const auto& y = m.layout.y_names;
+    m.sensor.delays = {{y.front(), 2}, {y.back(), 1}};
+    m.sensor.crosstalk = {{y.front(), y.back(), 0.25}};
+    m.sensor.drifts = {{y.back(), true, 0.004}, {y.front(), false, -0.5}};
+    m.sensor.clips = {{y.front(), 1, 0.1875}, {y.back(), -1, -2.5}};
   }
   return m;
 }
@@ -106,7 +110,7 @@ void expect_same_model(const HadynetModel& got, const HadynetModel& want) {
     EXPECT_EQ(g.samples, w.samples);
     EXPECT_EQ(g.source, w.source);
   }
-  EXPECT_EQ(got.output_clips, want.output_clips);
+  EXPECT_TRUE(got.sensor == want.sensor);
   ASSERT_EQ(got.ranges.has_value(), want.ranges.has_value());
   if (want.ranges) {
     EXPECT_EQ(*got.ranges, *want.ranges);  // doubles exactly (JSON round trip)
@@ -215,16 +219,25 @@ class ModelFileRejects : public ::testing::Test {
   }
 };
 
-TEST_F(ModelFileRejects, OutputClipOnAnUnknownChannelOrSide) {
-  st::File f = good_;
-  edit_metadata(f, "output_clips", "\"side\":-1", "\"side\":0");
-  expect_rejected(f, "output clip side");
-  f = good_;
-  edit_metadata(f, "output_clips", "\"channel\":\"", "\"channel\":\"no_");
-  expect_rejected(f, "not a y channel");
-  f = good_;
-  edit_metadata(f, "output_clips", "\"rail\"", "\"rial\"");
-  expect_rejected(f, "rail");
+TEST_F(ModelFileRejects, SensorModelOnAnUnknownChannelOrWithBadNumbers) {
+  // Each edit of the "sensor" metadata, and the part of the error it must give.
+  const struct {
+    const char* from;
+    const char* to;
+    const char* error;
+  } cases[] = {
+      {"\"side\":-1", "\"side\":0", "output clip side"},
+      {"\"channel\":\"", "\"channel\":\"no_", "not a y channel"},
+      {"\"rail\"", "\"rial\"", "rail"},
+      {"\"driver\":\"load\"", "\"driver\":\"heat\"", "driver 'heat'"},
+      {"\"steps\":2", "\"steps\":0", "< 1 step"},
+      {"\"crosstalk\":[", "\"crosstalk\":{\"a\":1},\"x\":[", "'crosstalk' is not an array"},
+  };
+  for (const auto& c : cases) {
+    st::File f = good_;
+    edit_metadata(f, "sensor", c.from, c.to);
+    expect_rejected(f, c.error);
+  }
 }
 
 TEST_F(ModelFileRejects, TheUnmodifiedFileLoads) {

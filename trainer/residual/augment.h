@@ -2,50 +2,38 @@
 // attribution's winning effect to the model, fine-tune it, and measure the
 // error before and after on held-out data.
 //
-// Implemented augmentations (docs/residual.md says for each why this one):
-//   sensor-delay  time alignment. The delayed channels C (the winner's family,
-//                 all with the same delay d) are shifted d steps earlier in the
-//                 data, y'_c(s) = y_c(s + d), and the model is fine-tuned on
-//                 the aligned logs: it predicts the true-time signal. The
-//                 delay is an output transform stated in the model file
-//                 (provenance "output_delay"): the measured y_c(t) is the
-//                 model's y'_c(t - d). Same dims and weights layout.
+// Implemented augmentations (docs/residual.md says for each why this one).
+// Sensor effects become part of the model's sensor model (sensor_model.h:
+// the measured channels from the network's; each model is fed logs moved
+// into its own frame), so the network keeps its structure:
+//   sensor-delay  time alignment of the winner's family (the channels with
+//                 the winner's delay d): the model is fine-tuned on logs with
+//                 y'_c(s) = y_c(s + d) and predicts the true-time signal.
+//   crosstalk     removal: the winner's target c picks up k times source s
+//                 (the fitted gain); the model is fine-tuned on y'_c = y_c -
+//                 k y_s (in y and x); the measured y_c is y'_c + k y'_s.
+//   drift-load,   a bias state b_c(t) = rate * D_c(t) per family channel (D:
+//   drift-time    accumulated load sum |y_c| dt, or time), removed from the
+//                 data (in y and x) and added to the prediction; the rate is
+//                 re-estimated before fine-tuning (the attribution's fit is
+//                 low: the model carries part of a bias over from x_t).
+//   saturation    clipping: each family channel's prediction passes through
+//                 min(., R) (max for a lower rail) at its measured rail R,
+//                 applied by every prediction, and the model is fine-tuned on
+//                 the clipped output (a clipped element has zero gradient).
+// Effects of the dynamics change the network's inputs:
 //   aux-channel   the aux_* column becomes an observed channel: appended to y
-//                 (and so to x, as an input of the encoder). The encoder gets a
-//                 zero column for it and the decoder a zero row (the new output
-//                 starts at the channel's mean), then the model is fine-tuned.
-//                 dims.x and dims.y grow by one.
-//   crosstalk     removal of the cross-talk from the data. The winner's target
-//                 c picks up k times source s (the fitted gain): the c column
-//                 is replaced by y'_c = y_c - k y_s in every row (so in y and
-//                 in x), and the model is fine-tuned on these logs: it
-//                 predicts the channel without the cross-talk. The cross-talk
-//                 is an output transform stated in the model file (provenance
-//                 "output_crosstalk"): the measured y_c(t) is the model's
-//                 y'_c(t) + k y_s(t), with y_s the model's own prediction of
-//                 the source; the inputs get y_c - k y_s. Same dims and
-//                 weights layout.
-//   friction      a hysteresis state as an input. For every muscle m of the
-//                 winner's family, two derived command channels sign_<m>
+//                 (and so to x, an encoder input) with a zero encoder column
+//                 and a zero decoder row (the new output starts at the
+//                 channel's mean). dims.x and dims.y grow by one.
+//   friction      a hysteresis state as an input: for every muscle m of the
+//                 winner's family, the derived command channels sign_<m>
 //                 (direction of motion) and hyst_<m> (sign of the last
 //                 non-zero command; trainer/derived_inputs.h) are appended to
-//                 u. The LSTM gets zero input columns for them (the model
-//                 starts as before), then it is fine-tuned. dims.u grows by
-//                 two per muscle; a log needs no new column (they are computed
-//                 from the commands).
-//   saturation    clipping: every family channel's prediction passes through
-//                 min(., R) (max for a lower rail) with its measured rail R
-//                 (HadynetModel::output_clips, applied by every prediction),
-//                 and the model is fine-tuned on the clipped output (the loss
-//                 gradient of a clipped element is 0). Same dims.
-//   drift-load,   a drift/bias state b_c(t) = rate * D_c(t) per family channel
-//   drift-time    (D: accumulated load sum |y_c| dt, or time), removed from
-//                 the data, y'_c = y_c - b_c (in y and x), and added back to the
-//                 prediction; the rate is re-estimated before fine-tuning
-//                 (refine_drift_rates: the attribution's fitted rate is low,
-//                 since the model carries part of a bias over from x_t).
-//                 Stated in the model file (provenance "output_drift"). Same
-//                 dims.
+//                 u with zero LSTM input weights. dims.u grows by two per
+//                 muscle; logs need no new column (they are computed from
+//                 the commands).
+// Then the model is fine-tuned (batch norm frozen).
 //
 // Held out by time: the first `train_fraction` of each log's rows are the only
 // data fine-tuning sees; every number is reported on the remaining rows.
@@ -54,9 +42,10 @@
 // channel's true value at t - d - 1 is its measurement at t - 1) and runs
 // d + 1 steps with the logged commands; a delayed channel's measured y_c(t) is
 // its first step, every other channel its last. With d = 0 this is the plain
-// 1-step prediction of compute_residuals. For crosstalk (d = 0) the measured
-// target is the model's y'_c(t) plus k times its prediction of y_s(t), both
-// from the same step.
+// 1-step prediction of compute_residuals. For crosstalk the measured target
+// is the model's y'_c(t) plus k times its prediction of y_s(t), both from the
+// same step; for a drift, the bias known at t - 1 plus its increment from the
+// prediction.
 #pragma once
 
 #include <Eigen/Core>
@@ -67,7 +56,6 @@
 
 #include "trainer/hadynet_model.h"
 #include "trainer/residual/attribution.h"
-#include "trainer/residual/frame_transforms.h"
 #include "trainer/residual/residuals.h"
 #include "trainer/residual/whiteness.h"
 
@@ -92,11 +80,12 @@ struct Augmentation {
   // drifting (drift) channels.
   std::vector<std::string> channels;
   int delay = 0;                   // steps (sensor-delay); 0 otherwise
-  std::string source;              // crosstalk: the source y channel; empty otherwise
-  double gain = 0;                 // crosstalk: fitted gain k (target units per source unit); 0 otherwise
+  std::string source;              // crosstalk: the winner's source y channel; empty otherwise
+  double gain = 0;                 // crosstalk: the winner's fitted gain k (target units per source unit)
+  std::vector<SensorCrosstalk> crosstalk;  // crosstalk: the pairs removed (the winner's)
   std::vector<std::string> inputs;  // friction: derived u channels added (sign_u0, hyst_u0, ...)
   std::vector<OutputClip> clips;    // saturation: one per channel
-  std::vector<DriftState> drifts;   // drift: one per channel (rates refined by fix())
+  std::vector<SensorDrift> drifts;   // drift: one per channel (rates refined by fix())
 };
 // True for the effects --fix implements (all but input-delay).
 bool fix_supported(EffectKind kind);
@@ -105,19 +94,22 @@ bool fix_supported(EffectKind kind);
 // member with the winner's delay). None without a winner.
 std::optional<Augmentation> plan_augmentation(const ResidualData& data, const Attribution& attribution);
 
-// Logs in the augmented model's frame: aligned (delayed channels shifted d
-// rows earlier, the last d rows dropped); crosstalk: the target column
-// replaced by y_c - k y_s (same rows); drift: y_c - b_c (same rows);
-// unchanged otherwise (friction's inputs are derived from the commands).
-std::vector<LogInput> augmented_logs(const std::vector<LogInput>& logs, const Augmentation& a);
+// The sensor model after adding the augmentation's part (delay,
+// cross-talk, drift, clips; the others leave it as it is). A delay found in
+// the model's frame adds to a channel's existing delay.
+SensorModel sensor_after(const SensorModel& before, const Augmentation& a);
+
+// Logs moved into the frame of a model with sensor model `sensor`
+// (to_model_frame); the same logs if its frame is the measured one.
+std::vector<LogInput> model_frame_logs(const SensorModel& sensor, const std::vector<LogInput>& logs);
 
 // The model with the augmentation's structural change (aux: one more y and x
 // channel; friction: the derived u channels; standardisation of a new channel
-// fitted on `train_seqs`, which must hold it), its output clips (saturation)
-// and the provenance keys "residual_fix" and "output_delay" (delay),
-// "output_crosstalk" (crosstalk) or "output_drift" (drift). Weights otherwise
-// unchanged (new inputs get zero weights); detection statistics are dropped
-// (they belong to the old weights) and ranges must be re-measured.
+// fitted on `train_seqs`, which must hold it), its sensor model
+// (sensor_after) and the provenance key "residual_fix" (what was added, after
+// what an earlier fix added). Weights otherwise unchanged (new inputs get
+// zero weights); detection statistics are dropped (they belong to the old
+// weights) and ranges must be re-measured.
 HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
                              const std::vector<LogSequence>& train_seqs);
 

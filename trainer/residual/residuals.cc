@@ -96,7 +96,9 @@ ResidualData compute_residuals(const HadynetModel& model, const std::vector<LogI
   data.aux_names = common_aux_names(logs);
   data.y_scale = model.norm.y.std;
 
-  for (const auto& in : logs) {
+  for (const auto& raw : logs) {
+    // The model sees (and predicts) its own frame (sensor_model.h).
+    const LogInput in{to_model_frame(model.sensor, raw.table, raw.file), raw.file};
     ResidualLog log;
     log.seq = log_sequence(in.table, in.file, model.layout);
     if (log.seq.steps() < ResidualLog::kFirstRow + 1 + model.train_steps) {

@@ -1,0 +1,151 @@
+#include "trainer/sensor_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace hadynet::trainer {
+
+namespace {
+
+std::size_t column(const datalog::LogTable& table, const std::string& file, const std::string& name) {
+  const auto c = table.column_index(name);
+  if (!c) throw std::runtime_error(file + ": no column '" + name + "' (the model's sensor model needs it)");
+  return *c;
+}
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+}  // namespace
+
+void SensorModel::check(const std::vector<std::string>& y_names) const {
+  const auto need_channel = [&](const std::string& name, const std::string& what) {
+    if (std::find(y_names.begin(), y_names.end(), name) == y_names.end())
+      throw std::invalid_argument("sensor model: " + what + " on '" + name + "', not a y channel");
+  };
+  for (std::size_t i = 0; i < delays.size(); ++i) {
+    need_channel(delays[i].channel, "delay");
+    if (delays[i].steps < 1) throw std::invalid_argument("sensor model: delay of " + delays[i].channel + " < 1 step");
+    for (std::size_t j = 0; j < i; ++j)
+      if (delays[j].channel == delays[i].channel)
+        throw std::invalid_argument("sensor model: two delays on " + delays[i].channel);
+  }
+  for (const auto& x : crosstalk) {
+    need_channel(x.target, "cross-talk");
+    need_channel(x.source, "cross-talk");
+    if (x.target == x.source || !std::isfinite(x.gain))
+      throw std::invalid_argument("sensor model: cross-talk " + x.source + " -> " + x.target + " is invalid");
+  }
+  for (const auto& d : drifts) {
+    need_channel(d.channel, "drift");
+    if (!std::isfinite(d.rate)) throw std::invalid_argument("sensor model: drift rate on " + d.channel + " not finite");
+  }
+  for (const auto& c : clips) {
+    need_channel(c.channel, "output clip");
+    if (c.side != 1 && c.side != -1) throw std::invalid_argument("sensor model: output clip side must be +1 or -1");
+    if (!std::isfinite(c.rail)) throw std::invalid_argument("sensor model: output clip rail not finite");
+  }
+}
+
+std::vector<std::string> SensorModel::describe() const {
+  std::vector<std::string> out;
+  for (const auto& d : delays) out.push_back(d.channel + " reported " + std::to_string(d.steps) + " steps late");
+  for (const auto& x : crosstalk) out.push_back(x.target + " += " + num(x.gain) + " * " + x.source);
+  for (const auto& d : drifts)
+    out.push_back(d.channel + " += " + num(d.rate) + (d.load ? " * sum |" + d.channel + "| dt" : std::string(" * t")));
+  for (const auto& c : clips) out.push_back(c.channel + (c.side > 0 ? " <= " : " >= ") + num(c.rail));
+  return out;
+}
+
+int SensorModel::max_delay() const {
+  int d = 0;
+  for (const auto& x : delays) d = std::max(d, x.steps);
+  return d;
+}
+
+int SensorModel::delay_of(const std::string& channel) const {
+  for (const auto& x : delays)
+    if (x.channel == channel) return x.steps;
+  return 0;
+}
+
+double log_dt(const datalog::LogTable& table, const std::string& file) {
+  const auto dt = table.metadata.get("dt_s");
+  if (!dt) return 1.0;
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(*dt, &used);
+    if (used == dt->size() && std::isfinite(v) && v > 0) return v;
+  } catch (const std::exception&) {
+  }
+  throw std::runtime_error(file + ": metadata dt_s '" + *dt + "' is not a positive number");
+}
+
+std::vector<double> drift_driver(const datalog::LogTable& table, const std::string& file, const SensorDrift& drift) {
+  const std::size_t c = column(table, file, drift.channel);
+  const double dt = log_dt(table, file);
+  std::vector<double> d(table.rows());
+  double load = 0;
+  for (std::size_t r = 0; r < d.size(); ++r) {
+    load += std::abs(table.at(r, c)) * dt;
+    d[r] = drift.load ? load : static_cast<double>(r) * dt;
+  }
+  return d;
+}
+
+datalog::LogTable time_aligned(const datalog::LogTable& t, const std::string& file,
+                               const std::vector<SensorDelay>& delays) {
+  if (delays.empty()) return t;
+  const std::size_t T = t.rows(), cols = t.columns.size();
+  std::vector<std::size_t> shift(cols, 0);
+  std::size_t d = 0;
+  for (const auto& x : delays) {
+    if (x.steps < 1) throw std::invalid_argument("time alignment: delay < 1 step");
+    shift[column(t, file, x.channel)] = static_cast<std::size_t>(x.steps);
+    d = std::max(d, static_cast<std::size_t>(x.steps));
+  }
+  if (T <= d) throw std::runtime_error(file + ": fewer rows than the sensor delay");
+  datalog::LogTable aligned;
+  aligned.metadata = t.metadata;
+  aligned.columns = t.columns;
+  aligned.values.reserve((T - d) * cols);
+  for (std::size_t r = 0; r + d < T; ++r)
+    for (std::size_t c = 0; c < cols; ++c) aligned.values.push_back(t.at(r + shift[c], c));
+  return aligned;
+}
+
+datalog::LogTable crosstalk_removed(const datalog::LogTable& table, const std::string& file,
+                                    const std::vector<SensorCrosstalk>& crosstalk) {
+  datalog::LogTable out = table;
+  for (const auto& x : crosstalk) {
+    // Every pair removes its source's measured value (not a source already
+    // corrected): the sensor model adds the network's sources.
+    const std::size_t c = column(out, file, x.target), s = column(table, file, x.source);
+    for (std::size_t r = 0; r < out.rows(); ++r) out.at(r, c) -= x.gain * table.at(r, s);
+  }
+  return out;
+}
+
+datalog::LogTable drift_removed(const datalog::LogTable& table, const std::string& file,
+                                const std::vector<SensorDrift>& drifts) {
+  datalog::LogTable out = table;
+  for (const auto& drift : drifts) {
+    const std::vector<double> d = drift_driver(table, file, drift);  // from the measured column
+    const std::size_t c = column(out, file, drift.channel);
+    for (std::size_t r = 0; r < d.size(); ++r) out.at(r, c) -= drift.rate * d[r];
+  }
+  return out;
+}
+
+datalog::LogTable to_model_frame(const SensorModel& sensor, const datalog::LogTable& table, const std::string& file) {
+  if (sensor.frame_is_measured()) return table;
+  return time_aligned(crosstalk_removed(drift_removed(table, file, sensor.drifts), file, sensor.crosstalk), file,
+                      sensor.delays);
+}
+
+}  // namespace hadynet::trainer

@@ -1,0 +1,106 @@
+// What a model knows about its sensors beyond the network: how the measured
+// channels follow from the channels the network predicts (its "frame").
+// Added by `hadynet residual --fix` (docs/residual.md); empty for a model
+// trained on logs as they are. With the network's channels y' (physical
+// units, the model's frame), a measured channel is
+//
+//   y_c(t) = clip_c( y'_c(t - delay_c) + sum_s k_cs y'_s(t) + b_c(t) )
+//
+//   delay_c y_c is reported `steps` rows late (a sensor delay);
+//   k_cs    cross-talk: the target picks up `gain` times the source;
+//   b_c     a drift/bias state, rate * D_c(t), D_c the load the sensor has
+//           carried since the log's start (sum_{s<=t} |y_c(s)| dt) or the
+//           time since then (t dt), from the measured column;
+//   clip_c  a rail the sensor saturates at (side +1: min(., rail); -1: max).
+//
+// to_model_frame() moves a log into the model's frame (the inverse: the
+// delay undone, which is not causal, cross-talk and drift removed); the
+// clips are applied to every prediction (output_clip.h). Whoever feeds the
+// network logs or frames must apply it: the trainer's commands do
+// (read_sequences), the firmware applies cross-talk, drift and clips at its
+// boundary (docs/firmware.md).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "datalog/log_table.h"
+
+namespace hadynet::trainer {
+
+struct SensorDelay {
+  std::string channel;  // a y channel reported late
+  int steps = 0;        // rows, >= 1
+
+  bool operator==(const SensorDelay&) const = default;
+};
+
+struct SensorCrosstalk {
+  std::string target, source;  // y channels
+  double gain = 0;             // target units per source unit
+
+  bool operator==(const SensorCrosstalk&) const = default;
+};
+
+struct SensorDrift {
+  std::string channel;  // a y channel
+  bool load = true;     // D = accumulated load; false: time
+  double rate = 0;      // channel units per (channel unit s), or per s
+
+  bool operator==(const SensorDrift&) const = default;
+};
+
+struct OutputClip {
+  std::string channel;  // a y channel
+  int side = 1;         // +1 upper rail, -1 lower rail
+  double rail = 0;      // physical units
+
+  bool operator==(const OutputClip&) const = default;
+};
+
+struct SensorModel {
+  std::vector<SensorDelay> delays;  // one per delayed channel
+  std::vector<SensorCrosstalk> crosstalk;
+  std::vector<SensorDrift> drifts;
+  std::vector<OutputClip> clips;
+
+  bool empty() const { return delays.empty() && crosstalk.empty() && drifts.empty() && clips.empty(); }
+  // The frame transform (delay, cross-talk, drift) is the identity.
+  bool frame_is_measured() const { return delays.empty() && crosstalk.empty() && drifts.empty(); }
+  // The largest delay (rows; 0 without one), and the delay of a channel.
+  int max_delay() const;
+  int delay_of(const std::string& channel) const;
+  // Throws std::invalid_argument naming the first entry whose channel is not
+  // in `y_names` or whose numbers are invalid.
+  void check(const std::vector<std::string>& y_names) const;
+  // One line per part, e.g. "fc2 += 0.252 * fc3"; empty if none.
+  std::vector<std::string> describe() const;
+
+  bool operator==(const SensorModel&) const = default;
+};
+
+// The control period of a log: metadata dt_s (s), 1 if absent. Throws
+// std::runtime_error naming `file` if it is not a positive number.
+double log_dt(const datalog::LogTable& table, const std::string& file);
+
+// D_c of every row (see SensorDrift) from the measured column.
+std::vector<double> drift_driver(const datalog::LogTable& table, const std::string& file, const SensorDrift& drift);
+
+// The parts of the frame transform, each on a copy; a missing column is a
+// std::runtime_error naming `file`.
+//   time_aligned: each delayed channel shifted its `steps` rows earlier,
+//                 y'_c(s) = y_c(s + steps); the last max_delay rows are dropped.
+//   crosstalk_removed: target -= gain * source, every row.
+//   drift_removed: y_c -= rate * D_c (D_c from the measured column), every row.
+datalog::LogTable time_aligned(const datalog::LogTable& table, const std::string& file,
+                               const std::vector<SensorDelay>& delays);
+datalog::LogTable crosstalk_removed(const datalog::LogTable& table, const std::string& file,
+                                    const std::vector<SensorCrosstalk>& crosstalk);
+datalog::LogTable drift_removed(const datalog::LogTable& table, const std::string& file,
+                                const std::vector<SensorDrift>& drifts);
+
+// A measured log in the model's frame: drift removed, then cross-talk
+// removed, then time-aligned (the inverse of the sensor model's order).
+datalog::LogTable to_model_frame(const SensorModel& sensor, const datalog::LogTable& table, const std::string& file);
+
+}  // namespace hadynet::trainer
