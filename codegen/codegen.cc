@@ -276,6 +276,81 @@ std::vector<bool> active_commands(const HadynetModel& model, const ControlOption
   return active;
 }
 
+// The derived-input and sensor-model arrays of the header (model_contract.h),
+// as literals; arrays hold max(count, 1) entries (a zero entry when empty).
+struct SensorArrays {
+  std::vector<std::string> derived, derived_base;
+  int crosstalk_count = 0, drift_count = 0, clip_count = 0;
+  std::vector<std::string> crosstalk_target, crosstalk_source, crosstalk_gain;
+  std::vector<std::string> drift_channel, drift_is_load, drift_rate;
+  std::string period = "0.0f";
+  std::vector<std::string> clip_channel, clip_side, clip_rail, clip_rail_model;
+  std::vector<std::string> notes;  // comment lines
+};
+
+SensorArrays sensor_arrays(const HadynetModel& model, bool q15, int frac_y) {
+  const auto& y = model.layout.y_names;
+  const auto& u = model.layout.u_names;
+  const auto y_index = [&](const std::string& name) {
+    const auto it = std::find(y.begin(), y.end(), name);
+    if (it == y.end()) reject("sensor model names '" + name + "', not a y channel");
+    return std::to_string(it - y.begin());
+  };
+  SensorArrays a;
+  for (std::size_t i = 0; i < u.size(); ++i) {
+    const auto d = trainer::parse_derived_input(u[i]);
+    if (!d) {
+      a.derived.push_back("hadynet::firmware::DerivedInput::kNone");
+      a.derived_base.push_back(std::to_string(i));
+      continue;
+    }
+    const auto it = std::find(u.begin(), u.end(), d->base);
+    if (it == u.end()) reject("derived input '" + u[i] + "': no command '" + d->base + "' in the model");
+    if (trainer::parse_derived_input(d->base)) reject("derived input '" + u[i] + "' is derived from a derived input");
+    a.derived.push_back(d->kind == trainer::DerivedKind::kSign ? "hadynet::firmware::DerivedInput::kSign"
+                                                               : "hadynet::firmware::DerivedInput::kHysteresis");
+    a.derived_base.push_back(std::to_string(it - u.begin()));
+  }
+  const trainer::SensorModel& s = model.sensor;
+  for (const auto& x : s.crosstalk) {
+    a.crosstalk_target.push_back(y_index(x.target));
+    a.crosstalk_source.push_back(y_index(x.source));
+    a.crosstalk_gain.push_back(float_literal(static_cast<float>(x.gain)));
+  }
+  for (const auto& d : s.drifts) {
+    a.drift_channel.push_back(y_index(d.channel));
+    a.drift_is_load.push_back(d.load ? "true" : "false");
+    a.drift_rate.push_back(float_literal(static_cast<float>(d.rate)));
+  }
+  if (!s.drifts.empty()) a.period = float_literal(static_cast<float>(s.period_s));
+  for (const auto& c : s.clips) {
+    const std::string row = y_index(c.channel);
+    const std::size_t r = static_cast<std::size_t>(std::stoi(row));
+    a.clip_channel.push_back(row);
+    a.clip_side.push_back(std::to_string(c.side));
+    a.clip_rail.push_back(float_literal(static_cast<float>(c.rail)));
+    const double standardised = (c.rail - model.norm.y.mean(static_cast<Eigen::Index>(r))) /
+                                model.norm.y.std(static_cast<Eigen::Index>(r));
+    a.clip_rail_model.push_back(
+        q15 ? std::to_string(std::clamp<std::int64_t>(to_fixed(standardised, frac_y), -32768, 32767))
+            : float_literal(static_cast<float>(standardised)));
+  }
+  a.crosstalk_count = static_cast<int>(a.crosstalk_target.size());
+  a.drift_count = static_cast<int>(a.drift_channel.size());
+  a.clip_count = static_cast<int>(a.clip_channel.size());
+  for (auto* v : {&a.crosstalk_target, &a.crosstalk_source, &a.drift_channel, &a.clip_channel, &a.clip_side})
+    if (v->empty()) v->push_back("0");
+  for (auto* v : {&a.crosstalk_gain, &a.drift_rate, &a.clip_rail})
+    if (v->empty()) v->push_back("0.0f");
+  if (a.drift_is_load.empty()) a.drift_is_load.push_back("false");
+  if (a.clip_rail_model.empty()) a.clip_rail_model.push_back(q15 ? "0" : "0.0f");
+  for (const std::string& l : s.describe()) a.notes.push_back(l);
+  for (const auto& d : s.delays)
+    a.notes.push_back(d.channel + ": the firmware does not undo this delay (it needs future samples); the " +
+                      "network sees the late measurement");
+  return a;
+}
+
 void check_options(const HadynetModel& model, const CodegenOptions& o) {
   check_namespace(namespace_of(o));
   if (!std::isfinite(o.headroom) || o.headroom < 1.0 || o.headroom > 1e6) {
@@ -720,6 +795,7 @@ GeneratedHeader generate(const HadynetModel& model, const ModelIdentity& identit
   const auto loss_down = tw.vector("kLossWeightDown", d.y, f.loss_w.frac, false,
                                    [&](Eigen::Index i) { return weight_of(i, false); });
   const std::vector<bool> active = active_commands(model, ctl);
+  const SensorArrays sensor = sensor_arrays(model, q15, f.y.frac);
   std::string threshold_sq;
   const double threshold = det ? det->threshold : 0.0;
   if (q15) {
@@ -952,6 +1028,27 @@ GeneratedHeader generate(const HadynetModel& model, const ModelIdentity& identit
   items.clear();
   for (const bool a : active) items.push_back(a ? "true" : "false");
   e.array1("bool", "kControlActive[kU]", items);
+  e.line();
+  e.line("  // ---- derived inputs: computed by the firmware from their base command");
+  e.array1("hadynet::firmware::DerivedInput", "kUDerived[kU]", sensor.derived);
+  e.array1("int", "kUDerivedBase[kU]", sensor.derived_base);
+  e.line();
+  e.line("  // ---- sensor model: measured y_c = clip(y'_c + sum gain y'_source + rate D_c)");
+  for (const std::string& l : sensor.notes) e.line("  // " + l);
+  e.member("int", "kCrosstalkCount", std::to_string(sensor.crosstalk_count));
+  e.array1("int", "kCrosstalkTarget[" + std::to_string(sensor.crosstalk_target.size()) + "]", sensor.crosstalk_target);
+  e.array1("int", "kCrosstalkSource[" + std::to_string(sensor.crosstalk_source.size()) + "]", sensor.crosstalk_source);
+  e.array1("float", "kCrosstalkGain[" + std::to_string(sensor.crosstalk_gain.size()) + "]", sensor.crosstalk_gain);
+  e.member("int", "kDriftCount", std::to_string(sensor.drift_count));
+  e.array1("int", "kDriftChannel[" + std::to_string(sensor.drift_channel.size()) + "]", sensor.drift_channel);
+  e.array1("bool", "kDriftIsLoad[" + std::to_string(sensor.drift_is_load.size()) + "]", sensor.drift_is_load);
+  e.array1("float", "kDriftRate[" + std::to_string(sensor.drift_rate.size()) + "]", sensor.drift_rate);
+  e.member("float", "kSensorPeriod", sensor.period, "s per frame (drift integration)");
+  e.member("int", "kClipCount", std::to_string(sensor.clip_count));
+  e.array1("int", "kClipChannel[" + std::to_string(sensor.clip_channel.size()) + "]", sensor.clip_channel);
+  e.array1("int", "kClipSide[" + std::to_string(sensor.clip_side.size()) + "]", sensor.clip_side);
+  e.array1("float", "kClipRail[" + std::to_string(sensor.clip_rail.size()) + "]", sensor.clip_rail);
+  e.array1("Value", "kClipRailModel[" + std::to_string(sensor.clip_rail_model.size()) + "]", sensor.clip_rail_model);
   e.line("};");
   e.line();
   e.line("static_assert(hadynet::firmware::GeneratedModel<Model>);");

@@ -68,7 +68,8 @@ Eigen::MatrixXd read_matrix(const st::File& file, const std::string& name, std::
 
 // The sensor model (sensor_model.h) as metadata "sensor":
 //   {"delays": [{"channel", "steps"}], "crosstalk": [{"target", "source", "gain"}],
-//    "drifts": [{"channel", "driver": "load"|"time", "rate"}], "clips": [{"channel", "side", "rail"}]}
+//    "drifts": [{"channel", "driver": "load"|"time", "rate"}], "period_s": s,
+//    "clips": [{"channel", "side", "rail"}]}
 json sensor_json(const SensorModel& s) {
   json j = json::object();
   j["delays"] = json::array();
@@ -78,6 +79,7 @@ json sensor_json(const SensorModel& s) {
   j["drifts"] = json::array();
   for (const auto& d : s.drifts)
     j["drifts"].push_back({{"channel", d.channel}, {"driver", d.load ? "load" : "time"}, {"rate", d.rate}});
+  j["period_s"] = s.period_s;
   j["clips"] = json::array();
   for (const auto& c : s.clips) j["clips"].push_back({{"channel", c.channel}, {"side", c.side}, {"rail", c.rail}});
   return j;
@@ -104,6 +106,7 @@ SensorModel sensor_from_json(const json& j, const std::string& origin) {
     s.drifts.push_back({json_get<std::string>(d, "channel", "sensor drift", origin), driver == "load",
                         json_get<double>(d, "rate", "sensor drift", origin)});
   }
+  s.period_s = json_get<double>(j, "period_s", "sensor", origin);
   for (const json& c : json_array(j, "clips", origin))
     s.clips.push_back({json_get<std::string>(c, "channel", "sensor clip", origin),
                        json_get<int>(c, "side", "sensor clip", origin),

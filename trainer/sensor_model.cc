@@ -41,6 +41,8 @@ void SensorModel::check(const std::vector<std::string>& y_names) const {
     if (x.target == x.source || !std::isfinite(x.gain))
       throw std::invalid_argument("sensor model: cross-talk " + x.source + " -> " + x.target + " is invalid");
   }
+  if (!drifts.empty() && !(period_s > 0 && std::isfinite(period_s)))
+    throw std::invalid_argument("sensor model: drifts need a positive period_s");
   for (const auto& d : drifts) {
     need_channel(d.channel, "drift");
     if (!std::isfinite(d.rate)) throw std::invalid_argument("sensor model: drift rate on " + d.channel + " not finite");

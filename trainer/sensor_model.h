@@ -63,6 +63,9 @@ struct SensorModel {
   std::vector<SensorCrosstalk> crosstalk;
   std::vector<SensorDrift> drifts;
   std::vector<OutputClip> clips;
+  // The control period (s) of the logs the drifts were fitted on: D of a
+  // load drift grows by |y_c| period_s per row (the firmware integrates it).
+  double period_s = 0;
 
   bool empty() const { return delays.empty() && crosstalk.empty() && drifts.empty() && clips.empty(); }
   // The frame transform (delay, cross-talk, drift) is the identity.

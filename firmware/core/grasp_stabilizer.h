@@ -94,6 +94,13 @@ class GraspStabilizer {
   void set_hold(const Value (&hold)[kU]) noexcept {
     for (int i = 0; i < kU; ++i) hold_[i] = hold[i];
   }
+  // Holds input i (one the stabiliser does not set, e.g. a derived input) at
+  // `value` (standardised Q(kFracIn)) in the hold command and at every step
+  // of the plan: over the horizon it stays where it is now.
+  void hold_input(int i, Value value) noexcept {
+    hold_[i] = value;
+    for (int k = 0; k < kHorizon; ++k) seq_[k][i] = value;
+  }
   Settings& settings() noexcept { return settings_; }
 
   // Optimises the sequence from the standardised initial state x_t (and the

@@ -10,6 +10,8 @@
 //        (modes detect and control, if the model has detection statistics),
 //        command = u_t from the stabiliser (mode control; needs 2 frames).
 // Entering control mode takes the next frame's y as the reference y_ref.
+// A model with a sensor model or derived inputs (sensor_stage.h) sees every
+// frame in its own frame, and its prediction is reported as measured.
 #ifndef HADYNET_FIRMWARE_CORE_HADYNET_RUNTIME_H_
 #define HADYNET_FIRMWARE_CORE_HADYNET_RUNTIME_H_
 
@@ -19,6 +21,7 @@
 #include "firmware/core/detector.h"
 #include "firmware/core/grasp_stabilizer.h"
 #include "firmware/core/hadynet_net.h"
+#include "firmware/core/sensor_stage.h"
 
 namespace hadynet::firmware {
 
@@ -62,6 +65,7 @@ class HadynetRuntime {
   // starts as the detection PB (or PB table row 0, or zero).
   void reset() noexcept {
     history_.clear();
+    sensor_.reset();
     reference_pending_ = true;
     const float zero_u[M::kU] = {};
     B::u_to_model(zero_u, hold_);
@@ -95,14 +99,19 @@ class HadynetRuntime {
   // One period. Never fails: results not yet computable are marked invalid.
   StepResult<M> step(const SensorFrame<M>& frame) noexcept {
     StepResult<M> out;
-    history_.push(frame.y, frame.u_prev);
+    float y_frame[M::kY], u_frame[M::kU];
+    sensor_.to_model(frame.y, frame.u_prev, y_frame, u_frame);
+    history_.push(y_frame, u_frame);
     Value y_now[M::kY];
-    B::y_to_model(frame.y, y_now);
+    B::y_to_model(y_frame, y_now);
 
     if (Det::ready(history_)) {
       Value y_est[M::kY];
       Det::estimate(history_, pb_, net_, y_est);
-      B::y_to_physical(y_est, out.prediction);
+      SensorStage<M>::clip(y_est);
+      float predicted[M::kY];
+      B::y_to_physical(y_est, predicted);
+      sensor_.to_measured(predicted, out.prediction);
       out.prediction_valid = true;
       if (M::kHasDetection && mode_ != Mode::kObserve) {
         const auto d2 = Det::distance2(y_est, y_now);
@@ -121,6 +130,12 @@ class HadynetRuntime {
         Value x[M::kX];
         B::x_from_frames(history_.y(0), history_.y(1), x);
         Value u[M::kU];
+        if constexpr (SensorStage<M>::has_derived_inputs()) {
+          // Derived inputs keep their value of the newest frame over the horizon.
+          B::u_to_model(u_frame, u);
+          for (int i = 0; i < M::kU; ++i)
+            if (M::kUDerived[i] != DerivedInput::kNone) stabilizer_.hold_input(i, u[i]);
+        }
         stabilizer_.plan(net_, x, y_now, pb_, u);
         B::u_to_physical(u, out.command);
         out.command_valid = true;
@@ -142,6 +157,7 @@ class HadynetRuntime {
   Value pb_[M::kPb] = {};
   Value hold_[M::kU] = {};
   bool reference_pending_ = true;
+  SensorStage<M> sensor_{};
   typename Det::History history_{};
   HadynetNet<M> net_{};
   GraspStabilizer<M> stabilizer_{};

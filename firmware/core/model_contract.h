@@ -44,7 +44,7 @@ enum class Numeric { kQ15, kF32 };
 // The generator version the core was written against; codegen writes the
 // same number into kGeneratorVersion and the core rejects other versions at
 // compile time (a stale generated header fails the build, not the robot).
-inline constexpr int kModelContractVersion = 1;
+inline constexpr int kModelContractVersion = 2;
 
 // Loss class of each observed channel for the grasp stabiliser.
 enum class LossClass : std::uint8_t {
@@ -52,6 +52,14 @@ enum class LossClass : std::uint8_t {
   kForce = 1,   // F = (f, f_contact): weight 1 if est >= ref, else beta
   kAngle = 2,   // theta: weight w2
   kLength = 3,  // l: weight w3
+};
+
+// A command channel computed from another command (trainer/derived_inputs.h):
+// the firmware computes it, the stabiliser never sets it.
+enum class DerivedInput : std::uint8_t {
+  kNone = 0,        // a command
+  kSign = 1,        // sign(u_base): -1, 0, +1
+  kHysteresis = 2,  // sign of the last non-zero u_base (0 before the first)
 };
 
 // clang-format off
@@ -138,6 +146,29 @@ concept GeneratedModel = requires {
   M::kLossWeightUp;       // Value[kY] weight where est >= ref, Q(kFracLossW)
   M::kLossWeightDown;     // Value[kY] weight where est <  ref, Q(kFracLossW)
   M::kControlActive;      // bool[kU]  commands the stabiliser may change (others: "no change")
+
+  // ---- derived inputs (DerivedInput; a model fixed for friction has some)
+  M::kUDerived;           // DerivedInput[kU]
+  M::kUDerivedBase;       // int[kU]  the command it is computed from (itself for kNone)
+
+  // ---- sensor model (trainer/sensor_model.h; counts 0 for a model trained on
+  // logs as they are; arrays hold max(count, 1) entries). The measured y is
+  //   y_c = clip( y'_c + sum k y'_s + rate D_c ),  y' the network's channel,
+  // D_c = sum |y_c| kSensorPeriod (load) or t kSensorPeriod (time) since reset.
+  { M::kCrosstalkCount } -> std::convertible_to<int>;
+  M::kCrosstalkTarget;    // int[]  y channel that picks up
+  M::kCrosstalkSource;    // int[]  y channel it picks up from
+  M::kCrosstalkGain;      // float[] target units per source unit
+  { M::kDriftCount } -> std::convertible_to<int>;
+  M::kDriftChannel;       // int[]
+  M::kDriftIsLoad;        // bool[] true: D = accumulated load; false: time
+  M::kDriftRate;          // float[] units per (unit s), or per s
+  { M::kSensorPeriod } -> std::convertible_to<float>;  // s per frame for D
+  { M::kClipCount } -> std::convertible_to<int>;
+  M::kClipChannel;        // int[]
+  M::kClipSide;           // int[]  +1: min(., rail); -1: max(., rail)
+  M::kClipRail;           // float[] physical
+  M::kClipRailModel;      // Value[] the rail standardised, Q(kFracY)
 };
 // clang-format on
 

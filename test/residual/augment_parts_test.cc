@@ -133,6 +133,7 @@ TEST(SensorFrame, AlignmentCrosstalkAndTheWholeFrame) {
   // The whole frame: drift (from the measured fc0), then cross-talk, then the delay.
   SensorModel s;
   s.drifts = {{"fc0", true, 0.1}};
+  s.period_s = 0.5;
   s.crosstalk = {{"fc0", "fc1", 0.2}};
   s.delays = {{"fc0", 1}};
   const auto frame = to_model_frame(s, in, "d.csv");

@@ -65,6 +65,7 @@ HadynetModel sample_model(bool with_detection) {
     m.sensor.delays = {{y.front(), 2}, {y.back(), 1}};
     m.sensor.crosstalk = {{y.front(), y.back(), 0.25}};
     m.sensor.drifts = {{y.back(), true, 0.004}, {y.front(), false, -0.5}};
+    m.sensor.period_s = 0.2;
     m.sensor.clips = {{y.front(), 1, 0.1875}, {y.back(), -1, -2.5}};
   }
   return m;

@@ -294,6 +294,10 @@ std::optional<Augmentation> plan_augmentation(const ResidualData& data, const At
     }
     case EffectKind::kDriftLoad:
     case EffectKind::kDriftTime: {
+      a.period_s = data.logs.front().dt_s;
+      for (const auto& log : data.logs)
+        if (log.dt_s != a.period_s)
+          throw std::runtime_error(log.seq.file + ": dt_s differs from the other logs' (a drift needs one period)");
       for (const auto& r : attribution.winner_family()) {
         a.channels.push_back(data.y_names[static_cast<std::size_t>(r.hypothesis.target)]);
         a.drifts.push_back({a.channels.back(), h.kind == EffectKind::kDriftLoad, r.parameter});
@@ -328,6 +332,7 @@ SensorModel sensor_after(const SensorModel& before, const Augmentation& a) {
     case EffectKind::kDriftLoad:
     case EffectKind::kDriftTime:
       s.drifts.insert(s.drifts.end(), a.drifts.begin(), a.drifts.end());
+      s.period_s = a.period_s;
       break;
     case EffectKind::kSaturation:
       for (const OutputClip& c : a.clips) {

@@ -86,6 +86,7 @@ struct Augmentation {
   std::vector<std::string> inputs;  // friction: derived u channels added (sign_u0, hyst_u0, ...)
   std::vector<OutputClip> clips;    // saturation: one per channel
   std::vector<SensorDrift> drifts;   // drift: one per channel (rates refined by fix())
+  double period_s = 0;               // drift: the logs' control period (s)
 };
 // True for the effects --fix implements (all but input-delay).
 bool fix_supported(EffectKind kind);

@@ -1,0 +1,106 @@
+// The model's sensor model and derived inputs at the core's boundary
+// (model_contract.h; trainer/sensor_model.h and trainer/derived_inputs.h are
+// the trainer's side, `hadynet residual --fix` adds them). A model trained on
+// logs as they are has none, and then every function here copies.
+//
+//   measured frame -> model frame (to_model):
+//     derived commands: sign(u_base) and the hysteresis state (the sign of
+//       the last non-zero u_base, kept here), overwriting the frame's values;
+//     drift: D_c += |y_c| kSensorPeriod (load) or kSensorPeriod (time), then
+//       y1_c = y_c - rate D_c;
+//     cross-talk: y'_c = y1_c - gain y1_s (the source after the drift step).
+//   model-frame prediction -> measured (to_measured):
+//     y_c = clip(y'_c + gain y'_s + rate D_c), D_c as of the newest frame.
+// The trainer does the same (to_model_frame, the --fix evaluation). A sensor
+// delay is not undone here (it needs future samples): the network gets the
+// late measurement. Float operations only, each one IEEE binary32 operation
+// in a fixed order (-ffp-contract=off), so host and MCU agree bit for bit.
+#ifndef HADYNET_FIRMWARE_CORE_SENSOR_STAGE_H_
+#define HADYNET_FIRMWARE_CORE_SENSOR_STAGE_H_
+
+#include "firmware/core/model_contract.h"
+
+namespace hadynet::firmware {
+
+template <GeneratedModel M>
+class SensorStage {
+ public:
+  using Value = typename M::Value;
+  static constexpr int kY = M::kY, kU = M::kU;
+
+  // Forgets the drift integrals and the hysteresis states (a new log starts).
+  void reset() noexcept {
+    for (float& d : driver_) d = 0.0f;
+    for (float& h : hysteresis_) h = 0.0f;
+  }
+
+  // A measured frame (y_t, u_{t-1}; physical) in the model's frame.
+  void to_model(const float (&y)[kY], const float (&u_prev)[kU], float (&y_model)[kY],
+                float (&u_model)[kU]) noexcept {
+    for (int i = 0; i < kU; ++i) {
+      const float base = u_prev[M::kUDerivedBase[i]];
+      const float sign = base > 0.0f ? 1.0f : (base < 0.0f ? -1.0f : 0.0f);
+      switch (M::kUDerived[i]) {
+        case DerivedInput::kNone: u_model[i] = u_prev[i]; break;
+        case DerivedInput::kSign: u_model[i] = sign; break;
+        case DerivedInput::kHysteresis:
+          if (sign != 0.0f) hysteresis_[i] = sign;
+          u_model[i] = hysteresis_[i];
+          break;
+      }
+    }
+    float drifted[kY];
+    for (int i = 0; i < kY; ++i) drifted[i] = y[i];
+    for (int k = 0; k < M::kDriftCount; ++k) {
+      const int c = M::kDriftChannel[k];
+      const float magnitude = y[c] < 0.0f ? -y[c] : y[c];
+      driver_[k] += M::kDriftIsLoad[k] ? magnitude * M::kSensorPeriod : M::kSensorPeriod;
+      // The time driver is t dt with t counted from 0 at the first frame.
+      drifted[c] -= M::kDriftRate[k] * drift_driver(k);
+    }
+    for (int i = 0; i < kY; ++i) y_model[i] = drifted[i];
+    for (int k = 0; k < M::kCrosstalkCount; ++k)
+      y_model[M::kCrosstalkTarget[k]] -= M::kCrosstalkGain[k] * drifted[M::kCrosstalkSource[k]];
+  }
+
+  // A model-frame prediction (physical) as the sensors would report it.
+  void to_measured(const float (&y_model)[kY], float (&y)[kY]) const noexcept {
+    for (int i = 0; i < kY; ++i) y[i] = y_model[i];
+    for (int k = 0; k < M::kCrosstalkCount; ++k)
+      y[M::kCrosstalkTarget[k]] += M::kCrosstalkGain[k] * y_model[M::kCrosstalkSource[k]];
+    for (int k = 0; k < M::kDriftCount; ++k) y[M::kDriftChannel[k]] += M::kDriftRate[k] * drift_driver(k);
+    for (int k = 0; k < M::kClipCount; ++k) {
+      float& v = y[M::kClipChannel[k]];
+      if (M::kClipSide[k] > 0 ? v > M::kClipRail[k] : v < M::kClipRail[k]) v = M::kClipRail[k];
+    }
+  }
+
+  // The clips on a standardised model-frame estimate (Q(kFracY)), so that
+  // detection compares what a saturating sensor can show.
+  static void clip(Value (&y)[kY]) noexcept {
+    for (int k = 0; k < M::kClipCount; ++k) {
+      Value& v = y[M::kClipChannel[k]];
+      if (M::kClipSide[k] > 0 ? v > M::kClipRailModel[k] : v < M::kClipRailModel[k]) v = M::kClipRailModel[k];
+    }
+  }
+
+  static constexpr bool has_derived_inputs() noexcept {
+    for (int i = 0; i < kU; ++i)
+      if (M::kUDerived[i] != DerivedInput::kNone) return true;
+    return false;
+  }
+
+ private:
+  // D_k as of the newest frame: load sum, or (frames - 1) periods for time.
+  float drift_driver(int k) const noexcept {
+    return M::kDriftIsLoad[k] ? driver_[k] : driver_[k] - M::kSensorPeriod;
+  }
+
+  static constexpr int kDrifts = M::kDriftCount > 0 ? M::kDriftCount : 1;
+  float driver_[kDrifts] = {};
+  float hysteresis_[kU] = {};
+};
+
+}  // namespace hadynet::firmware
+
+#endif  // HADYNET_FIRMWARE_CORE_SENSOR_STAGE_H_
