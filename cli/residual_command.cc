@@ -14,6 +14,7 @@
 #include "cli/commands.h"
 #include "cli/gnuplot.h"
 #include "cli/options.h"
+#include "cli/residual_fix_report.h"
 #include "datalog/log_reader.h"
 #include "trainer/model_file.h"
 #include "trainer/residual/attribution.h"
@@ -358,89 +359,6 @@ std::string markdown(const Analysis& a, const std::string& model_path, const std
   return m;
 }
 
-// ---- --fix ----
-
-json held_out_json(const rs::HeldOutError& e) {
-  json ch = json::array();
-  for (std::size_t c = 0; c < e.channels.size(); ++c) {
-    const auto i = static_cast<Eigen::Index>(c);
-    const auto& w = e.whiteness[c];
-    ch.push_back({{"channel", e.channels[c]}, {"rmse", e.rmse(i)}, {"fit_percent", e.fit(i)},
-                  {"ljung_box", {{"q", w.ljung_box.q}, {"dof", w.ljung_box.dof}, {"p_value", w.ljung_box.p_value}}},
-                  {"white", w.white()}, {"acf_lags_outside", w.outside}, {"input_lags_outside", e.inputs_outside[c]}});
-  }
-  return {{"samples", e.samples}, {"verdict", e.verdict}, {"channels", ch}};
-}
-
-json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
-  json j = {{"status", f.status},
-            {"changed", f.changed},
-            {"train_fraction", o.train_fraction},
-            {"epochs", o.epochs},
-            {"lr", o.lr},
-            {"seed", o.seed},
-            {"before", held_out_json(f.before)}};
-  if (f.augmentation) {
-    j["augmentation"] = {{"effect", f.augmentation->effect}, {"description", f.augmentation->description},
-                         {"channels", f.augmentation->channels}, {"delay_steps", f.augmentation->delay}};
-    if (f.augmentation->kind == rs::EffectKind::kCrosstalk) {
-      j["augmentation"]["source"] = f.augmentation->source;
-      j["augmentation"]["gain"] = f.augmentation->gain;
-    }
-  }
-  if (f.control) j["control"] = held_out_json(*f.control);
-  if (f.changed) {
-    j["after"] = held_out_json(f.after);
-    j["loss_history"] = f.loss_history;
-    j["train_windows"] = f.train_windows;
-  }
-  return j;
-}
-
-// Per channel: RMSE and fit before / fine-tune only / after, and Ljung-Box p before / after.
-std::string fix_table(const rs::FixResult& f) {
-  auto find = [](const rs::HeldOutError& e, const std::string& name) -> int {
-    for (std::size_t c = 0; c < e.channels.size(); ++c)
-      if (e.channels[c] == name) return static_cast<int>(c);
-    return -1;
-  };
-  const rs::HeldOutError& last = f.changed ? f.after : f.before;
-  std::string m = "| channel | RMSE before | RMSE fine-tune only | RMSE after | fit before (%) | fit after (%) | "
-                  "Ljung-Box p before | after | input lags outside before | after |\n|---|---|---|---|---|---|---|---|---|---|\n";
-  for (const auto& name : last.channels) {
-    const int b = find(f.before, name), c = f.control ? find(*f.control, name) : -1, a = find(f.after, name);
-    auto cell = [](const rs::HeldOutError* e, int i, const char* fmt, int what) -> std::string {
-      if (e == nullptr || i < 0) return "-";
-      const auto k = static_cast<Eigen::Index>(i);
-      const double v = what == 0 ? e->rmse(k) : what == 1 ? e->fit(k) : what == 2
-                       ? e->whiteness[static_cast<std::size_t>(i)].ljung_box.p_value
-                       : e->inputs_outside[static_cast<std::size_t>(i)];
-      return num(fmt, v);
-    };
-    const rs::HeldOutError* after = f.changed ? &f.after : nullptr;
-    const rs::HeldOutError* ctrl = f.control ? &*f.control : nullptr;
-    m += "| " + name + " | " + cell(&f.before, b, "%.4g", 0) + " | " + cell(ctrl, c, "%.4g", 0) + " | " +
-         cell(after, a, "%.4g", 0) + " | " + cell(&f.before, b, "%.1f", 1) + " | " + cell(after, a, "%.1f", 1) + " | " +
-         cell(&f.before, b, "%.2g", 2) + " | " + cell(after, a, "%.2g", 2) + " | " + cell(&f.before, b, "%.0f", 3) +
-         " | " + cell(after, a, "%.0f", 3) + " |\n";
-  }
-  return m;
-}
-
-std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const std::string& out) {
-  std::string m = "\n## Fix (--fix)\n\n**" + f.status + "**";
-  if (f.augmentation) m += ": " + f.augmentation->effect + ", " + f.augmentation->description;
-  m += "\n\nFine-tuned " + std::to_string(o.epochs) + " epochs (batch norm frozen, Adam lr " + num("%g", o.lr) +
-       ", seed " + std::to_string(o.seed) + ") on the first " + num("%.0f", 100 * o.train_fraction) +
-       " % of each log's rows; every number below is on the remaining rows (" + std::to_string(f.before.samples) +
-       " held-out rows, causal 1-step predictions of the measured values). \"Fine-tune only\" is the same "
-       "fine-tuning without the augmentation.\n\n";
-  m += "Verdict before: " + f.before.verdict + "\n\n";
-  if (f.changed) m += "Verdict after (the augmented model on its own frame): " + f.after.verdict + "\n\n";
-  if (!out.empty()) m += "Model written: `" + out + "`\n\n";
-  return m + fix_table(f);
-}
-
 std::string verdict_text(const rs::Attribution& att) {
   const auto w = att.winner();
   if (!w) return "no significant effect";
@@ -640,7 +558,13 @@ int run_residual(int argc, char** argv) {
       std::ofstream md(md_path);
       if (!md) throw std::runtime_error(md_path + ": cannot write");
       md << markdown(a, model_path, pb_choice, pngs);
-      if (fixed) md << fix_markdown(*fixed, fo, written);
+      std::string fix_png;
+      if (fixed && fixed->changed) {
+        plot("fix.png", fix_plot(*fixed, (dir / "fix.png").string()));
+        pngs.pop_back();  // shown in the Fix section
+        fix_png = "fix.png";
+      }
+      if (fixed) md << fix_markdown(*fixed, fo, written, fix_png);
       std::fprintf(stderr, "wrote %s\n", md_path.c_str());
     }
   } catch (const std::exception& e) {

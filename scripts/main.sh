@@ -6,7 +6,9 @@
 # simulation; summary in out/paper/summary.md), then codegen of the trained
 # model and the firmware core on it (scripts/firmware_experiments.sh: replay
 # of held-out logs, the grasp stabiliser in closed loop with the plant;
-# summary in out/firmware/summary.md).
+# summary in out/firmware/summary.md), then the residual loop on it
+# (scripts/residual_experiments.sh: each plant effect named, added and
+# fine-tuned, error before and after; summary in out/residual/summary.md).
 # Usage: scripts/main.sh [DATA_DIR] [RESULTS_DIR]   (defaults: data/paper, out/paper)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -30,3 +32,5 @@ echo "== the seed paper's experiments -> $results"
 scripts/paper_experiments.sh "$out" "$results"
 echo "== codegen and the firmware core on the trained model -> out/firmware"
 scripts/firmware_experiments.sh "$results/hadynet_detect.safetensors" "$out" out/firmware
+echo "== the residual loop on the trained model -> out/residual"
+scripts/residual_experiments.sh "$results/hadynet_detect.safetensors" out/residual

@@ -1,0 +1,148 @@
+// The --fix part of `hadynet residual`'s outputs (docs/residual.md, "--fix"):
+// the JSON object, the Markdown section and the before/after plot.
+#include "cli/residual_fix_report.h"
+
+#include <cstdio>
+
+#include "cli/gnuplot.h"
+
+namespace hadynet::cli {
+
+namespace {
+
+namespace rs = trainer::residual;
+using nlohmann::json;
+
+std::string num(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+
+json held_out_json(const rs::HeldOutError& e) {
+  json ch = json::array();
+  for (std::size_t c = 0; c < e.channels.size(); ++c) {
+    const auto i = static_cast<Eigen::Index>(c);
+    const auto& w = e.whiteness[c];
+    ch.push_back({{"channel", e.channels[c]}, {"rmse", e.rmse(i)}, {"fit_percent", e.fit(i)},
+                  {"ljung_box", {{"q", w.ljung_box.q}, {"dof", w.ljung_box.dof}, {"p_value", w.ljung_box.p_value}}},
+                  {"white", w.white()}, {"acf_lags_outside", w.outside}, {"input_lags_outside", e.inputs_outside[c]}});
+  }
+  return {{"samples", e.samples}, {"verdict", e.verdict}, {"channels", ch}};
+}
+
+}  // namespace
+
+nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
+  json j = {{"status", f.status},
+            {"changed", f.changed},
+            {"train_fraction", o.train_fraction},
+            {"epochs", o.epochs},
+            {"lr", o.lr},
+            {"seed", o.seed},
+            {"before", held_out_json(f.before)}};
+  if (f.augmentation) {
+    j["augmentation"] = {{"effect", f.augmentation->effect}, {"description", f.augmentation->description},
+                         {"channels", f.augmentation->channels}, {"delay_steps", f.augmentation->delay}};
+    if (f.augmentation->kind == rs::EffectKind::kCrosstalk) {
+      j["augmentation"]["source"] = f.augmentation->source;
+      j["augmentation"]["gain"] = f.augmentation->gain;
+    }
+    if (!f.augmentation->inputs.empty()) j["augmentation"]["derived_inputs"] = f.augmentation->inputs;
+    if (!f.fitted_rates.empty()) j["augmentation"]["fitted_rates"] = f.fitted_rates;
+  }
+  if (f.changed) j["sensor_model"] = f.model.sensor.describe();
+  if (f.control) j["control"] = held_out_json(*f.control);
+  if (f.changed) {
+    j["after"] = held_out_json(f.after);
+    j["loss_history"] = f.loss_history;
+    j["train_windows"] = f.train_windows;
+  }
+  return j;
+}
+
+// Per channel: RMSE and fit before / fine-tune only / after, and Ljung-Box p before / after.
+namespace {
+
+std::string fix_table(const rs::FixResult& f) {
+  auto find = [](const rs::HeldOutError& e, const std::string& name) -> int {
+    for (std::size_t c = 0; c < e.channels.size(); ++c)
+      if (e.channels[c] == name) return static_cast<int>(c);
+    return -1;
+  };
+  const rs::HeldOutError& last = f.changed ? f.after : f.before;
+  std::string m = "| channel | RMSE before | RMSE fine-tune only | RMSE after | fit before (%) | fit after (%) | "
+                  "Ljung-Box p before | after | input lags outside before | after |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& name : last.channels) {
+    const int b = find(f.before, name), c = f.control ? find(*f.control, name) : -1, a = find(f.after, name);
+    auto cell = [](const rs::HeldOutError* e, int i, const char* fmt, int what) -> std::string {
+      if (e == nullptr || i < 0) return "-";
+      const auto k = static_cast<Eigen::Index>(i);
+      const double v = what == 0 ? e->rmse(k) : what == 1 ? e->fit(k) : what == 2
+                       ? e->whiteness[static_cast<std::size_t>(i)].ljung_box.p_value
+                       : e->inputs_outside[static_cast<std::size_t>(i)];
+      return num(fmt, v);
+    };
+    const rs::HeldOutError* after = f.changed ? &f.after : nullptr;
+    const rs::HeldOutError* ctrl = f.control ? &*f.control : nullptr;
+    m += "| " + name + " | " + cell(&f.before, b, "%.4g", 0) + " | " + cell(ctrl, c, "%.4g", 0) + " | " +
+         cell(after, a, "%.4g", 0) + " | " + cell(&f.before, b, "%.1f", 1) + " | " + cell(after, a, "%.1f", 1) + " | " +
+         cell(&f.before, b, "%.2g", 2) + " | " + cell(after, a, "%.2g", 2) + " | " + cell(&f.before, b, "%.0f", 3) +
+         " | " + cell(after, a, "%.0f", 3) + " |\n";
+  }
+  return m;
+}
+
+}  // namespace
+
+std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const std::string& out,
+                         const std::string& png) {
+  std::string m = "\n## Fix (--fix)\n\n**" + f.status + "**";
+  if (f.augmentation) m += ": " + f.augmentation->effect + ", " + f.augmentation->description;
+  m += "\n\nFine-tuned " + std::to_string(o.epochs) + " epochs (batch norm frozen, Adam lr " + num("%g", o.lr) +
+       ", seed " + std::to_string(o.seed) + ") on the first " + num("%.0f", 100 * o.train_fraction) +
+       " % of each log's rows; every number below is on the remaining rows (" + std::to_string(f.before.samples) +
+       " held-out rows, causal 1-step predictions of the measured values). \"Fine-tune only\" is the same "
+       "fine-tuning without the augmentation.\n\n";
+  m += "Verdict before: " + f.before.verdict + "\n\n";
+  if (f.changed) m += "Verdict after (the augmented model on its own frame): " + f.after.verdict + "\n\n";
+  if (f.changed && !f.model.sensor.empty()) {
+    m += "Sensor model of the fixed model (measured channels from the network's):\n\n";
+    for (const auto& line : f.model.sensor.describe()) m += "- " + line + "\n";
+    m += "\n";
+  }
+  if (!out.empty()) m += "Model written: `" + out + "`\n\n";
+  if (!png.empty()) m += "![" + png + "](" + png + ")\n\n";
+  return m + fix_table(f);
+}
+
+
+std::string fix_plot(const rs::FixResult& f, const std::string& png) {
+  if (!f.changed) return "";
+  // Per channel: held-out RMSE after and fine-tune only, relative to before.
+  std::string s = "$r << EOD\n";
+  for (std::size_t c = 0; c < f.after.channels.size(); ++c) {
+    const std::string& name = f.after.channels[c];
+    int b = -1;
+    for (std::size_t i = 0; i < f.before.channels.size(); ++i)
+      if (f.before.channels[i] == name) b = static_cast<int>(i);
+    if (b < 0) continue;  // a channel the fix added
+    const double before = f.before.rmse(b);
+    const double after = f.after.rmse(static_cast<Eigen::Index>(c)) / before;
+    const double control = f.control ? f.control->rmse(b) / before : after;
+    s += std::to_string(c) + " " + num("%.6g", control) + " " + num("%.6g", after) + " " + name + "\n";
+  }
+  s += "EOD\n";
+  s += "set terminal pngcairo size 1400,600 font 'sans,9' noenhanced\nset output " + gnuplot_quote(png) + "\n";
+  s += "set title " + gnuplot_quote("held-out 1-step RMSE relative to before the fix (1 = unchanged): " +
+                                    (f.augmentation ? f.augmentation->effect : std::string("")) + "; " +
+                                    "verdict after: " + f.after.verdict) + "\n";
+  s += "set style data histogram\nset style histogram cluster gap 1\nset style fill solid 0.8\nset grid y\n";
+  s += "set yrange [0:*]\nset key top right\nset xtics rotate by -45 font 'sans,8'\n";
+  s += "set arrow from graph 0, first 1 to graph 1, first 1 nohead dt 2 lc rgb 'black'\n";
+  s += "plot $r using 2:xtic(4) title 'fine-tune only' lc rgb '#999999', '' using 3 title 'after the fix' lc rgb '#2ca02c'\n";
+  return run_gnuplot(s, png);
+}
+
+}  // namespace hadynet::cli

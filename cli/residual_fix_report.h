@@ -1,0 +1,25 @@
+// The --fix part of `hadynet residual`'s outputs (docs/residual.md, "--fix").
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "trainer/residual/augment.h"
+
+namespace hadynet::cli {
+
+// The "fix" object of the JSON: status, augmentation, the fixed model's
+// sensor model, and before / fine-tune only / after per channel.
+nlohmann::json fix_json(const trainer::residual::FixResult& f, const trainer::residual::FixOptions& o);
+
+// The "Fix" section of REPORT.md; `out` is the written model ("" if none),
+// `png` the plot's file name in the report folder ("" if none).
+std::string fix_markdown(const trainer::residual::FixResult& f, const trainer::residual::FixOptions& o,
+                         const std::string& out, const std::string& png);
+
+// fix.png: each channel's held-out RMSE after the fix and after fine-tuning
+// alone, relative to before. Returns "" on success (or nothing to plot), else
+// a message (gnuplot missing or failed).
+std::string fix_plot(const trainer::residual::FixResult& f, const std::string& png);
+
+}  // namespace hadynet::cli
