@@ -13,6 +13,7 @@
 
 #include "cli/commands.h"
 #include "cli/gnuplot.h"
+#include "cli/number_text.h"
 #include "cli/options.h"
 #include "cli/residual_fix_report.h"
 #include "datalog/log_reader.h"
@@ -28,12 +29,6 @@ namespace {
 
 namespace rs = trainer::residual;
 using nlohmann::json;
-
-std::string num(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
 
 std::vector<double> to_vector(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
 

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "cli/gnuplot.h"
+#include "cli/number_text.h"
 
 namespace hadynet::cli {
 
@@ -12,12 +13,6 @@ namespace {
 
 namespace rs = trainer::residual;
 using nlohmann::json;
-
-std::string num(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
 
 
 json held_out_json(const rs::HeldOutError& e) {
