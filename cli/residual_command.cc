@@ -344,7 +344,7 @@ std::string markdown(const Analysis& a, const std::string& model_path, const std
          num("%.4f", r.explained_std) + " | " + num("%.3f", r.explained_train) + " | " + num("%.1f", r.t_stat) + " | " +
          num("%.2g", r.p_adjusted) + " | " + (r.significant ? "yes" : "no") + " |\n";
   }
-  m += "\n## Effect library\n\n| effect | feature test | parameter | planned augmentation (--fix) |\n|---|---|---|---|\n";
+  m += "\n## Effect library\n\n| effect | feature test | parameter | augmentation (--fix) |\n|---|---|---|---|\n";
   for (const auto& e : rs::effect_library())
     m += std::string("| ") + e.name + " | " + e.feature + " | " + e.parameter + " | " + e.augmentation + " |\n";
   if (!pngs.empty()) {

@@ -505,7 +505,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     return result;
   }
   if (!fix_supported(aug->kind)) {
-    result.status = "not supported: " + aug->effect + " (planned: " + aug->description + ")";
+    result.status = "not supported: " + aug->effect + ": " + aug->description;
     return result;
   }
 

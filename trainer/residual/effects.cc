@@ -14,39 +14,40 @@ const std::vector<EffectInfo>& effect_library() {
        "y_hat_c(t-d) - y_hat_c(t): the residual a sensor reporting d steps late leaves against the model's "
        "prediction (d = 1..max_delay)",
        "delay d (steps) and the gain of the aligned prediction (1: the whole residual is the delay)",
-       "time alignment: predict the delayed channel from a d-step-delayed copy of the prediction "
-       "(equivalently train on y_c shifted d steps earlier), and feed x the undelayed estimate"},
+       "time alignment: train on y_c shifted d steps earlier (the network predicts the true-time signal), "
+       "with the winner's group where the same delay tests significant; the delay goes into the sensor model"},
       {EffectKind::kInputDelay, "input-delay",
        "u(t-1-d) - u(t-1), every command channel: commands that act d steps later than the model assumes",
-       "delay d (steps)", "lagged inputs: feed the network u(t-d) instead of u(t) (d steps of command history in x)"},
+       "delay d (steps)",
+       "none (named and reported only): dead time in the commands would change what the stabiliser controls"},
       {EffectKind::kFriction, "friction",
        "sign(u_m(t-1)) and the hysteresis state h_m(t) (sign of the last non-zero command of muscle m): dry "
        "friction acting against the motion of muscle m",
        "the residual offset while muscle m moves in the + direction (target units; minus that in the other)",
-       "a hysteresis state as an input: append sign(u_m) and h_m to the network's inputs (x and u)"},
+       "a hysteresis state as an input: the derived commands sign_u_m and hyst_u_m appended to u"},
       {EffectKind::kDriftLoad, "drift-load",
        "the accumulated load sum_{s<=t} |y_c(s)| dt from the log's start: a bias that grows with the load "
        "the sensor has carried",
        "rate: bias per accumulated load (target units per (target unit s))",
-       "a drift/bias state: a per-channel bias integrating |y_c| dt with a learned rate, subtracted from the "
-       "measured y_c before the network sees it and added to its prediction"},
+       "a drift/bias state in the sensor model: a per-channel bias integrating |y_c| dt at a re-estimated "
+       "rate, subtracted from the measured y_c before the network sees it and added to its prediction"},
       {EffectKind::kDriftTime, "drift-time", "time since the log's start: a bias growing with time",
        "rate: bias per second (target units per s)",
-       "a drift/bias state: a per-channel bias growing with time (re-estimated online like the PB)"},
+       "a drift/bias state in the sensor model, growing with time at a re-estimated rate"},
       {EffectKind::kSaturation, "saturation",
        "min(y_hat_c, R) - y_hat_c (upper rail R = the largest measured value over the logs; lower: max(y_hat_c, "
        "R) - y_hat_c with the smallest): the part of the prediction a clipped sensor cannot show",
        "the rail R (target units) and the gain (1: fully clipped)",
-       "clipping: pass the prediction of y_c through min(., R) (max for a lower rail) and train on the "
-       "clipped output"},
+       "clipping in the sensor model: the prediction of y_c passes min(., R) (max for a lower rail); "
+       "fine-tuned on the clipped output"},
       {EffectKind::kCrosstalk, "crosstalk",
        "y_s(t): another channel's measured value (by default of the target's group) leaking into the target",
        "gain: the fraction of y_s the target picks up",
-       "a cross-talk matrix: model y_c = y_c,true + k y_s at the output (a fixed linear layer after the "
-       "decoder, and its inverse on x)"},
+       "removal: train on y_c - k y_s (in y and x); the sensor model adds k times the predicted y_s back"},
       {EffectKind::kAuxChannel, "aux-channel",
        "an aux_* column's value at t: a logged channel the model does not use",
-       "gain (target units per aux unit)", "use it as an input: append the aux channel to x and u"},
+       "gain (target units per aux unit)",
+       "use it: the aux channel becomes an observed channel (an input in x, predicted in y)"},
   };
   return library;
 }

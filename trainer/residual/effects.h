@@ -3,7 +3,7 @@
 //   (a) a feature test: regressors built from the logs, the model's 1-step
 //       predictions and the auxiliary channels, which should explain the
 //       1-step residual of one target channel if the effect is present, and
-//   (b) a model augmentation (implemented later by `hadynet residual --fix`;
+//   (b) a model augmentation (added by `hadynet residual --fix`, augment.h;
 //       `augmentation` describes it).
 // A hypothesis is one effect with its parameters (target channel, source,
 // delay, rail). Nothing here knows the hand: channels come by index into the
@@ -34,7 +34,7 @@ struct EffectInfo {
   const char* name;          // used in the CLI, the JSON and the report
   const char* feature;       // the regressors of the feature test
   const char* parameter;     // what the fitted parameter means
-  const char* augmentation;  // the planned model augmentation (--fix)
+  const char* augmentation;  // the model augmentation of --fix (augment.h)
 };
 const std::vector<EffectInfo>& effect_library();
 const EffectInfo& effect_info(EffectKind kind);
