@@ -176,9 +176,13 @@ std::optional<HypothesisResult> Attribution::winner() const {
 }
 
 std::vector<HypothesisResult> Attribution::winner_family() const {
-  std::vector<HypothesisResult> out;
   const auto w = winner();
-  if (!w) return out;
+  return w ? family_of(*w) : std::vector<HypothesisResult>{};
+}
+
+std::vector<HypothesisResult> Attribution::family_of(const HypothesisResult& lead) const {
+  std::vector<HypothesisResult> out;
+  const HypothesisResult* w = &lead;
   std::map<int, bool> seen;
   for (const auto& r : ranked) {
     if (!r.significant) break;

@@ -77,6 +77,8 @@ struct Attribution {
   // Significant hypotheses of the winner's effect (and delay, for delays), one per target channel
   // (the best), by explained variance: where else the same effect shows.
   std::vector<HypothesisResult> winner_family() const;
+  // The same for any significant hypothesis `lead` (its effect and delay).
+  std::vector<HypothesisResult> family_of(const HypothesisResult& lead) const;
 };
 
 // Fits and tests one hypothesis (steps 1-3; p_adjusted and significant are left for step 4).

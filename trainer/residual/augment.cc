@@ -212,16 +212,35 @@ std::string verdict_of(const Attribution& a) {
 bool fix_supported(EffectKind kind) { return kind != EffectKind::kInputDelay; }
 
 std::optional<Augmentation> plan_augmentation(const ResidualData& data, const Attribution& attribution) {
-  const auto w = attribution.winner();
-  if (!w) return std::nullopt;
+  const auto winner = attribution.winner();
+  if (!winner) return std::nullopt;
+  // The best significant hypothesis whose effect --fix can add: the winner,
+  // unless its effect has no augmentation (input-delay), then the next one
+  // in the ranking. A sensor delay on a channel the commands drive directly
+  // leaves nearly the residual of an input delay on that channel alone, so
+  // the two can swap places (docs/residual.md).
+  const HypothesisResult* w = nullptr;
+  for (const auto& r : attribution.ranked) {
+    if (!r.significant) break;
+    if (fix_supported(r.hypothesis.kind)) {
+      w = &r;
+      break;
+    }
+  }
   Augmentation a;
+  if (w == nullptr) {  // nothing significant can be added: fix() says "not supported"
+    a.kind = winner->hypothesis.kind;
+    a.effect = winner->effect;
+    a.description = effect_info(a.kind).augmentation;
+    return a;
+  }
   a.kind = w->hypothesis.kind;
   a.effect = w->effect;
   const auto& h = w->hypothesis;
   switch (h.kind) {
     case EffectKind::kSensorDelay: {
       a.delay = h.delay;
-      for (const auto& r : attribution.winner_family())
+      for (const auto& r : attribution.family_of(*w))
         if (r.hypothesis.delay == h.delay) a.channels.push_back(data.y_names[static_cast<std::size_t>(r.hypothesis.target)]);
       // A delay belongs to the acquisition chain, so it extends to the other
       // channels of the winner's group where the same delay passes the test
@@ -267,7 +286,7 @@ std::optional<Augmentation> plan_augmentation(const ResidualData& data, const At
     }
     case EffectKind::kFriction: {
       std::vector<std::string> muscles;
-      for (const auto& r : attribution.winner_family()) {
+      for (const auto& r : attribution.family_of(*w)) {
         a.channels.push_back(data.y_names[static_cast<std::size_t>(r.hypothesis.target)]);
         const std::string& m = data.u_names[static_cast<std::size_t>(r.hypothesis.source)];
         if (std::find(muscles.begin(), muscles.end(), m) == muscles.end()) muscles.push_back(m);
@@ -281,7 +300,7 @@ std::optional<Augmentation> plan_augmentation(const ResidualData& data, const At
     }
     case EffectKind::kSaturation: {
       std::vector<std::string> rails;
-      for (const auto& r : attribution.winner_family()) {
+      for (const auto& r : attribution.family_of(*w)) {
         const auto& hr = r.hypothesis;
         a.channels.push_back(data.y_names[static_cast<std::size_t>(hr.target)]);
         a.clips.push_back({a.channels.back(), hr.side, hr.rail});
@@ -298,7 +317,7 @@ std::optional<Augmentation> plan_augmentation(const ResidualData& data, const At
       for (const auto& log : data.logs)
         if (log.dt_s != a.period_s)
           throw std::runtime_error(log.seq.file + ": dt_s differs from the other logs' (a drift needs one period)");
-      for (const auto& r : attribution.winner_family()) {
+      for (const auto& r : attribution.family_of(*w)) {
         a.channels.push_back(data.y_names[static_cast<std::size_t>(r.hypothesis.target)]);
         a.drifts.push_back({a.channels.back(), h.kind == EffectKind::kDriftLoad, r.parameter});
       }
@@ -311,6 +330,9 @@ std::optional<Augmentation> plan_augmentation(const ResidualData& data, const At
       a.description = effect_info(h.kind).augmentation;
       break;
   }
+  if (w->label != winner->label)
+    a.description = "the winner (" + winner->effect + ": " + winner->label +
+                    ") has no augmentation; the best significant effect that has: " + w->label + "; " + a.description;
   return a;
 }
 

@@ -91,8 +91,11 @@ struct Augmentation {
 // True for the effects --fix implements (all but input-delay).
 bool fix_supported(EffectKind kind);
 
-// The augmentation of the attribution's winner (sensor-delay: every family
-// member with the winner's delay). None without a winner.
+// The augmentation of the attribution's winner, with its family (see each
+// effect above). When the winner's effect has no augmentation (input-delay),
+// the best significant hypothesis that has one, and the description says so;
+// when none has, the winner's (fix() then reports "not supported"). None
+// without a winner.
 std::optional<Augmentation> plan_augmentation(const ResidualData& data, const Attribution& attribution);
 
 // The sensor model after adding the augmentation's part (delay,
