@@ -394,9 +394,9 @@ int run_residual(int argc, char** argv) {
   opt.flag("all-sources", "cross-talk sources from every observed group (default: the target's group)");
   opt.value("report", "DIR", "write DIR/REPORT.md with PNG plots (gnuplot) and DIR/residual.json");
   opt.value("json", "FILE", "write every number as JSON");
-  opt.flag("fix", "add the winning effect (sensor-delay: time alignment; aux-channel: as an input; crosstalk: removed\n"
-                  "from the data), fine-tune on the first --train-fraction of each log and report before/after on\n"
-                  "the rest");
+  opt.flag("fix", "add the winning effect (sensor delay: time alignment; cross-talk: removal; drift: a bias state;\n"
+                  "saturation: clipping; friction: hysteresis inputs; aux channel: an observed channel), fine-tune\n"
+                  "on the first --train-fraction of each log and report before/after on the rest");
   opt.value("out", "FILE", "with --fix: write the augmented model (only when something was fixed)");
   opt.value("fix-epochs", "N", "with --fix: fine-tuning epochs", "20");
   opt.value("fix-lr", "X", "with --fix: Adam learning rate", "0.001");

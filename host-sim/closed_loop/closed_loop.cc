@@ -23,10 +23,14 @@ std::size_t index_of(const std::vector<std::string>& names, const char* name, co
 template <class M>
 ClosedLoopRun run_with(const ClosedLoopOptions& opt) {
   plant::GraspSession session(opt.object, opt.init_id, opt.wear_level, opt.seed, opt.disturbance);
-  // The model's channels in the plant's order.
+  // The model's channels in the plant's order; a derived input is computed
+  // by the firmware from its base command, not sent to the plant (kNoCommand).
+  constexpr std::size_t kNoCommand = static_cast<std::size_t>(-1);
+  const auto derived = [](int i) { return M::kUDerived[i] != firmware::DerivedInput::kNone; };
   std::vector<std::size_t> y_index, u_index;
   for (int i = 0; i < M::kY; ++i) y_index.push_back(index_of(session.y_names(), M::kYNames[i], "channel"));
-  for (int i = 0; i < M::kU; ++i) u_index.push_back(index_of(session.u_names(), M::kUNames[i], "command"));
+  for (int i = 0; i < M::kU; ++i)
+    u_index.push_back(derived(i) ? kNoCommand : index_of(session.u_names(), M::kUNames[i], "command"));
 
   auto rt = std::make_unique<firmware::HadynetRuntime<M>>();
   if (!opt.pb_state.empty()) {
@@ -42,7 +46,7 @@ ClosedLoopRun run_with(const ClosedLoopOptions& opt) {
   if (opt.absolute_reference) settings.reference = firmware::GraspStabilizer<M>::Reference::kAbsolute;
   if (opt.adopt_best_always) settings.keep_if_no_descent = false;
   if (opt.all_commands)
-    for (bool& a : settings.active) a = true;
+    for (int i = 0; i < M::kU; ++i) settings.active[i] = !derived(i);
   rt->set_mode(opt.control ? firmware::Mode::kControl : firmware::Mode::kDetect);
 
   ClosedLoopRun run;
@@ -53,8 +57,10 @@ ClosedLoopRun run_with(const ClosedLoopOptions& opt) {
   for (int t = 0; t <= opt.steps; ++t) {
     const std::vector<double>& y = session.y();
     for (int i = 0; i < M::kY; ++i) frame.y[i] = static_cast<float>(y[y_index[static_cast<std::size_t>(i)]]);
-    for (int i = 0; i < M::kU; ++i)
-      frame.u_prev[i] = static_cast<float>(session.last_u()[u_index[static_cast<std::size_t>(i)]]);
+    for (int i = 0; i < M::kU; ++i) {
+      const std::size_t k = u_index[static_cast<std::size_t>(i)];
+      frame.u_prev[i] = k == kNoCommand ? 0.0f : static_cast<float>(session.last_u()[k]);
+    }
     const firmware::StepResult<M> r = rt->step(frame);
     ClosedLoopStep s;
     s.step = t;
@@ -65,9 +71,12 @@ ClosedLoopRun run_with(const ClosedLoopOptions& opt) {
     s.d = r.d;
     std::fill(u.begin(), u.end(), 0.0);
     if (opt.control && r.command_valid)
-      for (int i = 0; i < M::kU; ++i) u[u_index[static_cast<std::size_t>(i)]] = r.command[i];
+      for (int i = 0; i < M::kU; ++i)
+        if (u_index[static_cast<std::size_t>(i)] != kNoCommand) u[u_index[static_cast<std::size_t>(i)]] = r.command[i];
     s.command.assign(M::kU, 0.0);
-    for (int i = 0; i < M::kU; ++i) s.command[static_cast<std::size_t>(i)] = u[u_index[static_cast<std::size_t>(i)]];
+    for (int i = 0; i < M::kU; ++i)
+      if (u_index[static_cast<std::size_t>(i)] != kNoCommand)
+        s.command[static_cast<std::size_t>(i)] = u[u_index[static_cast<std::size_t>(i)]];
     if (opt.control && r.command_valid) {
       s.loss_initial = firmware::GraspStabilizer<M>::loss_value(rt->stabilizer().loss_initial());
       s.loss_final = firmware::GraspStabilizer<M>::loss_value(rt->stabilizer().loss_final());

@@ -36,13 +36,22 @@ CompiledModelInfo info_of() {
   return info;
 }
 
-// Column index of every model channel in the log, in model order.
+// A model channel the log need not have (map_columns): the frame carries 0.
+constexpr std::size_t kNotLogged = static_cast<std::size_t>(-1);
+
+// Column index of every model channel in the log, in model order. A channel
+// with `computed[i]` (a derived input: the firmware computes it from its base
+// command) may be absent and maps to kNotLogged.
 std::vector<std::size_t> map_columns(const datalog::LogTable& log, const std::string& file,
-                                     const std::vector<std::string>& names) {
+                                     const std::vector<std::string>& names, const std::vector<bool>& computed = {}) {
   std::vector<std::size_t> cols;
-  for (const auto& name : names) {
-    const auto c = log.column_index(name);
-    if (!c) throw std::runtime_error(file + ": no column '" + name + "', which the compiled model reads");
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const auto c = log.column_index(names[i]);
+    if (!c && i < computed.size() && computed[i]) {
+      cols.push_back(kNotLogged);
+      continue;
+    }
+    if (!c) throw std::runtime_error(file + ": no column '" + names[i] + "', which the compiled model reads");
     cols.push_back(*c);
   }
   return cols;
@@ -104,7 +113,9 @@ ReplayResult replay_on(Device& device, const datalog::LogTable& log, const std::
                        const ReplayOptions& opt) {
   const CompiledModelInfo info = info_of<M>();
   const auto y_cols = map_columns(log, file, info.y_names);
-  const auto u_cols = map_columns(log, file, info.u_names);
+  std::vector<bool> derived;
+  for (int i = 0; i < M::kU; ++i) derived.push_back(M::kUDerived[i] != firmware::DerivedInput::kNone);
+  const auto u_cols = map_columns(log, file, info.u_names, derived);
   const auto t_col = log.column_index("t");
   if (!opt.pb.empty()) {
     if (static_cast<int>(opt.pb.size()) != M::kPb)
@@ -129,7 +140,9 @@ ReplayResult replay_on(Device& device, const datalog::LogTable& log, const std::
       device.set_mode(firmware::Mode::kControl);
     for (int i = 0; i < M::kY; ++i) frame.y[i] = static_cast<float>(log.at(row, y_cols[static_cast<std::size_t>(i)]));
     for (int i = 0; i < M::kU; ++i)
-      frame.u_prev[i] = row == 0 ? 0.0f : static_cast<float>(log.at(row - 1, u_cols[static_cast<std::size_t>(i)]));
+      frame.u_prev[i] = row == 0 || u_cols[static_cast<std::size_t>(i)] == kNotLogged
+                            ? 0.0f
+                            : static_cast<float>(log.at(row - 1, u_cols[static_cast<std::size_t>(i)]));
     ReplayStep s;
     const firmware::StepResult<M> r = device.step(frame, s);
     s.time = t_col ? log.at(row, *t_col) : static_cast<double>(row);
