@@ -7,13 +7,7 @@
 #include <numeric>
 #include <stdexcept>
 
-#include "trainer/deploy_prep.h"
 #include "trainer/derived_inputs.h"
-#include "trainer/output_clip.h"
-#include "trainer/hadynet_network.h"
-#include "trainer/optim.h"
-#include "trainer/training.h"
-#include "trainer/window_dataset.h"
 
 namespace hadynet::trainer::residual {
 
@@ -28,178 +22,6 @@ std::string join(const std::vector<std::string>& v) {
   std::string s;
   for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + v[i];
   return s;
-}
-
-// Adds a PB row for every state of `seqs` the model does not know, starting
-// from the PB the analysis used for that state's logs; returns each
-// sequence's row.
-std::vector<int> ensure_states(HadynetModel& model, const std::vector<LogSequence>& seqs,
-                               const std::vector<Eigen::VectorXf>& pb_of_seq) {
-  std::vector<int> rows;
-  for (std::size_t i = 0; i < seqs.size(); ++i) {
-    int k = model.state_index(seqs[i].state);
-    if (k < 0) {
-      k = static_cast<int>(model.states.size());
-      model.states.push_back({seqs[i].state, seqs[i].object});
-      model.params.pb.conservativeResize(k + 1, model.params.dims.pb);
-      model.params.pb.row(k) = pb_of_seq[i].transpose();
-      model.params.dims.states = k + 1;
-    }
-    rows.push_back(k);
-  }
-  return rows;
-}
-
-// Fine-tunes `model` on every window of `seqs` with batch norm frozen (eval
-// mode: the running statistics of the original training data stay; with a
-// few hundred windows, batch statistics would move them and hurt every
-// channel); Adam on every weight and the PB table, the window order of
-// epoch_order(seed, epoch). Returns the loss per epoch and the number of
-// windows; re-measures the value ranges on those windows.
-std::vector<double> fine_tune(HadynetModel& model, const std::vector<LogSequence>& seqs,
-                              const std::vector<int>& state_rows, const FixOptions& o, long* windows) {
-  const WindowDataset data(seqs, state_rows, model.layout, model.norm, model.train_steps);
-  std::vector<int> ids(static_cast<std::size_t>(data.size()));
-  std::iota(ids.begin(), ids.end(), 0);
-  if (ids.size() < 2) throw std::runtime_error("--fix: the training part of the logs holds fewer than 2 windows");
-  Adam<float> adam(Adam<float>::Options{o.lr, 0.9, 0.999, 1e-8}, GroupSet::all().without(ParamGroup::kEncoderBn));
-  HadynetNetwork<float> net;
-  HadynetGrads<float> grads;
-  WindowBatch<float> batch;
-  Matrix<float> y, y_hat, d_y;
-  std::vector<double> history;
-  const auto batch_size = static_cast<std::size_t>(std::max(1, o.batch));
-  for (int epoch = 1; epoch <= o.epochs; ++epoch) {
-    const std::vector<int> order = epoch_order(ids, o.seed, epoch);
-    double sum = 0;
-    int batches = 0;
-    for (std::size_t begin = 0; begin < order.size(); begin += batch_size) {
-      const std::size_t n = std::min(batch_size, order.size() - begin);
-      data.gather(std::span<const int>(order).subspan(begin, n), batch, y);
-      // The loss of the clipped output (saturation; no clips: the plain loss).
-      y_hat = net.forward(model.params, batch, BnMode::kEval);
-      clip_standardised(model, y_hat);
-      sum += static_cast<double>(mse_loss(y_hat, y, &d_y));
-      clip_standardised(model, y_hat, &d_y);  // zero gradient where clipped
-      net.backward(model.params, d_y, grads);
-      adam.step(model.params, grads.params);
-      ++batches;
-    }
-    history.push_back(sum / batches);
-    if (!std::isfinite(history.back())) throw std::runtime_error("--fix: fine-tuning diverged (loss not finite)");
-  }
-  ValueRanges ranges = measure_ranges(model, data, ids);
-  ranges.source = "hadynet residual --fix: training part of " + std::to_string(seqs.size()) + " logs";
-  model.ranges = ranges;
-  model.detection.reset();  // calibrated with the old weights
-  if (windows != nullptr) *windows = static_cast<long>(ids.size());
-  return history;
-}
-
-// How the model's frame maps to the measured channels: its sensor model
-// (sensor_model.h) by y row. The clips are applied by the predictions.
-struct OutputMap {
-  std::vector<int> delay;  // per y channel: reported this many steps late
-  int d = 0;               // the largest delay
-  struct Crosstalk {
-    Eigen::Index target, source;
-    double gain;
-  };
-  std::vector<Crosstalk> crosstalk;                    // measured y_c = y'_c + gain y'_s
-  std::vector<std::pair<Eigen::Index, SensorDrift>> drifts;  // measured y_c = y'_c + b_c
-};
-
-OutputMap output_map(const HadynetModel& m) {
-  const auto row = [&](const std::string& name) {
-    const int c = index_of(m.layout.y_names, name);
-    if (c < 0) throw std::logic_error("--fix: sensor model channel " + name + " not in the model");
-    return static_cast<Eigen::Index>(c);
-  };
-  OutputMap map;
-  map.delay.assign(m.layout.y_names.size(), 0);
-  map.d = m.sensor.max_delay();
-  for (const auto& x : m.sensor.delays) map.delay[static_cast<std::size_t>(row(x.channel))] = x.steps;
-  for (const auto& x : m.sensor.crosstalk) map.crosstalk.push_back({row(x.target), row(x.source), x.gain});
-  for (const auto& drift : m.sensor.drifts) map.drifts.emplace_back(row(drift.channel), drift);
-  return map;
-}
-
-// Physical predictions of the measured rows of one log (y x T_raw, NaN where
-// there is none): see the header for the frame and the d + 1 steps.
-Eigen::MatrixXd measured_predictions(const HadynetModel& model, const LogSequence& frame, const Eigen::VectorXf& pb,
-                                     const OutputMap& map, const LogInput& measured, int rows_raw) {
-  const int d = map.d;
-  const Eigen::MatrixXd p = predict_windows(model, frame, pb, d + 1);
-  const Eigen::Index B = p.cols() / (d + 1);
-  Eigen::MatrixXd out = Eigen::MatrixXd::Constant(p.rows(), rows_raw, std::numeric_limits<double>::quiet_NaN());
-  for (int t = d + 2; t < rows_raw; ++t) {
-    const Eigen::Index b = t - d - 2;  // window starting at frame row t - d - 1
-    if (b >= B) break;
-    for (Eigen::Index c = 0; c < p.rows(); ++c) {
-      const Eigen::Index k = d - map.delay[static_cast<std::size_t>(c)];  // step predicting row t - delay_c
-      out(c, t) = p(c, k * B + b);
-    }
-    for (const auto& x : map.crosstalk) out(x.target, t) += x.gain * p(x.source, b);
-  }
-  // Drift: the bias state is known up to row t - 1 from the measurements; its
-  // last increment is estimated from the prediction itself (causal).
-  const double dt = log_dt(measured.table, measured.file);
-  for (const auto& [c, drift] : map.drifts) {
-    const std::vector<double> driver = drift_driver(measured.table, measured.file, drift);
-    for (int t = d + 2; t < rows_raw; ++t) {
-      if (std::isnan(out(c, t))) continue;
-      const double known = drift.rate * driver[static_cast<std::size_t>(t - 1)];
-      const double increment = drift.load ? std::abs(out(c, t) + known) * dt : dt;
-      out(c, t) += known + drift.rate * increment;
-    }
-  }
-  return out;
-}
-
-struct EvalLog {
-  const LogInput* raw = nullptr;  // the measured log
-  LogSequence measured;  // raw log in the model's layout
-  LogSequence frame;     // the log in the model's frame (aligned for a delay)
-  Eigen::VectorXf pb;
-  int first = 0, end = 0;  // held-out rows [first, end)
-};
-
-HeldOutError held_out_error(const HadynetModel& model, const std::vector<EvalLog>& logs, const OutputMap& map) {
-  HeldOutError e;
-  e.channels = model.layout.y_names;
-  const auto ny = static_cast<Eigen::Index>(e.channels.size());
-  const auto nu = static_cast<Eigen::Index>(model.layout.u_names.size());
-  Eigen::VectorXd sum_y = Eigen::VectorXd::Zero(ny), sum_yy = sum_y, sum_ee = sum_y;
-  std::vector<Segments> res(static_cast<std::size_t>(ny)), inp(static_cast<std::size_t>(nu));
-  for (const auto& log : logs) {
-    const Eigen::MatrixXd p = measured_predictions(model, log.frame, log.pb, map, *log.raw, log.measured.steps());
-    const int n = log.end - log.first;
-    const Eigen::MatrixXd y = log.measured.y.middleCols(log.first, n);
-    const Eigen::MatrixXd r = y - p.middleCols(log.first, n);
-    if (!r.allFinite()) throw std::logic_error("--fix: a held-out row has no prediction");
-    const Eigen::MatrixXd yc = y.colwise() - model.norm.y.mean;  // shifted: no cancellation
-    sum_y += yc.rowwise().sum();
-    sum_yy += yc.array().square().matrix().rowwise().sum();
-    sum_ee += r.array().square().matrix().rowwise().sum();
-    e.samples += n;
-    for (Eigen::Index c = 0; c < ny; ++c) res[static_cast<std::size_t>(c)].push_back(r.row(c).transpose());
-    for (Eigen::Index j = 0; j < nu; ++j)
-      inp[static_cast<std::size_t>(j)].push_back(log.measured.u.row(j).segment(log.first, n).transpose());
-  }
-  const double n = static_cast<double>(e.samples);
-  e.rmse.resize(ny);
-  e.fit.resize(ny);
-  for (Eigen::Index c = 0; c < ny; ++c) {
-    const double ss_total = sum_yy(c) - sum_y(c) * sum_y(c) / n;
-    e.rmse(c) = std::sqrt(sum_ee(c) / n);
-    e.fit(c) = ss_total > 0 ? 100.0 * (1.0 - std::sqrt(sum_ee(c) / ss_total)) : 0.0;
-    const auto& rc = res[static_cast<std::size_t>(c)];
-    e.whiteness.push_back(whiteness(rc, kDefaultMaxLag));
-    int outside = 0;
-    for (const auto& u : inp) outside += cross_correlate(rc, u, kDefaultMaxLag).outside;
-    e.inputs_outside.push_back(outside);
-  }
-  return e;
 }
 
 std::string verdict_of(const Attribution& a) {
@@ -499,9 +321,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // Each model is fed the logs in its own frame and judged on the measured rows.
   auto eval_logs = [&](const HadynetModel& m, const std::vector<Eigen::VectorXf>& pbs) {
     const std::vector<LogInput> frame_logs = model_frame_logs(m.sensor, logs);
-    std::vector<EvalLog> out;
+    std::vector<HeldOutLog> out;
     for (std::size_t i = 0; i < logs.size(); ++i) {
-      EvalLog e;
+      HeldOutLog e;
       e.raw = &logs[i];
       e.measured = log_sequence(logs[i].table, logs[i].file, m.layout);
       e.frame = log_sequence(frame_logs[i].table, frame_logs[i].file, m.layout);
@@ -517,9 +339,10 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     for (const auto& log : data.logs) pbs.push_back(m.params.pb.row(m.state_index(log.seq.state)).transpose());
     return pbs;
   };
+  const FineTuneOptions tuning{options.epochs, options.batch, options.lr, options.seed};
   std::vector<Eigen::VectorXf> before_pbs;
   for (const auto& log : data.logs) before_pbs.push_back(log.pb);
-  result.before = held_out_error(model, eval_logs(model, before_pbs), output_map(model));
+  result.before = held_out_error(model, eval_logs(model, before_pbs));
   result.before.verdict = verdict_of(attribution);
 
   if (aug == nullptr) {
@@ -548,12 +371,12 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       for (int step = 0; step <= 50; ++step) {
         a.drifts[k].rate = fitted * 0.1 * step;
         probe.sensor = sensor_after(model.sensor, a);
-        std::vector<EvalLog> train = eval_logs(probe, before_pbs);
+        std::vector<HeldOutLog> train = eval_logs(probe, before_pbs);
         for (std::size_t i = 0; i < train.size(); ++i) {
           train[i].end = train[i].first;
           train[i].first = ResidualLog::kFirstRow + d;
         }
-        const double rmse = held_out_error(probe, train, output_map(probe)).rmse(c);
+        const double rmse = held_out_error(probe, train).rmse(c);
         if (rmse < best_rmse) best_rmse = rmse, best_rate = a.drifts[k].rate;
       }
       a.drifts[k].rate = best_rate;
@@ -586,8 +409,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     HadynetModel c = model;
     const auto seqs = training_part(c.sensor, c.layout);
     const auto rows = ensure_states(c, seqs, before_pbs);
-    fine_tune(c, seqs, rows, options, nullptr);
-    result.control = held_out_error(c, eval_logs(c, state_pbs(c)), output_map(c));
+    fine_tune(c, seqs, rows, tuning, nullptr);
+    result.control = held_out_error(c, eval_logs(c, state_pbs(c)));
   }
 
   // The augmented layout first (aux adds a channel, friction commands), then its training data.
@@ -605,9 +428,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   const auto seqs = training_part(sensor_after(model.sensor, *aug), layout);
   HadynetModel after = augmented_model(model, *aug, seqs);
   const auto rows = ensure_states(after, seqs, before_pbs);
-  result.loss_history = fine_tune(after, seqs, rows, options, &result.train_windows);
+  result.loss_history = fine_tune(after, seqs, rows, tuning, &result.train_windows);
   after.check_consistent();
-  result.after = held_out_error(after, eval_logs(after, state_pbs(after)), output_map(after));
+  result.after = held_out_error(after, eval_logs(after, state_pbs(after)));
 
   // The residual analysis of the augmented model (in its own frame).
   ResidualData again = compute_residuals(after, logs, "state");

@@ -37,15 +37,8 @@
 //
 // Held out by time: the first `train_fraction` of each log's rows are the only
 // data fine-tuning sees; every number is reported on the remaining rows.
-// A causal 1-step prediction of a measured row t in both frames: the model
-// starts from frame row t - d - 1 (all of it is known at t - 1: a delayed
-// channel's true value at t - d - 1 is its measurement at t - 1) and runs
-// d + 1 steps with the logged commands; a delayed channel's measured y_c(t) is
-// its first step, every other channel its last. With d = 0 this is the plain
-// 1-step prediction of compute_residuals. For crosstalk the measured target
-// is the model's y'_c(t) plus k times its prediction of y_s(t), both from the
-// same step; for a drift, the bias known at t - 1 plus its increment from the
-// prediction.
+// Every model (before, fine-tune only, after) is judged on the same rows by
+// its causal 1-step prediction of the measured values (held_out.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -57,6 +50,8 @@
 #include "trainer/hadynet_model.h"
 #include "trainer/residual/attribution.h"
 #include "trainer/residual/residuals.h"
+#include "trainer/residual/fine_tune.h"
+#include "trainer/residual/held_out.h"
 #include "trainer/residual/whiteness.h"
 
 namespace hadynet::trainer::residual {
@@ -116,17 +111,6 @@ std::vector<LogInput> model_frame_logs(const SensorModel& sensor, const std::vec
 // weights) and ranges must be re-measured.
 HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
                              const std::vector<LogSequence>& train_seqs);
-
-// Error of one model on the held-out rows, per channel (physical units).
-struct HeldOutError {
-  std::vector<std::string> channels;  // the model's y channels
-  Eigen::VectorXd rmse;               // sqrt(mean (y - y_hat)^2)
-  Eigen::VectorXd fit;                // 100 (1 - ||y - y_hat|| / ||y - mean(y)||), percent
-  std::vector<Whiteness> whiteness;   // Ljung-Box etc. of the held-out 1-step residual, per channel
-  std::vector<int> inputs_outside;    // lags -L..L outside the 99 % bound, summed over the inputs
-  long samples = 0;                   // held-out rows (all logs)
-  std::string verdict;                // attribution on the model's own frame (empty: not run)
-};
 
 struct FixResult {
   std::string status;  // "no significant effect", "not supported: ...", "fixed"

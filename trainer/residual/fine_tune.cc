@@ -1,0 +1,75 @@
+#include "trainer/residual/fine_tune.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <span>
+#include <stdexcept>
+
+#include "trainer/deploy_prep.h"
+#include "trainer/hadynet_network.h"
+#include "trainer/optim.h"
+#include "trainer/output_clip.h"
+#include "trainer/training.h"
+#include "trainer/window_dataset.h"
+
+namespace hadynet::trainer::residual {
+
+std::vector<int> ensure_states(HadynetModel& model, const std::vector<LogSequence>& seqs,
+                               const std::vector<Eigen::VectorXf>& pb_of_seq) {
+  std::vector<int> rows;
+  for (std::size_t i = 0; i < seqs.size(); ++i) {
+    int k = model.state_index(seqs[i].state);
+    if (k < 0) {
+      k = static_cast<int>(model.states.size());
+      model.states.push_back({seqs[i].state, seqs[i].object});
+      model.params.pb.conservativeResize(k + 1, model.params.dims.pb);
+      model.params.pb.row(k) = pb_of_seq[i].transpose();
+      model.params.dims.states = k + 1;
+    }
+    rows.push_back(k);
+  }
+  return rows;
+}
+
+std::vector<double> fine_tune(HadynetModel& model, const std::vector<LogSequence>& seqs,
+                              const std::vector<int>& state_rows, const FineTuneOptions& o, long* windows) {
+  const WindowDataset data(seqs, state_rows, model.layout, model.norm, model.train_steps);
+  std::vector<int> ids(static_cast<std::size_t>(data.size()));
+  std::iota(ids.begin(), ids.end(), 0);
+  if (ids.size() < 2) throw std::runtime_error("--fix: the training part of the logs holds fewer than 2 windows");
+  Adam<float> adam(Adam<float>::Options{o.lr, 0.9, 0.999, 1e-8}, GroupSet::all().without(ParamGroup::kEncoderBn));
+  HadynetNetwork<float> net;
+  HadynetGrads<float> grads;
+  WindowBatch<float> batch;
+  Matrix<float> y, y_hat, d_y;
+  std::vector<double> history;
+  const auto batch_size = static_cast<std::size_t>(std::max(1, o.batch));
+  for (int epoch = 1; epoch <= o.epochs; ++epoch) {
+    const std::vector<int> order = epoch_order(ids, o.seed, epoch);
+    double sum = 0;
+    int batches = 0;
+    for (std::size_t begin = 0; begin < order.size(); begin += batch_size) {
+      const std::size_t n = std::min(batch_size, order.size() - begin);
+      data.gather(std::span<const int>(order).subspan(begin, n), batch, y);
+      // The loss of the clipped output (saturation; no clips: the plain loss).
+      y_hat = net.forward(model.params, batch, BnMode::kEval);
+      clip_standardised(model, y_hat);
+      sum += static_cast<double>(mse_loss(y_hat, y, &d_y));
+      clip_standardised(model, y_hat, &d_y);  // zero gradient where clipped
+      net.backward(model.params, d_y, grads);
+      adam.step(model.params, grads.params);
+      ++batches;
+    }
+    history.push_back(sum / batches);
+    if (!std::isfinite(history.back())) throw std::runtime_error("--fix: fine-tuning diverged (loss not finite)");
+  }
+  ValueRanges ranges = measure_ranges(model, data, ids);
+  ranges.source = "hadynet residual --fix: training part of " + std::to_string(seqs.size()) + " logs";
+  model.ranges = ranges;
+  model.detection.reset();  // calibrated with the old weights
+  if (windows != nullptr) *windows = static_cast<long>(ids.size());
+  return history;
+}
+
+}  // namespace hadynet::trainer::residual

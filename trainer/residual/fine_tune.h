@@ -1,0 +1,37 @@
+// Fine-tuning for `hadynet residual --fix` (docs/residual.md): a few epochs
+// from the current weights on the training part of the analysed logs.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "trainer/hadynet_model.h"
+
+namespace hadynet::trainer::residual {
+
+struct FineTuneOptions {
+  int epochs = 20;         // from the current weights
+  int batch = 100;         // windows per Adam step
+  double lr = 1e-3;        // Adam
+  std::uint64_t seed = 1;  // window order: epoch_order(seed, epoch)
+};
+
+// Adds a PB row for every state of `seqs` the model does not know, started
+// from `pb_of_seq` of its first sequence; returns each sequence's row.
+std::vector<int> ensure_states(HadynetModel& model, const std::vector<LogSequence>& seqs,
+                               const std::vector<Eigen::VectorXf>& pb_of_seq);
+
+// Fine-tunes `model` on every window of `seqs` (state rows `state_rows`)
+// with batch norm frozen (eval mode: the running statistics of the original
+// training data stay; with a few hundred windows, batch statistics would move
+// them and hurt every channel); Adam on every weight and the PB table. The
+// loss is that of the clipped output (a clipped element has zero gradient;
+// output_clip.h). Re-measures the value ranges on the windows and drops the
+// detection calibration (it belongs to the old weights). Returns the loss
+// per epoch (standardised) and sets *windows. Throws std::runtime_error for
+// fewer than 2 windows or a loss that is not finite.
+std::vector<double> fine_tune(HadynetModel& model, const std::vector<LogSequence>& seqs,
+                              const std::vector<int>& state_rows, const FineTuneOptions& options, long* windows);
+
+}  // namespace hadynet::trainer::residual

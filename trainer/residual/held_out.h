@@ -1,0 +1,50 @@
+// The before/after of `hadynet residual --fix` (docs/residual.md): a model's
+// causal 1-step error on held-out rows of measured logs, per channel. Each
+// model is fed the logs in its own frame and its predictions are mapped back
+// through its sensor model (sensor_model.h): with D its largest delay, the
+// measured row t is predicted from frame row t - D - 1 (known at t - 1),
+// running D + 1 steps with the logged commands; channel c is the step that
+// predicts frame row t - delay_c; cross-talk adds gain times the model's
+// prediction of the source from the same step; a drift adds the bias known at
+// t - 1 plus its increment from the prediction. Without a sensor model this
+// is the analysis's 1-step prediction.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "trainer/hadynet_model.h"
+#include "trainer/residual/residuals.h"
+#include "trainer/residual/whiteness.h"
+
+namespace hadynet::trainer::residual {
+
+// Error of one model on the held-out rows, per channel (physical units).
+struct HeldOutError {
+  std::vector<std::string> channels;  // the model's y channels
+  Eigen::VectorXd rmse;               // sqrt(mean (y - y_hat)^2)
+  Eigen::VectorXd fit;                // 100 (1 - ||y - y_hat|| / ||y - mean(y)||), percent
+  std::vector<Whiteness> whiteness;   // Ljung-Box etc. of the held-out 1-step residual, per channel
+  std::vector<int> inputs_outside;    // lags -L..L outside the 99 % bound, summed over the inputs
+  long samples = 0;                   // held-out rows (all logs)
+  std::string verdict;                // attribution on the model's own frame (empty: not run)
+};
+
+// One log for held_out_error: the measured log, it in the model's layout
+// (measured) and in the model's frame (frame: to_model_frame), the PB, and
+// the held-out rows [first, end) of the measured log.
+struct HeldOutLog {
+  const LogInput* raw = nullptr;
+  LogSequence measured;
+  LogSequence frame;
+  Eigen::VectorXf pb;
+  int first = 0, end = 0;
+};
+
+// RMSE, fit, whiteness and independence (against the logged commands) per
+// channel over the held-out rows of every log (verdict left empty). Throws
+// std::logic_error if a held-out row has no prediction (rows before D + 2).
+HeldOutError held_out_error(const HadynetModel& model, const std::vector<HeldOutLog>& logs);
+
+}  // namespace hadynet::trainer::residual
