@@ -70,7 +70,7 @@ json hypothesis_json(const rs::ResidualData& data, const rs::HypothesisResult& r
             {"p_value", r.p_value},
             {"p_adjusted", r.p_adjusted},
             {"significant", r.significant},
-            {"testable", r.testable},
+            {"testable", r.testable}, {"plausible", r.plausible},
             {"ar_order", r.ar_order},
             {"n_train", r.n_train},
             {"n_held_out", r.n_held_out}};

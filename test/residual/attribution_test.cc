@@ -108,6 +108,25 @@ TEST(Attribution, AuxChannelAndCrosstalkWin) {
   EXPECT_EQ(xt.winner()->hypothesis.source, 1);
   EXPECT_EQ(xt.winner()->hypothesis.target, 0);
   EXPECT_NEAR(xt.winner()->parameter, 0.3, 0.03);
+
+  // The same structure with gain -0.3 is outside cross-talk's domain (a
+  // fraction, 0 < gain < 1): tested, fitted and implausible, so never the
+  // winner, although it is strong.
+  const Attribution neg =
+      run(synthetic(7, [](ResidualLog& log) { log.r.row(0) -= 0.3 * (log.y_hat.row(1) + log.r.row(1)); }));
+  int found = 0;
+  for (const auto& r : neg.ranked) {
+    if (r.hypothesis.kind != EffectKind::kCrosstalk || r.hypothesis.target != 0 || r.hypothesis.source != 1) continue;
+    ++found;
+    EXPECT_NEAR(r.parameter, -0.3, 0.03);
+    EXPECT_FALSE(r.plausible);
+    EXPECT_LT(r.p_adjusted, 1e-6);
+    EXPECT_FALSE(r.significant);
+  }
+  EXPECT_EQ(found, 1);
+  if (neg.winner()) {
+    EXPECT_NE(neg.winner()->hypothesis.kind, EffectKind::kCrosstalk) << neg.winner()->label;
+  }
 }
 
 TEST(Attribution, SaturationAndDriftWin) {

@@ -133,6 +133,7 @@ HypothesisResult test_hypothesis(const ResidualData& data, const Hypothesis& h, 
   }
   res.coef = beta;
   res.parameter = main_parameter(h, beta);
+  res.plausible = plausible(h, res.parameter);
   res.label = describe(h, data, beta);
   res.explained_train = explained(train, beta).share;
   const Explained e_held = explained(held, beta);
@@ -219,7 +220,7 @@ Attribution attribute(const ResidualData& data, const std::vector<Hypothesis>& h
     results[i].p_adjusted = adjusted[f];
     results[i].significant = adjusted[f] < options.alpha &&
                              results[i].explained >= options.min_explained &&
-                             results[i].explained_std >= options.min_explained_std;
+                             results[i].explained_std >= options.min_explained_std && results[i].plausible;
   }
   std::stable_sort(results.begin(), results.end(), [](const HypothesisResult& a, const HypothesisResult& b) {
     if (a.significant != b.significant) return a.significant;

@@ -64,6 +64,7 @@ struct HypothesisResult {
   // lower the channel's standardised 1-step MSE (the model's loss).
   double explained_std = 0;
   bool testable = true;        // false: a regressor is (nearly) constant in the training part
+  bool plausible = true;       // the parameter is in the effect's physical domain (effects.h plausible())
   double t_stat = 0, p_value = 1, p_adjusted = 1;
   bool significant = false;
 };

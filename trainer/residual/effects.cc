@@ -155,6 +155,18 @@ double main_parameter(const Hypothesis& h, const Eigen::VectorXd& coef) {
   }
 }
 
+bool plausible(const Hypothesis& h, double parameter) {
+  switch (h.kind) {
+    case EffectKind::kCrosstalk:
+      return parameter > 0 && parameter < 1;
+    case EffectKind::kSensorDelay:
+    case EffectKind::kSaturation:
+      return parameter > 0;
+    default:
+      return std::isfinite(parameter);
+  }
+}
+
 std::string describe(const Hypothesis& h, const ResidualData& data, const Eigen::VectorXd& coef) {
   const std::string& target = data.y_names[static_cast<std::size_t>(h.target)];
   const double p = main_parameter(h, coef);

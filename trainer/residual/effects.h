@@ -62,6 +62,14 @@ std::string describe(const Hypothesis& h, const ResidualData& data, const Eigen:
 // The main fitted parameter (e.g. gain, friction in target units, drift rate).
 double main_parameter(const Hypothesis& h, const Eigen::VectorXd& coef);
 
+// Whether the main parameter is in the effect's physical domain: a
+// cross-talk picks up a fraction of its source (0 < gain < 1), and a delay
+// or a rail explains the residual with a positive gain. The other effects
+// take either sign (friction's sign follows the command convention; a drift
+// may lower a reading). An implausible hypothesis is tested but never
+// significant (attribution.h).
+bool plausible(const Hypothesis& h, double parameter);
+
 struct LibraryOptions {
   int max_delay = 5;                // delays 1..max_delay steps
   bool crosstalk_same_group = true; // cross-talk sources: channels of the target's group only
