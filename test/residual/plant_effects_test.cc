@@ -92,18 +92,23 @@ TEST(PlantEffects, CrosstalkIsNamedWithAPlantPairAndGain) {
   EXPECT_LT(w.parameter, 0.5) << w.label;
 }
 
-TEST(PlantEffects, DriftIsNamedAtFiveTimesTheDefaultRate) {
-  // Plant: loadcell bias growing 0.02 N per N s of load (5x the default 0.004, which leaves
-  // no detectable 1-step residual: docs/residual.md) plus a 0.01 N/sqrt(step) random walk.
-  const Outcome o = analyse("drift=0.02");
+// The winner is a load drift on a loadcell with a rate within 0.2x..1.5x
+// `plant_rate` (the 1-step residual keeps what the model does not carry over).
+void expect_load_drift_on_a_loadcell(const Outcome& o, double plant_rate) {
   ASSERT_TRUE(o.attribution.winner().has_value());
   const auto w = *o.attribution.winner();
   EXPECT_EQ(w.hypothesis.kind, EffectKind::kDriftLoad) << w.label;
   EXPECT_EQ(channel_group(name_of(o, w.hypothesis.target)), "fc") << w.label;
+  EXPECT_GT(w.parameter, 0.2 * plant_rate) << w.label;
+  EXPECT_LT(w.parameter, 1.5 * plant_rate) << w.label;
+}
+
+TEST(PlantEffects, DriftIsNamedAtFiveTimesTheDefaultRate) {
+  // Plant: loadcell bias growing 0.02 N per N s of load (5x the default 0.004, which leaves
+  // no detectable 1-step residual: docs/residual.md) plus a 0.01 N/sqrt(step) random walk.
   // The 1-step residual keeps only what the model does not carry over from the
   // biased x_t (measured rate 0.0084 of 0.02); bound 0.2x..1.5x the plant's rate.
-  EXPECT_GT(w.parameter, 0.2 * 0.02) << w.label;
-  EXPECT_LT(w.parameter, 1.5 * 0.02) << w.label;
+  expect_load_drift_on_a_loadcell(analyse("drift=0.02"), 0.02);
 }
 
 TEST(PlantEffects, DefaultDriftIsNamedOnLongLogsAndCleanLongLogsGiveNothing) {
@@ -112,15 +117,9 @@ TEST(PlantEffects, DefaultDriftIsNamedOnLongLogsAndCleanLongLogsGiveNothing) {
   const Outcome clean = analyse("", 1000);
   EXPECT_FALSE(clean.attribution.winner().has_value()) << clean.attribution.ranked.front().label;
   // Plant default drift: 0.004 N per N s of load plus a 0.01 N/sqrt(step) walk.
-  const Outcome o = analyse("drift", 1000);
-  ASSERT_TRUE(o.attribution.winner().has_value());
-  const auto w = *o.attribution.winner();
-  EXPECT_EQ(w.hypothesis.kind, EffectKind::kDriftLoad) << w.label;
-  EXPECT_EQ(channel_group(name_of(o, w.hypothesis.target)), "fc") << w.label;
   // Rate (measured 0.0033 on fc2): within 0.2x..1.5x the plant's, less what
   // persistence carries over.
-  EXPECT_GT(w.parameter, 0.2 * 0.004) << w.label;
-  EXPECT_LT(w.parameter, 1.5 * 0.004) << w.label;
+  expect_load_drift_on_a_loadcell(analyse("drift", 1000), 0.004);
 }
 
 TEST(PlantEffects, SaturationIsNamedWithItsRailAtTwoNewtons) {
