@@ -50,10 +50,7 @@ int main(int argc, char** argv) {
     friction.description = "test: hysteresis inputs of u0";
     friction.inputs = {"sign_u0", "hyst_u0"};
     std::vector<LogSequence> seqs;
-    FeatureLayout layout = base.layout;
-    std::vector<std::string> u = layout.u_names;
-    u.insert(u.end(), friction.inputs.begin(), friction.inputs.end());
-    layout = feature_layout_from_names(layout.y_names, u, layout.delta_groups);
+    const FeatureLayout layout = residual::augmented_layout(base.layout, friction);
     for (const auto& l : logs) seqs.push_back(log_sequence(l.table, l.file, layout));
     HadynetModel m = residual::augmented_model(base, friction, seqs);
     // Fixed, non-zero weights for the two new inputs (columns before the PB).

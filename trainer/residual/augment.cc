@@ -199,6 +199,13 @@ std::vector<LogInput> model_frame_logs(const SensorModel& sensor, const std::vec
   return out;
 }
 
+FeatureLayout augmented_layout(const FeatureLayout& layout, const Augmentation& a) {
+  std::vector<std::string> y = layout.y_names, u = layout.u_names;
+  if (a.kind == EffectKind::kAuxChannel) y.push_back(a.channels.at(0));
+  u.insert(u.end(), a.inputs.begin(), a.inputs.end());
+  return feature_layout_from_names(y, u, layout.delta_groups);
+}
+
 namespace {
 
 // Mean and population std of row `row` over the training sequences' `Eigen::MatrixXd LogSequence::*` rows.
@@ -226,11 +233,10 @@ void append(Eigen::VectorXd& v, double value) {
 // `m` (a copy of `model`) with the derived command channels `inputs` appended
 // to u: standardisation from the training rows (whose u holds them, last),
 // zero LSTM input weights (inputs are [u ; p]).
-HadynetModel with_derived_inputs(const HadynetModel& model, HadynetModel m, const std::vector<std::string>& inputs,
+HadynetModel with_derived_inputs(const HadynetModel& model, HadynetModel m, const Augmentation& a,
                                  const std::vector<LogSequence>& train_seqs) {
-  std::vector<std::string> u = model.layout.u_names;
-  u.insert(u.end(), inputs.begin(), inputs.end());
-  m.layout = feature_layout_from_names(model.layout.y_names, u, model.layout.delta_groups);
+  const std::vector<std::string>& inputs = a.inputs;
+  m.layout = augmented_layout(model.layout, a);
   const auto u_old = static_cast<Eigen::Index>(model.layout.u_names.size());
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     const auto [mean, sd] = row_moments(train_seqs, &LogSequence::u, u_old + static_cast<Eigen::Index>(i), inputs[i]);
@@ -264,12 +270,11 @@ HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
   if (a.kind == EffectKind::kSensorDelay || a.kind == EffectKind::kCrosstalk || a.kind == EffectKind::kSaturation ||
       a.kind == EffectKind::kDriftLoad || a.kind == EffectKind::kDriftTime)
     return m;
-  if (a.kind == EffectKind::kFriction) return with_derived_inputs(model, m, a.inputs, train_seqs);
+  if (a.kind == EffectKind::kFriction) return with_derived_inputs(model, m, a, train_seqs);
   if (a.kind != EffectKind::kAuxChannel) throw std::invalid_argument("--fix: " + a.effect + " is not implemented");
   const std::string& aux = a.channels.at(0);
-  std::vector<std::string> y = model.layout.y_names;
-  y.push_back(aux);
-  m.layout = feature_layout_from_names(y, model.layout.u_names, model.layout.delta_groups);
+  m.layout = augmented_layout(model.layout, a);
+  const std::vector<std::string>& y = m.layout.y_names;
   // The aux group is last in y and not a delta group, so it is the last x channel.
   if (m.layout.x_names.back() != aux || m.layout.x_names.size() != model.layout.x_names.size() + 1)
     throw std::logic_error("--fix: unexpected x layout for " + aux);
@@ -414,18 +419,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   }
 
   // The augmented layout first (aux adds a channel, friction commands), then its training data.
-  FeatureLayout layout = model.layout;
-  if (aug->kind == EffectKind::kAuxChannel) {
-    std::vector<std::string> y = layout.y_names;
-    y.push_back(aug->channels.at(0));
-    layout = feature_layout_from_names(y, layout.u_names, layout.delta_groups);
-  }
-  if (!aug->inputs.empty()) {
-    std::vector<std::string> u = layout.u_names;
-    u.insert(u.end(), aug->inputs.begin(), aug->inputs.end());
-    layout = feature_layout_from_names(layout.y_names, u, layout.delta_groups);
-  }
-  const auto seqs = training_part(sensor_after(model.sensor, *aug), layout);
+  const auto seqs = training_part(sensor_after(model.sensor, *aug), augmented_layout(model.layout, *aug));
   HadynetModel after = augmented_model(model, *aug, seqs);
   const auto rows = ensure_states(after, seqs, before_pbs);
   result.loss_history = fine_tune(after, seqs, rows, tuning, &result.train_windows);

@@ -98,6 +98,10 @@ std::optional<Augmentation> plan_augmentation(const ResidualData& data, const At
 // the model's frame adds to a channel's existing delay.
 SensorModel sensor_after(const SensorModel& before, const Augmentation& a);
 
+// The channel layout after the augmentation: the aux channel appended to y
+// (aux-channel), the derived inputs to u (friction); the same otherwise.
+FeatureLayout augmented_layout(const FeatureLayout& layout, const Augmentation& a);
+
 // Logs moved into the frame of a model with sensor model `sensor`
 // (to_model_frame); the same logs if its frame is the measured one.
 std::vector<LogInput> model_frame_logs(const SensorModel& sensor, const std::vector<LogInput>& logs);
