@@ -291,10 +291,10 @@ struct SensorArrays {
 SensorArrays sensor_arrays(const HadynetModel& model, bool q15, int frac_y) {
   const auto& y = model.layout.y_names;
   const auto& u = model.layout.u_names;
-  const auto y_index = [&](const std::string& name) {
+  const auto y_index = [&](const std::string& name) -> Eigen::Index {
     const auto it = std::find(y.begin(), y.end(), name);
     if (it == y.end()) reject("sensor model names '" + name + "', not a y channel");
-    return std::to_string(it - y.begin());
+    return it - y.begin();
   };
   SensorArrays a;
   for (std::size_t i = 0; i < u.size(); ++i) {
@@ -313,24 +313,22 @@ SensorArrays sensor_arrays(const HadynetModel& model, bool q15, int frac_y) {
   }
   const trainer::SensorModel& s = model.sensor;
   for (const auto& x : s.crosstalk) {
-    a.crosstalk_target.push_back(y_index(x.target));
-    a.crosstalk_source.push_back(y_index(x.source));
+    a.crosstalk_target.push_back(std::to_string(y_index(x.target)));
+    a.crosstalk_source.push_back(std::to_string(y_index(x.source)));
     a.crosstalk_gain.push_back(float_literal(static_cast<float>(x.gain)));
   }
   for (const auto& d : s.drifts) {
-    a.drift_channel.push_back(y_index(d.channel));
+    a.drift_channel.push_back(std::to_string(y_index(d.channel)));
     a.drift_is_load.push_back(d.load ? "true" : "false");
     a.drift_rate.push_back(float_literal(static_cast<float>(d.rate)));
   }
   if (!s.drifts.empty()) a.period = float_literal(static_cast<float>(s.period_s));
   for (const auto& c : s.clips) {
-    const std::string row = y_index(c.channel);
-    const std::size_t r = static_cast<std::size_t>(std::stoi(row));
-    a.clip_channel.push_back(row);
+    const Eigen::Index r = y_index(c.channel);
+    a.clip_channel.push_back(std::to_string(r));
     a.clip_side.push_back(std::to_string(c.side));
     a.clip_rail.push_back(float_literal(static_cast<float>(c.rail)));
-    const double standardised = (c.rail - model.norm.y.mean(static_cast<Eigen::Index>(r))) /
-                                model.norm.y.std(static_cast<Eigen::Index>(r));
+    const double standardised = (c.rail - model.norm.y.mean(r)) / model.norm.y.std(r);
     a.clip_rail_model.push_back(
         q15 ? std::to_string(std::clamp<std::int64_t>(to_fixed(standardised, frac_y), -32768, 32767))
             : float_literal(static_cast<float>(standardised)));

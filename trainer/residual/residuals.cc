@@ -105,8 +105,7 @@ ResidualData compute_residuals(const HadynetModel& model, const std::vector<LogI
       throw std::runtime_error(in.file + ": " + std::to_string(log.seq.steps()) + " rows; at least " +
                                std::to_string(ResidualLog::kFirstRow + 1 + model.train_steps) + " needed");
     }
-    const auto dt = in.table.metadata.get("dt_s");
-    log.dt_s = dt ? parse_number(*dt, in.file + ": metadata dt_s") : 1.0;
+    log.dt_s = log_dt(in.table, in.file);
     const auto T = static_cast<Eigen::Index>(in.table.rows());
     log.aux.resize(static_cast<Eigen::Index>(data.aux_names.size()), T);
     for (std::size_t a = 0; a < data.aux_names.size(); ++a) {
