@@ -121,7 +121,7 @@ int run_simulate(int argc, char** argv) {
 
     // The predicted log: t, y channels, the commands that produced them.
     const auto t_col = table.column_index("t");
-    const double dt = std::stod(table.metadata.get("dt_s").value_or("0.2"));
+    const double dt = datalog::log_dt_s(table, log_path);
     datalog::LogTable out;
     out.metadata.set("format", "hadynet-log");
     out.metadata.set("format_version", "1");

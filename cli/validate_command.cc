@@ -2,13 +2,12 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <nlohmann/json.hpp>
 #include <set>
 
 #include "cli/commands.h"
 #include "cli/options.h"
+#include "datalog/dataset_manifest.h"
 #include "datalog/log_error.h"
 #include "datalog/log_reader.h"
 
@@ -35,29 +34,15 @@ bool list_folder(const fs::path& dir, std::vector<LogEntry>& out) {
     for (const auto& f : files) out.push_back({f, f.parent_path().filename().string(), std::nullopt});
     return true;
   }
-  std::ifstream in(manifest_path);
-  nlohmann::json manifest;
   try {
-    manifest = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    std::fprintf(stderr, "%s: byte %zu: not valid JSON: %s\n", manifest_path.c_str(), e.byte, e.what());
-    return false;
-  }
-  if (!manifest.is_object() || manifest.value("format", "") != "hadynet-dataset" || !manifest.contains("logs") ||
-      !manifest["logs"].is_array()) {
-    std::fprintf(stderr, "%s: expected a hadynet-dataset manifest with a \"logs\" array\n", manifest_path.c_str());
-    return false;
-  }
-  std::size_t index = 0;
-  for (const auto& log : manifest["logs"]) {
-    if (!log.is_object() || !log.contains("file") || !log["file"].is_string()) {
-      std::fprintf(stderr, "%s: logs[%zu]: expected an object with a \"file\" string\n", manifest_path.c_str(), index);
-      return false;
+    for (const auto& log : datalog::read_dataset_manifest(manifest_path).logs) {
+      std::optional<long> rows;
+      if (log.rows) rows = static_cast<long>(*log.rows);
+      out.push_back({dir / log.file, log.split, rows});
     }
-    LogEntry entry{dir / log["file"].get<std::string>(), log.value("split", "?"), std::nullopt};
-    if (log.contains("rows") && log["rows"].is_number_integer()) entry.expected_rows = log["rows"].get<long>();
-    out.push_back(entry);
-    ++index;
+  } catch (const datalog::LogError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return false;
   }
   return true;
 }

@@ -1058,12 +1058,10 @@ GeneratedHeader generate(const HadynetModel& model, const ModelIdentity& identit
 }
 
 LoadedModel load_model_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw trainer::ModelFileError(path + ": cannot open");
-  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) throw trainer::ModelFileError(path + ": read error");
+  std::string bytes;
   trainer::safetensors::File file;
   try {
+    bytes = trainer::safetensors::read_bytes(path);
     file = trainer::safetensors::parse(bytes, path);
   } catch (const trainer::safetensors::FormatError& e) {
     throw trainer::ModelFileError(e.what());

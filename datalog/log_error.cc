@@ -2,6 +2,8 @@
 
 #include <utility>
 
+#include "datalog/log_rules.h"
+
 namespace hadynet::datalog {
 namespace {
 
@@ -14,7 +16,7 @@ std::string compose(const std::string& file, std::size_t line, std::size_t colum
     if (column != 0) out += ':' + std::to_string(column);
   }
   if (!out.empty()) out += ": ";
-  if (!column_name.empty()) out += "column '" + column_name + "': ";
+  if (!column_name.empty()) out += "column '" + rules::printable(column_name) + "': ";
   out += message;
   return out;
 }

@@ -3,12 +3,15 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
+#include <cmath>
 #include <optional>
 #include <system_error>
 #include <unordered_map>
 
+#include "datalog/log_limits.h"
 #include "datalog/log_rules.h"
 
 namespace hadynet::datalog {
@@ -75,6 +78,12 @@ std::size_t count_newlines(std::string_view text) {
   return n;
 }
 
+std::size_t count_commas(std::string_view text) {
+  std::size_t n = 0;
+  for (char c : text) n += c == ',' ? 1 : 0;
+  return n;
+}
+
 // Iterates the lines of a text that ends with '\n'; line numbers are 1-based.
 class LineCursor {
  public:
@@ -119,13 +128,10 @@ void parse_metadata_line(std::string_view line, std::size_t line_no, const std::
     if (value.front() != ' ') throw malformed();
     value.remove_prefix(1);
   }
-  const auto& entries = metadata.entries();
-  for (std::size_t i = 0; i < entries.size(); ++i) {
-    if (entries[i].first == key) {
-      throw LogError(file, line_no, 0, "",
-                     "duplicate metadata key " + rules::quoted(key) + " (first on line " +
-                         std::to_string(i + 1) + ")");
-    }
+  if (const auto first = metadata.position(key)) {
+    throw LogError(file, line_no, 0, "",
+                   "duplicate metadata key " + rules::quoted(key) + " (first on line " +
+                       std::to_string(*first + 1) + ")");
   }
   metadata.set(key, std::string(value));
 }
@@ -244,13 +250,44 @@ ChannelLayout channel_layout(const LogTable& table, const std::string& file_for_
   return layout;
 }
 
+void check_magnitudes(const LogTable& table, std::span<const std::size_t> columns, double limit,
+                      const std::string& file_for_errors, const std::string& reason) {
+  const std::size_t first_data_line = rules::header_line(table) + 1;
+  for (std::size_t r = 0; r < table.rows(); ++r) {
+    for (const std::size_t c : columns) {
+      const double v = table.at(r, c);
+      if (!(std::fabs(v) <= limit)) {
+        throw LogError(file_for_errors, first_data_line + r, c + 1, table.columns[c],
+                       "value " + rules::format_number(v) + " is beyond +-" +
+                           rules::format_number(limit) + ": " + reason);
+      }
+    }
+  }
+}
+
+double log_dt_s(const LogTable& table, const std::string& file_for_errors) {
+  return rules::check_required_metadata(table.metadata, file_for_errors);
+}
+
 LogTable parse_log(std::string_view text, const std::string& file_for_errors) {
   const std::string& file = file_for_errors;
   if (text.empty()) {
     throw LogError(file, 0, 0, "",
                    "empty file; expected '# key: value' metadata lines, a header row and data rows");
   }
+  if (text.size() > kMaxLogBytes) {
+    throw LogError(file, 0, 0, "",
+                   "file of " + std::to_string(text.size()) + " bytes; a log may hold at most " +
+                       std::to_string(kMaxLogBytes) + " bytes (docs/log-format.md, Limits)");
+  }
   if (text.back() != '\n') {
+    // Old Mac line ends (CR alone) leave no LF after the last line break.
+    const std::size_t last_lf = text.rfind('\n');
+    const std::size_t tail = last_lf == kNotFound ? 0 : last_lf + 1;
+    if (text.find('\r', tail) != kNotFound) {
+      throw LogError(file, count_newlines(text) + 1, 0, "",
+                     "carriage return (CR) line ends without LF; expected lines ending in LF only");
+    }
     throw LogError(file, count_newlines(text) + 1, 0, "",
                    "truncated last line (no newline at end of file)");
   }
@@ -274,6 +311,12 @@ LogTable parse_log(std::string_view text, const std::string& file_for_errors) {
   // Metadata: every leading line that starts with '#'.
   while (!cursor.done() && cursor.peek().starts_with('#')) {
     check_no_cr(cursor.peek());
+    if (table.metadata.entries().size() == kMaxMetadataLines) {
+      throw LogError(file, cursor.number(), 0, "",
+                     "more than " + std::to_string(kMaxMetadataLines) +
+                         " metadata lines; a log may hold at most that many (docs/log-format.md, "
+                         "Limits)");
+    }
     parse_metadata_line(cursor.peek(), cursor.number(), file, table.metadata);
     cursor.advance();
   }
@@ -292,6 +335,11 @@ LogTable parse_log(std::string_view text, const std::string& file_for_errors) {
                    "empty header row; expected comma-separated column names");
   }
   const std::size_t header_line = cursor.number();
+  if (const std::size_t names = count_commas(header) + 1; names > kMaxLogColumns) {
+    throw LogError(file, header_line, 0, "",
+                   "header of " + std::to_string(names) + " columns; a log may hold at most " +
+                       std::to_string(kMaxLogColumns) + " (docs/log-format.md, Limits)");
+  }
   table.columns = split_header(header);
   const ChannelLayout layout = channel_layout(table, file);
   cursor.advance();
@@ -300,7 +348,10 @@ LogTable parse_log(std::string_view text, const std::string& file_for_errors) {
   const std::size_t time_field = layout.time_column + 1;
   double previous_t_s = 0.0;
   std::size_t rows = 0;
-  table.values.reserve(count_newlines(text.substr(cursor.offset())) * table.columns.size());
+  // Every field takes at least two bytes of text ("0,"), which bounds the
+  // values of a valid file: a wrong header never makes the reservation large.
+  const std::string_view data = text.substr(cursor.offset());
+  table.values.reserve(std::min(count_newlines(data) * table.columns.size(), data.size() / 2 + 1));
   while (!cursor.done()) {
     const std::string_view line = cursor.peek();
     const std::size_t line_no = cursor.number();
@@ -338,9 +389,12 @@ LogTable read_log(const std::filesystem::path& path) {
   };
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) throw fail(errno);
+  // Reads at most kMaxLogBytes + 1 bytes: whatever the file is (a device such
+  // as /dev/zero, a pipe, a huge file), the reader stops and parse_log names
+  // the size.
   std::string text;
   constexpr std::size_t kChunk = std::size_t{1} << 16;
-  while (true) {
+  while (text.size() <= kMaxLogBytes) {
     const std::size_t used = text.size();
     text.resize(used + kChunk);
     const ssize_t n = ::read(fd, text.data() + used, kChunk);
@@ -354,6 +408,11 @@ LogTable read_log(const std::filesystem::path& path) {
     }
   }
   ::close(fd);
+  if (text.size() > kMaxLogBytes) {
+    throw LogError(file, 0, 0, "",
+                   "more than " + std::to_string(kMaxLogBytes) +
+                       " bytes; a log may hold at most that many (docs/log-format.md, Limits)");
+  }
   return parse_log(text, file);
 }
 

@@ -4,7 +4,9 @@
 // partially read is ever returned.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -19,6 +21,17 @@ LogTable parse_log(std::string_view text, const std::string& file_for_errors);
 // Reads and parses the file at `path`; a file that cannot be read (missing,
 // a folder, no permission) is a LogError at line 0 with the system's reason.
 LogTable read_log(const std::filesystem::path& path);
+
+// The control period of `table` (its '# dt_s:' line), seconds, checked as
+// the reader checks it: LogError naming that line when missing or outside
+// [rules::kMinDtS, rules::kMaxDtS].
+double log_dt_s(const LogTable& table, const std::string& file_for_errors);
+
+// Throws LogError at the first value of `columns` (indices into
+// table.columns) whose magnitude exceeds `limit`, naming the file line and
+// column as the reader would; `reason` ends the message (why the limit).
+void check_magnitudes(const LogTable& table, std::span<const std::size_t> columns, double limit,
+                      const std::string& file_for_errors, const std::string& reason);
 
 // Derives the column roles from the header of `table` and checks the header
 // rules: exactly one 't'; unique names; every name is 't', <prefix><index>

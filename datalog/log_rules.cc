@@ -23,11 +23,8 @@ namespace {
 
 // Line of `key` in the file (1-based), or 0 when absent.
 std::size_t line_of(const LogMetadata& metadata, std::string_view key) {
-  const auto& entries = metadata.entries();
-  for (std::size_t i = 0; i < entries.size(); ++i) {
-    if (entries[i].first == key) return i + 1;
-  }
-  return 0;
+  const auto i = metadata.position(key);
+  return i ? *i + 1 : 0;
 }
 
 [[noreturn]] void missing(const std::string& file, std::string_view key, std::string_view example) {
@@ -58,10 +55,10 @@ double check_required_metadata(const LogMetadata& metadata, const std::string& f
   const auto dt = metadata.get("dt_s");
   if (!dt) missing(file, "dt_s", "0.2");
   const auto dt_s = parse_finite_number(*dt);
-  if (!dt_s || !(*dt_s > 0.0)) {
+  if (!dt_s || !(*dt_s >= kMinDtS && *dt_s <= kMaxDtS)) {
     throw LogError(file, line_of(metadata, "dt_s"), 0, "",
-                   "metadata 'dt_s': expected a positive finite number of seconds, got " +
-                       quoted(*dt));
+                   "metadata 'dt_s': expected a number of seconds from " + format_number(kMinDtS) +
+                       " to " + format_number(kMaxDtS) + ", got " + quoted(*dt));
   }
   return *dt_s;
 }
@@ -159,18 +156,35 @@ std::string invalid_utf8_message(std::string_view text, std::size_t offset) {
          " of the line; expected UTF-8 text";
 }
 
+std::string printable(std::string_view text) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte < 0x20u || byte == 0x7Fu) {
+      out += "\\x";
+      out += kHex[byte >> 4];
+      out += kHex[byte & 0xFu];
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 std::string quoted(std::string_view text) {
   constexpr std::size_t kMaxShown = 40;
   std::string out(1, '\'');
   if (text.size() <= kMaxShown) {
-    out.append(text);
+    out += printable(text);
     out += '\'';
     return out;
   }
   std::size_t cut = kMaxShown;
   // Do not cut a UTF-8 sequence in half.
   while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0u) == 0x80u) --cut;
-  out.append(text.substr(0, cut));
+  out += printable(text.substr(0, cut));
   out += "...' (";
   out += std::to_string(text.size());
   out += " bytes)";

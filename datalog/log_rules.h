@@ -23,6 +23,12 @@ inline std::size_t header_line(const LogTable& table) {
   return table.metadata.entries().size() + 1;
 }
 
+// The range of `dt_s`, seconds: a control period from a nanosecond to about
+// eleven days. Outside it the time checks and every tool that divides by
+// dt_s lose their meaning (a denormal dt_s overflows 1 / dt_s).
+inline constexpr double kMinDtS = 1e-9;
+inline constexpr double kMaxDtS = 1e6;
+
 // Checks `format`, `format_version` and `dt_s` (present, valid) and returns
 // dt_s in seconds. Errors point at the entry's line (its position + 1) or at
 // the whole file (line 0) when a key is missing.
@@ -50,7 +56,12 @@ std::size_t first_invalid_utf8(std::string_view text);
 // "invalid UTF-8 at byte K of the line; ..." for the byte at `offset`.
 std::string invalid_utf8_message(std::string_view text, std::size_t offset);
 
-// `text` in single quotes for a message, cut to a readable length.
+// `text` with every ASCII control byte (NUL, CR, ESC, ...) written as \xHH,
+// so that a message shows it and no terminal or C string cuts it short.
+std::string printable(std::string_view text);
+
+// `text` in single quotes for a message (printable()), cut to a readable
+// length.
 std::string quoted(std::string_view text);
 
 }  // namespace hadynet::datalog::rules

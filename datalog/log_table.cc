@@ -5,19 +5,23 @@
 namespace hadynet::datalog {
 
 std::optional<std::string> LogMetadata::get(std::string_view key) const {
-  for (const auto& [k, v] : entries_) {
-    if (k == key) return v;
-  }
-  return std::nullopt;
+  const auto i = position(key);
+  if (!i) return std::nullopt;
+  return entries_[*i].second;
+}
+
+std::optional<std::size_t> LogMetadata::position(std::string_view key) const {
+  const auto it = position_.find(key);
+  if (it == position_.end()) return std::nullopt;
+  return it->second;
 }
 
 void LogMetadata::set(std::string_view key, std::string value) {
-  for (auto& [k, v] : entries_) {
-    if (k == key) {
-      v = std::move(value);
-      return;
-    }
+  if (const auto i = position(key)) {
+    entries_[*i].second = std::move(value);
+    return;
   }
+  position_.emplace(std::string(key), entries_.size());
   entries_.emplace_back(std::string(key), std::move(value));
 }
 

@@ -5,9 +5,11 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -16,16 +18,28 @@ namespace hadynet::datalog {
 // The only format version this reader and writer understand.
 inline constexpr int kFormatVersion = 1;
 
-// Ordered `# key: value` metadata lines. Keys are unique.
+// Ordered `# key: value` metadata lines. Keys are unique. Look-ups and
+// inserts take constant time on average (a log of many keys reads in
+// linear time).
 class LogMetadata {
  public:
   std::optional<std::string> get(std::string_view key) const;
+  // 0-based position of `key` in entries(), or nullopt.
+  std::optional<std::size_t> position(std::string_view key) const;
   // Inserts or replaces; keeps the first insertion order.
   void set(std::string_view key, std::string value);
   const std::vector<std::pair<std::string, std::string>>& entries() const { return entries_; }
 
  private:
+  // Heterogeneous look-up by string_view without a temporary string.
+  struct KeyHash {
+    using is_transparent = void;
+    std::size_t operator()(std::string_view key) const noexcept {
+      return std::hash<std::string_view>{}(key);
+    }
+  };
   std::vector<std::pair<std::string, std::string>> entries_;
+  std::unordered_map<std::string, std::size_t, KeyHash, std::equal_to<>> position_;  // key -> index
 };
 
 // One channel group: columns named <prefix>0 .. <prefix>N-1 (e.g. fc0..fc8),

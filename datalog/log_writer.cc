@@ -81,7 +81,9 @@ std::string format_log(const LogTable& table, const std::string& file_for_errors
       const double value = table.at(r, c);
       if (!std::isfinite(value)) {
         throw LogError(file, line, c + 1, table.columns[c],
-                       "expected a finite number, got " + rules::format_number(value));
+                       "not written: the value to write is " + rules::format_number(value) +
+                           ", and a log holds finite numbers only (the computation that produced it "
+                           "failed)");
       }
       if (c > 0) out += ',';
       rules::append_number(out, value);

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "datalog/log_limits.h"
 #include "datalog/log_reader.h"
 #include "trainer/derived_inputs.h"
 
@@ -118,6 +119,11 @@ LogSequence log_sequence(const datalog::LogTable& table, const std::string& file
   const std::vector<std::size_t> y_cols = columns_of(layout.y_names, false);
   const std::vector<std::size_t> u_cols = columns_of(layout.u_names, true);
   const Eigen::Index T = static_cast<Eigen::Index>(table.rows());
+  std::vector<std::size_t> signal_cols = y_cols;
+  for (const std::size_t c : u_cols)
+    if (c != kDerived) signal_cols.push_back(c);
+  datalog::check_magnitudes(table, signal_cols, datalog::kMaxSignalMagnitude, file,
+                            "the trainer computes in float32 (docs/log-format.md, Limits)");
 
   LogSequence seq;
   seq.file = file;

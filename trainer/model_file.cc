@@ -2,10 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
+
+#include "trainer/model_limits.h"
 
 namespace hadynet::trainer {
 
@@ -55,6 +59,53 @@ T json_get(const json& j, const std::string& key, const std::string& where,
   }
 }
 
+// A whole number in [lo, hi] (never a float, never wrapped): the reader's
+// guard on every size it allocates from.
+std::int64_t json_int(const json& j, const std::string& key, const std::string& where,
+                      const std::string& origin, std::int64_t lo, std::int64_t hi) {
+  if (!j.is_object() || !j.contains(key)) fail(origin, where + " has no '" + key + "'");
+  const json& v = j.at(key);
+  const bool in_range = v.is_number_unsigned() ? v.get<std::uint64_t>() <= static_cast<std::uint64_t>(hi)
+                                               : v.is_number_integer() && v.get<std::int64_t>() <= hi;
+  if (!v.is_number_integer() || !in_range || v.get<std::int64_t>() < lo) {
+    fail(origin, where + " '" + key + "' must be a whole number in " + std::to_string(lo) + " .. " +
+                     std::to_string(hi) + ", got " + v.dump());
+  }
+  return v.get<std::int64_t>();
+}
+
+// A finite number with |v| <= ModelLimits::kMaxMagnitude (and in [lo, hi]).
+double json_number(const json& j, const std::string& key, const std::string& where, const std::string& origin,
+                   double lo = -ModelLimits::kMaxMagnitude, double hi = ModelLimits::kMaxMagnitude) {
+  const double v = json_get<double>(j, key, where, origin);
+  if (!(v >= lo && v <= hi)) {
+    char range[96];
+    std::snprintf(range, sizeof range, "%g .. %g", lo, hi);
+    fail(origin, where + " '" + key + "' must be a number in " + range + ", got " + j.at(key).dump());
+  }
+  return v;
+}
+
+// Throws unless every value of `v` lies within +-ModelLimits::kMaxMagnitude.
+template <class Values>
+void check_magnitude(const Values& v, const std::string& what, const std::string& origin) {
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    if (!(std::abs(v.data()[i]) <= ModelLimits::kMaxMagnitude)) {
+      fail(origin, what + " holds " + std::to_string(v.data()[i]) + " at flat index " + std::to_string(i) +
+                       "; stored numbers must be finite and within +-1e30");
+    }
+  }
+}
+
+// Parameters of a model of dims `d` (HadynetParams' tensors, summed in 64
+// bits), so that the reader can compare them with what the file holds before
+// it allocates anything.
+std::int64_t parameter_count(const HadynetDims& d) {
+  const std::int64_t h = d.hidden;
+  return h * (d.x + d.pb) + 5 * h + 4 * h * (d.u + d.pb) + 4 * h * h + 8 * h + d.y * h + d.y +
+         std::int64_t{d.states} * d.pb;
+}
+
 Eigen::VectorXd read_vector(const st::File& file, const std::string& name, std::int64_t n) {
   const std::vector<double> v = st::as_f64(file, name, {n});
   return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
@@ -95,22 +146,23 @@ SensorModel sensor_from_json(const json& j, const std::string& origin) {
   SensorModel s;
   for (const json& d : json_array(j, "delays", origin))
     s.delays.push_back({json_get<std::string>(d, "channel", "sensor delay", origin),
-                        json_get<int>(d, "steps", "sensor delay", origin)});
+                        static_cast<int>(json_int(d, "steps", "sensor delay", origin, 1, ModelLimits::kMaxDelaySteps))});
+  // A cross-talk gain is a fraction of the source leaking into the target.
   for (const json& x : json_array(j, "crosstalk", origin))
     s.crosstalk.push_back({json_get<std::string>(x, "target", "sensor crosstalk", origin),
                            json_get<std::string>(x, "source", "sensor crosstalk", origin),
-                           json_get<double>(x, "gain", "sensor crosstalk", origin)});
+                           json_number(x, "gain", "sensor crosstalk", origin, -1.0, 1.0)});
   for (const json& d : json_array(j, "drifts", origin)) {
     const std::string driver = json_get<std::string>(d, "driver", "sensor drift", origin);
     if (driver != "load" && driver != "time") fail(origin, "sensor drift driver '" + driver + "' is not load or time");
     s.drifts.push_back({json_get<std::string>(d, "channel", "sensor drift", origin), driver == "load",
-                        json_get<double>(d, "rate", "sensor drift", origin)});
+                        json_number(d, "rate", "sensor drift", origin)});
   }
-  s.period_s = json_get<double>(j, "period_s", "sensor", origin);
+  s.period_s = json_number(j, "period_s", "sensor", origin, 0.0);
   for (const json& c : json_array(j, "clips", origin))
     s.clips.push_back({json_get<std::string>(c, "channel", "sensor clip", origin),
-                       json_get<int>(c, "side", "sensor clip", origin),
-                       json_get<double>(c, "rail", "sensor clip", origin)});
+                       static_cast<int>(json_int(c, "side", "sensor clip", origin, -1, 1)),
+                       json_number(c, "rail", "sensor clip", origin)});
   return s;
 }
 
@@ -240,21 +292,23 @@ HadynetModel model_from_safetensors(const st::File& file, const std::string& ori
   try {
     const json dims = parse_metadata_json(file, "dims", origin);
     HadynetDims d;
-    d.x = json_get<int>(dims, "x", "dims", origin);
-    d.u = json_get<int>(dims, "u", "dims", origin);
-    d.y = json_get<int>(dims, "y", "dims", origin);
-    d.pb = json_get<int>(dims, "pb", "dims", origin);
-    d.hidden = json_get<int>(dims, "hidden", "dims", origin);
-    d.states = json_get<int>(dims, "states", "dims", origin);
-    model.train_steps = json_get<int>(dims, "train_steps", "dims", origin);
-    try {
-      validate(d);
-    } catch (const std::invalid_argument& e) {
-      fail(origin, std::string("metadata 'dims': ") + e.what());
-    }
-    if (d.x > 1 << 16 || d.u > 1 << 16 || d.y > 1 << 16 || d.pb > 1 << 16 ||
-        d.hidden > 1 << 16 || d.states > 1 << 20) {
-      fail(origin, "metadata 'dims' holds an absurd size");
+    const auto dim = [&](const char* key, std::int64_t hi) {
+      return static_cast<int>(json_int(dims, key, "metadata 'dims'", origin, 1, hi));
+    };
+    d.x = dim("x", ModelLimits::kMaxX);
+    d.u = dim("u", ModelLimits::kMaxChannels);
+    d.y = dim("y", ModelLimits::kMaxChannels);
+    d.pb = dim("pb", ModelLimits::kMaxPb);
+    d.hidden = dim("hidden", ModelLimits::kMaxHidden);
+    d.states = dim("states", ModelLimits::kMaxStates);
+    model.train_steps = dim("train_steps", ModelLimits::kMaxTrainSteps);
+    // The file must hold the parameters its dims promise before anything of
+    // that size is allocated.
+    std::int64_t stored_bytes = 0;
+    for (const auto& [name, tensor] : file.tensors) stored_bytes += static_cast<std::int64_t>(tensor.bytes.size());
+    if (4 * parameter_count(d) > stored_bytes) {
+      fail(origin, "metadata 'dims' promises " + std::to_string(parameter_count(d)) +
+                       " float32 parameters; the file's tensors hold " + std::to_string(stored_bytes) + " bytes");
     }
 
     const json channels = parse_metadata_json(file, "channels", origin);
@@ -289,6 +343,10 @@ HadynetModel model_from_safetensors(const st::File& file, const std::string& ori
       const std::vector<float> v = st::as_f32(file, name, shape);
       for (std::size_t i = 0; i < v.size(); ++i) {
         if (!std::isfinite(v[i])) fail(origin, "tensor '" + name + "' holds a non-finite value");
+        if (!(std::abs(v[i]) <= ModelLimits::kMaxMagnitude)) {
+          fail(origin, "tensor '" + name + "' holds " + std::to_string(v[i]) + " at flat index " +
+                           std::to_string(i) + "; stored numbers must be within +-1e30");
+        }
         t.data[i] = v[i];
       }
     }
@@ -308,24 +366,33 @@ HadynetModel model_from_safetensors(const st::File& file, const std::string& ori
     for (std::size_t i = 0; i < 6; ++i) {
       expected.insert(kNormTensors[i]);
       *norm[i] = read_vector(file, kNormTensors[i], sizes[i]);
-      if (!norm[i]->allFinite()) fail(origin, std::string(kNormTensors[i]) + " is not finite");
+      check_magnitude(*norm[i], kNormTensors[i], origin);
+      if (i % 2 == 1) {  // a std
+        for (Eigen::Index k = 0; k < norm[i]->size(); ++k) {
+          if (!((*norm[i])(k) >= ModelLimits::kMinStd)) {
+            fail(origin, std::string(kNormTensors[i]) + " holds " + std::to_string((*norm[i])(k)) + " at index " +
+                             std::to_string(k) + "; a standardisation std must be at least 1e-12");
+          }
+        }
+      }
     }
 
     if (file.metadata.count("detection") != 0) {
       const json det = parse_metadata_json(file, "detection", origin);
       DetectionCalibration c;
-      c.steps = json_get<int>(det, "steps", "detection", origin);
-      c.threshold = json_get<double>(det, "threshold", "detection", origin);
-      c.samples = json_get<long>(det, "samples", "detection", origin);
+      c.steps = static_cast<int>(json_int(det, "steps", "detection", origin, 1, model.train_steps));
+      c.threshold = json_number(det, "threshold", "detection", origin, 0.0);
+      c.samples = static_cast<long>(json_int(det, "samples", "detection", origin, 0,
+                                             std::int64_t{1} << 53));
       c.source = json_get<std::string>(det, "source", "detection", origin);
       c.pb = read_vector(file, "detect.pb", d.pb);
       c.mean = read_vector(file, "detect.mean", d.y);
       c.covariance = read_matrix(file, "detect.covariance", d.y);
       c.inverse = read_matrix(file, "detect.inverse", d.y);
-      if (!c.pb.allFinite() || !c.mean.allFinite() || !c.covariance.allFinite() ||
-          !c.inverse.allFinite()) {
-        fail(origin, "detection statistics are not finite");
-      }
+      check_magnitude(c.pb, "detect.pb", origin);
+      check_magnitude(c.mean, "detect.mean", origin);
+      check_magnitude(c.covariance, "detect.covariance", origin);
+      check_magnitude(c.inverse, "detect.inverse", origin);
       for (const char* n : {"detect.pb", "detect.mean", "detect.covariance", "detect.inverse"})
         expected.insert(n);
       model.detection = std::move(c);
@@ -335,8 +402,9 @@ HadynetModel model_from_safetensors(const st::File& file, const std::string& ori
       const json r = parse_metadata_json(file, "ranges", origin);
       ValueRanges ranges;
       for (const ValueRangeField& f : kValueRangeFields)
-        ranges.*f.member = json_get<double>(r, f.name, "ranges", origin);
-      ranges.windows = json_get<long>(r, "windows", "ranges", origin);
+        ranges.*f.member = json_number(r, f.name, "ranges", origin, 0.0);
+      ranges.windows = static_cast<long>(json_int(r, "windows", "ranges", origin, 0,
+                                                  std::int64_t{1} << 53));
       ranges.source = json_get<std::string>(r, "source", "ranges", origin);
       model.ranges = std::move(ranges);
     }

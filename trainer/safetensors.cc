@@ -569,7 +569,7 @@ File parse(std::string_view bytes, const std::string& origin) {
   return out;
 }
 
-File read_file(const std::string& path) {
+std::string read_bytes(const std::string& path) {
   const auto fail = [&](const std::string& what, int error) {
     return FormatError(path, "cannot read safetensors file: " + what + ": " +
                                  std::generic_category().message(error));
@@ -587,9 +587,15 @@ File read_file(const std::string& path) {
       throw fail("stat", error);
     }
     if (S_ISDIR(info.st_mode)) throw fail("open", EISDIR);
+    const auto too_large = [&] {
+      return FormatError(path, "cannot read safetensors file: larger than " +
+                                   std::to_string(kMaxFileBytes) + " bytes, the most a model file may hold");
+    };
+    if (info.st_size > 0 && static_cast<std::uint64_t>(info.st_size) > kMaxFileBytes) throw too_large();
     if (info.st_size > 0) bytes.reserve(static_cast<std::size_t>(info.st_size));
     char chunk[1 << 16];
     for (;;) {
+      if (bytes.size() > kMaxFileBytes) throw too_large();
       const ssize_t n = ::read(fd, chunk, sizeof chunk);
       if (n < 0) {
         const int error = errno;
@@ -604,8 +610,10 @@ File read_file(const std::string& path) {
     throw;
   }
   ::close(fd);
-  return parse(bytes, path);
+  return bytes;
 }
+
+File read_file(const std::string& path) { return parse(read_bytes(path), path); }
 
 void write_file(const std::string& path, const File& file) {
   const std::string bytes = serialize(file, path);

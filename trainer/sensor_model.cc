@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "datalog/log_reader.h"
+
 namespace hadynet::trainer {
 
 namespace {
@@ -77,15 +79,8 @@ int SensorModel::delay_of(const std::string& channel) const {
 }
 
 double log_dt(const datalog::LogTable& table, const std::string& file) {
-  const auto dt = table.metadata.get("dt_s");
-  if (!dt) return 1.0;
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(*dt, &used);
-    if (used == dt->size() && std::isfinite(v) && v > 0) return v;
-  } catch (const std::exception&) {
-  }
-  throw std::runtime_error(file + ": metadata dt_s '" + *dt + "' is not a positive number");
+  if (!table.metadata.get("dt_s")) return 1.0;
+  return datalog::log_dt_s(table, file);
 }
 
 std::vector<double> drift_driver(const datalog::LogTable& table, const std::string& file, const SensorDrift& drift) {

@@ -4,6 +4,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include "datalog/log_limits.h"
+#include "datalog/log_reader.h"
 #include "hadynet_model_f32.h"
 #include "hadynet_model_q15.h"
 #include "tools/link/link_session.h"
@@ -117,6 +119,11 @@ ReplayResult replay_on(Device& device, const datalog::LogTable& log, const std::
   for (int i = 0; i < M::kU; ++i) derived.push_back(M::kUDerived[i] != firmware::DerivedInput::kNone);
   const auto u_cols = map_columns(log, file, info.u_names, derived);
   const auto t_col = log.column_index("t");
+  std::vector<std::size_t> signal_cols = y_cols;
+  for (const std::size_t c : u_cols)
+    if (c != kNotLogged) signal_cols.push_back(c);
+  datalog::check_magnitudes(log, signal_cols, datalog::kMaxSignalMagnitude, file,
+                            "the firmware's boundary is float32 (docs/log-format.md, Limits)");
   if (!opt.pb.empty()) {
     if (static_cast<int>(opt.pb.size()) != M::kPb)
       throw std::invalid_argument("PB has " + std::to_string(opt.pb.size()) + " values, the model " +

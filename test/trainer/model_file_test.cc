@@ -231,7 +231,7 @@ TEST_F(ModelFileRejects, SensorModelOnAnUnknownChannelOrWithBadNumbers) {
       {"\"channel\":\"", "\"channel\":\"no_", "not a y channel"},
       {"\"rail\"", "\"rial\"", "rail"},
       {"\"driver\":\"load\"", "\"driver\":\"heat\"", "driver 'heat'"},
-      {"\"steps\":2", "\"steps\":0", "< 1 step"},
+      {"\"steps\":2", "\"steps\":0", "sensor delay 'steps' must be a whole number in 1 .. 4096, got 0"},
       {"\"crosstalk\":[", "\"crosstalk\":{\"a\":1},\"x\":[", "'crosstalk' is not an array"},
   };
   for (const auto& c : cases) {
@@ -324,7 +324,7 @@ TEST_F(ModelFileRejects, NonFiniteValues) {
 
   f = good_;
   std::memcpy(f.tensors.at("detect.covariance").bytes.data() + 8, &nan, sizeof nan);
-  expect_rejected(f, "detection statistics are not finite");
+  expect_rejected(f, "detect.covariance holds nan at flat index");
 }
 
 TEST_F(ModelFileRejects, ChannelsWhoseXDoesNotFollowFromYAndDeltaGroups) {
@@ -367,6 +367,58 @@ TEST_F(ModelFileRejects, DimsNotMatchingTheTensorsOrChannels) {
   expect_rejected(f, "metadata 'dims'");
 }
 
+// Issue 19, finding 7: sizes that overflow, wrap or promise more than the
+// file holds are refused by name before anything of that size is allocated,
+// and finite but absurd numbers are refused as codegen refuses them.
+TEST_F(ModelFileRejects, SizesThatOverflowWrapOrExceedTheFile) {
+  const struct {
+    const char* from;
+    const char* to;
+    const char* error;
+  } cases[] = {
+      // Was accepted: signed overflow in the window code, then bad_alloc.
+      {R"("train_steps":5)", R"("train_steps":2147483647)",
+       "metadata 'dims' 'train_steps' must be a whole number in 1 .. 4096, got 2147483647"},
+      // Was accepted as 37 (4294967333 mod 2^32).
+      {R"("x":)", R"("x":4294967333,"x_old":)", "metadata 'dims' 'x' must be a whole number in 1 .. 8192, got 4294967333"},
+      {R"("hidden":8)", R"("hidden":65536)", "metadata 'dims' 'hidden' must be a whole number in 1 .. 1024, got 65536"},
+      {R"("hidden":8)", R"("hidden":8.5)", "metadata 'dims' 'hidden' must be a whole number"},
+      {R"("states":2)", R"("states":100001)", "'states' must be a whole number in 1 .. 100000"},
+      // Within the limits, but the file's tensors cannot hold that model:
+      // refused before zeroing hidden^2 floats.
+      {R"("hidden":8)", R"("hidden":1000)", "float32 parameters; the file's tensors hold"},
+  };
+  for (const auto& c : cases) {
+    st::File f = good_;
+    edit_metadata(f, "dims", c.from, c.to);
+    expect_rejected(f, c.error);
+  }
+}
+
+TEST_F(ModelFileRejects, FiniteButAbsurdNumbers) {
+  st::File f = good_;
+  const double denormal = 4e-320;
+  std::memcpy(f.tensors.at("norm.y_std").bytes.data(), &denormal, sizeof denormal);
+  expect_rejected(f, "norm.y_std holds");  // adapt printed a -nan PB with it
+
+  f = good_;
+  const double huge = 1e300;
+  std::memcpy(f.tensors.at("norm.u_mean").bytes.data(), &huge, sizeof huge);
+  expect_rejected(f, "norm.u_mean holds");
+
+  f = good_;
+  set_f32(f, "dec.weight", 3, 3e38f);
+  expect_rejected(f, "tensor 'dec.weight' holds");
+
+  f = good_;
+  edit_metadata(f, "sensor", R"("gain":)", R"("gain":1e308,"gain_old":)");
+  expect_rejected(f, "sensor crosstalk 'gain' must be a number in -1 .. 1, got 1e+308");
+
+  f = good_;
+  edit_metadata(f, "sensor", R"("rate":)", R"("rate":1e308,"rate_old":)");
+  expect_rejected(f, "sensor drift 'rate' must be a number in -1e+30 .. 1e+30");
+}
+
 TEST_F(ModelFileRejects, InconsistentOrMalformedMetadata) {
   st::File f = good_;
   f.metadata["states"] = R"([{"name":"soft","object":"ball"}])";  // one name, two PB rows
@@ -390,12 +442,12 @@ TEST_F(ModelFileRejects, InconsistentOrMalformedMetadata) {
 
   f = good_;
   edit_metadata(f, "detection", R"("threshold":4.25)", R"("threshold":-1.0)");
-  expect_rejected(f, "detection threshold not positive");
+  expect_rejected(f, "detection 'threshold' must be a number in 0 .. 1e+30, got -1");
 
   f = good_;
   const double zero = 0.0;
   std::memcpy(f.tensors.at("norm.x_std").bytes.data(), &zero, sizeof zero);
-  expect_rejected(f, "std is not positive");
+  expect_rejected(f, "a standardisation std must be at least 1e-12");
 }
 
 TEST_F(ModelFileRejects, MalformedRanges) {
@@ -406,11 +458,11 @@ TEST_F(ModelFileRejects, MalformedRanges) {
 
   f = good_;
   edit_metadata(f, "ranges", R"("h":)", R"("h":-)");
-  expect_rejected(f, "range 'h' is negative or not finite");
+  expect_rejected(f, "ranges 'h' must be a number in 0 .. 1e+30");
 
   f = good_;
   edit_metadata(f, "ranges", R"("windows":321)", R"("windows":"many")");
-  expect_rejected(f, "ranges 'windows' has the wrong type");
+  expect_rejected(f, "ranges 'windows' must be a whole number in 0 .. 9007199254740992, got \"many\"");
 
   f = good_;
   edit_metadata(f, "ranges", R"("c":)", R"("c_old":)");
