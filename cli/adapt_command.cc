@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "cli/commands.h"
+#include "cli/error_text.h"
 #include "cli/options.h"
 #include "cli/pb_adapt_common.h"
 #include "cli/pb_map_plot.h"
@@ -116,7 +117,7 @@ int run_adapt(int argc, char** argv) {
       std::fprintf(stderr, "wrote %s\n", opt.get("json").c_str());
     }
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "hadynet adapt: %s\n", e.what());
+    std::fprintf(stderr, "hadynet adapt: %s\n", error_text(e).c_str());
     return 1;
   }
   return 0;

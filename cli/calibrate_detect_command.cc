@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "cli/commands.h"
+#include "cli/error_text.h"
 #include "cli/options.h"
 #include "cli/pb_adapt_common.h"
 #include "cli/trainer_inputs.h"
@@ -78,7 +79,7 @@ int run_calibrate_detect(int argc, char** argv) {
     trainer::save_model(opt.get("out"), model);
     std::printf("wrote %s\n", opt.get("out").c_str());
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "hadynet calibrate-detect: %s\n", e.what());
+    std::fprintf(stderr, "hadynet calibrate-detect: %s\n", error_text(e).c_str());
     return 1;
   }
   return 0;

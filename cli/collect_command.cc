@@ -4,6 +4,7 @@
 #include <thread>
 
 #include "cli/commands.h"
+#include "cli/error_text.h"
 #include "cli/options.h"
 #include "host-sim/plant/dataset.h"
 
@@ -115,7 +116,7 @@ int run_collect(int argc, char** argv) {
                 summary.logs, summary.rows, summary.physics_steps, summary.wall_seconds,
                 static_cast<double>(summary.physics_steps) / std::max(summary.wall_seconds, 1e-9), options.out_dir.c_str());
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "\nhadynet collect: %s\n", e.what());
+    std::fprintf(stderr, "\nhadynet collect: %s\n", error_text(e).c_str());
     return 1;
   }
   return 0;

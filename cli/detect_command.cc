@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "cli/commands.h"
+#include "cli/error_text.h"
 #include "cli/gnuplot.h"
 #include "cli/options.h"
 #include "cli/pb_adapt_common.h"
@@ -115,7 +116,7 @@ int run_detect(int argc, char** argv) {
       std::fprintf(stderr, "wrote %s\n", opt.get("plot").c_str());
     }
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "hadynet detect: %s\n", e.what());
+    std::fprintf(stderr, "hadynet detect: %s\n", error_text(e).c_str());
     return 1;
   }
   return 0;

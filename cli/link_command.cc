@@ -8,6 +8,7 @@
 #include <string>
 
 #include "cli/commands.h"
+#include "cli/error_text.h"
 #include "cli/options.h"
 #include "hadynet_model_f32.h"
 #include "hadynet_model_q15.h"
@@ -145,7 +146,7 @@ int run_link(int argc, char** argv) {
     return numeric == "q15" ? act<model_q15::Model>(*stream, opt.positional())
                             : act<model_f32::Model>(*stream, opt.positional());
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "hadynet link: %s\n", e.what());
+    std::fprintf(stderr, "hadynet link: %s\n", error_text(e).c_str());
     return 1;
   }
 }

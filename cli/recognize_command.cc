@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "cli/commands.h"
+#include "cli/error_text.h"
 #include "cli/options.h"
 #include "cli/pb_adapt_common.h"
 #include "cli/pb_map_plot.h"
@@ -120,7 +121,7 @@ int run_recognize(int argc, char** argv) {
       std::fprintf(stderr, "wrote %s\n", opt.get("plot").c_str());
     }
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "hadynet recognize: %s\n", e.what());
+    std::fprintf(stderr, "hadynet recognize: %s\n", error_text(e).c_str());
     return 1;
   }
   return 0;

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "cli/commands.h"
+#include "cli/error_text.h"
 #include "cli/gnuplot.h"
 #include "cli/options.h"
 #include "datalog/log_error.h"
@@ -246,7 +247,7 @@ int run_replay(int argc, char** argv) {
       }
     }
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "hadynet replay: %s\n", e.what());
+    std::fprintf(stderr, "hadynet replay: %s\n", error_text(e).c_str());
     return 1;
   }
   return 0;

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "cli/commands.h"
+#include "cli/error_text.h"
 #include "cli/gnuplot.h"
 #include "cli/number_text.h"
 #include "cli/options.h"
@@ -441,6 +442,11 @@ int run_residual(int argc, char** argv) {
     const std::string pb_choice = opt.get("pb");
     a.data = rs::compute_residuals(model, inputs, pb_choice);
     a.horizon = rs::horizon_metrics(model, a.data, horizon ? static_cast<int>(*horizon) : model.train_steps);
+    if (!a.horizon.rmse.allFinite()) {
+      // Never a table of NaN with "no significant effect" under it.
+      throw std::runtime_error(model_path + ": the model's prediction is not finite on these logs (float32 "
+                               "overflow in the network); no residual can be analysed");
+    }
     const auto& d = a.data;
     const std::size_t ny = d.y_names.size(), nu = d.u_names.size();
     a.with_inputs.assign(ny, {});
@@ -563,7 +569,7 @@ int run_residual(int argc, char** argv) {
       std::fprintf(stderr, "wrote %s\n", md_path.c_str());
     }
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "hadynet residual: %s\n", e.what());
+    std::fprintf(stderr, "hadynet residual: %s\n", error_text(e).c_str());
     return 1;
   }
   return 0;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "cli/commands.h"
+#include "cli/error_text.h"
 #include "cli/gnuplot.h"
 #include "cli/options.h"
 #include "cli/pb_adapt_common.h"
@@ -117,6 +118,10 @@ int run_simulate(int argc, char** argv) {
     }
     const Eigen::MatrixXd predicted =
         trainer::simulate(model, trainer::initial_state(model.layout, seq, t0), seq.u.middleCols(t0, n), pb);
+    if (!predicted.allFinite()) {
+      throw std::runtime_error(opt.positional().front() + ": the simulation is not finite (float32 overflow in the "
+                               "network on " + log_path + "); nothing written");
+    }
     const Eigen::MatrixXd measured = seq.y.middleCols(t0 + 1, n);
 
     // The predicted log: t, y channels, the commands that produced them.
@@ -166,7 +171,7 @@ int run_simulate(int argc, char** argv) {
       std::printf("wrote %s\n", opt.get("plot").c_str());
     }
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "hadynet simulate: %s\n", e.what());
+    std::fprintf(stderr, "hadynet simulate: %s\n", error_text(e).c_str());
     return 1;
   }
   return 0;

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "cli/commands.h"
+#include "cli/error_text.h"
 #include "cli/gnuplot.h"
 #include "cli/options.h"
 #include "host-sim/closed_loop/closed_loop.h"
@@ -294,7 +295,7 @@ int run_stabilize(int argc, char** argv) {
       std::printf("plot -> %s\n", opt.get("plot").c_str());
     }
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "hadynet stabilize: %s\n", e.what());
+    std::fprintf(stderr, "hadynet stabilize: %s\n", error_text(e).c_str());
     return 1;
   }
   return 0;

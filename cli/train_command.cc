@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "cli/commands.h"
+#include "cli/error_text.h"
 #include "cli/gnuplot.h"
 #include "cli/options.h"
 #include "cli/trainer_inputs.h"
@@ -261,7 +262,7 @@ int run_train(int argc, char** argv) {
     std::printf("wrote %s (train loss %.5f, held-out loss %.5f after %d epochs)\n", out.c_str(),
                 last.train_loss, last.held_out_loss, last.epoch);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "hadynet train: %s\n", e.what());
+    std::fprintf(stderr, "hadynet train: %s\n", error_text(e).c_str());
     return 1;
   }
   return 0;
