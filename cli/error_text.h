@@ -13,7 +13,7 @@ namespace hadynet::cli {
 inline std::string error_text(const std::exception& e) {
   if (dynamic_cast<const std::bad_alloc*>(&e) != nullptr) {
     return "out of memory: the inputs need more memory than this machine has (the input limits are in "
-           "docs/log-format.md and docs/model-file.md)";
+           "docs/input-limits.md)";
   }
   const std::string what = e.what();
   if (what.rfind("sto", 0) == 0 && what.size() <= 6) {  // std::stoi, stod, stof, ... with no context

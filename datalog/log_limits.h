@@ -1,4 +1,4 @@
-// The input limits of the log reader (docs/log-format.md, "Limits"): what a
+// The input limits of the log reader (docs/input-limits.md): what a
 // log may hold at most before the reader refuses it with a clear error
 // instead of allocating for it. Each limit is far above what a robot log
 // needs and low enough that every accepted file is parsed in bounded memory

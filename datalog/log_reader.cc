@@ -278,7 +278,7 @@ LogTable parse_log(std::string_view text, const std::string& file_for_errors) {
   if (text.size() > kMaxLogBytes) {
     throw LogError(file, 0, 0, "",
                    "file of " + std::to_string(text.size()) + " bytes; a log may hold at most " +
-                       std::to_string(kMaxLogBytes) + " bytes (docs/log-format.md, Limits)");
+                       std::to_string(kMaxLogBytes) + " bytes (docs/input-limits.md)");
   }
   if (text.back() != '\n') {
     // Old Mac line ends (CR alone) leave no LF after the last line break.
@@ -314,8 +314,7 @@ LogTable parse_log(std::string_view text, const std::string& file_for_errors) {
     if (table.metadata.entries().size() == kMaxMetadataLines) {
       throw LogError(file, cursor.number(), 0, "",
                      "more than " + std::to_string(kMaxMetadataLines) +
-                         " metadata lines; a log may hold at most that many (docs/log-format.md, "
-                         "Limits)");
+                         " metadata lines; a log may hold at most that many (docs/input-limits.md)");
     }
     parse_metadata_line(cursor.peek(), cursor.number(), file, table.metadata);
     cursor.advance();
@@ -338,7 +337,7 @@ LogTable parse_log(std::string_view text, const std::string& file_for_errors) {
   if (const std::size_t names = count_commas(header) + 1; names > kMaxLogColumns) {
     throw LogError(file, header_line, 0, "",
                    "header of " + std::to_string(names) + " columns; a log may hold at most " +
-                       std::to_string(kMaxLogColumns) + " (docs/log-format.md, Limits)");
+                       std::to_string(kMaxLogColumns) + " (docs/input-limits.md)");
   }
   table.columns = split_header(header);
   const ChannelLayout layout = channel_layout(table, file);
@@ -411,7 +410,7 @@ LogTable read_log(const std::filesystem::path& path) {
   if (text.size() > kMaxLogBytes) {
     throw LogError(file, 0, 0, "",
                    "more than " + std::to_string(kMaxLogBytes) +
-                       " bytes; a log may hold at most that many (docs/log-format.md, Limits)");
+                       " bytes; a log may hold at most that many (docs/input-limits.md)");
   }
   return parse_log(text, file);
 }

@@ -1,7 +1,8 @@
 // One fuzz input through a fresh device (HadynetRuntime<q15> + DeviceLink),
 // with the protocol's robustness contract as the oracle (docs/protocol.md):
-//   * every reply is a well-formed frame of a reply type, at most one per
-//     received frame;
+//   * every reply is a well-formed frame of a reply type, and every
+//     non-empty received frame (the bytes between two delimiters) gets
+//     exactly one reply (a lone delimiter gets none);
 //   * a byte that is not a delimiter never executes anything;
 //   * an error reply, or no reply, leaves the runtime byte for byte as it
 //     was, and the sequence state too;
@@ -57,6 +58,8 @@ class LinkFuzzHarness {
 
   // Runs one input (link_fuzz_input.h).
   void run(const std::uint8_t* data, std::size_t size) {
+    frame_bytes_ = 0;
+    frame_replies_ = 0;
     std::size_t pos = 0;
     while (pos < size) {
       const std::uint8_t kind = data[pos];
@@ -69,6 +72,9 @@ class LinkFuzzHarness {
       record(kind, std::span<const std::uint8_t>(data + pos, length));
       pos += length;
     }
+    // A frame the input left unfinished may have had its one reply already
+    // (an oversize frame is answered when it overflows).
+    check(frame_replies_ <= 1);
   }
 
   std::size_t replies() const { return replies_; }
@@ -113,6 +119,7 @@ class LinkFuzzHarness {
     const bool was_synchronised = link_->dispatcher().synchronised();
     const std::uint16_t was_expected = link_->dispatcher().expected_sequence();
     const std::span<const std::uint8_t> wire = link_->receive(byte);
+    count_reply(delimiter, !wire.empty());
     if (wire.empty()) {
       if (delimiter) check_unchanged();
       check(link_->dispatcher().synchronised() == was_synchronised);
@@ -148,6 +155,19 @@ class LinkFuzzHarness {
     }
   }
 
+  // Exactly one reply per non-empty frame: counted between delimiters.
+  void count_reply(bool delimiter, bool replied) {
+    if (replied) ++frame_replies_;
+    if (!delimiter) {
+      ++frame_bytes_;
+      check(frame_replies_ <= 1);
+      return;
+    }
+    check(frame_replies_ == (frame_bytes_ > 0 ? 1u : 0u));
+    frame_bytes_ = 0;
+    frame_replies_ = 0;
+  }
+
   void snapshot() { std::memcpy(&before_, runtime_, sizeof(Runtime)); }
   void check_unchanged() const { check(std::memcmp(&before_, runtime_, sizeof(Runtime)) == 0); }
 
@@ -165,6 +185,8 @@ class LinkFuzzHarness {
   DeviceLink<FuzzModel>* link_ = nullptr;
   std::size_t replies_ = 0;
   std::size_t executed_ = 0;
+  std::size_t frame_bytes_ = 0;    // non-delimiter bytes since the last delimiter
+  std::size_t frame_replies_ = 0;  // replies since the last delimiter
 };
 
 }  // namespace hadynet::link::fuzz

@@ -123,7 +123,7 @@ LogSequence log_sequence(const datalog::LogTable& table, const std::string& file
   for (const std::size_t c : u_cols)
     if (c != kDerived) signal_cols.push_back(c);
   datalog::check_magnitudes(table, signal_cols, datalog::kMaxSignalMagnitude, file,
-                            "the trainer computes in float32 (docs/log-format.md, Limits)");
+                            "the trainer computes in float32 (docs/input-limits.md)");
 
   LogSequence seq;
   seq.file = file;

@@ -1,4 +1,4 @@
-// The limits the model-file reader enforces (docs/model-file.md, "Limits"):
+// The limits the model-file reader enforces (docs/input-limits.md):
 // every model it accepts can be loaded in bounded memory and computed on in
 // float32 without overflow, so no command meets an absurd model after
 // loading it. Each limit is far above any model this project trains (the

@@ -123,7 +123,7 @@ ReplayResult replay_on(Device& device, const datalog::LogTable& log, const std::
   for (const std::size_t c : u_cols)
     if (c != kNotLogged) signal_cols.push_back(c);
   datalog::check_magnitudes(log, signal_cols, datalog::kMaxSignalMagnitude, file,
-                            "the firmware's boundary is float32 (docs/log-format.md, Limits)");
+                            "the firmware's boundary is float32 (docs/input-limits.md)");
   if (!opt.pb.empty()) {
     if (static_cast<int>(opt.pb.size()) != M::kPb)
       throw std::invalid_argument("PB has " + std::to_string(opt.pb.size()) + " values, the model " +
