@@ -1,10 +1,10 @@
-// hadynet: one program, one subcommand per job (collect, validate, and the
-// trainer, codegen and replay commands as they land).
+// hadynet: one program, one subcommand per job (kCommands below).
 #include <Eigen/Core>
 #include <cstdio>
 #include <cstring>
 
 #include "cli/commands.h"
+#include "cli/error_text.h"
 
 namespace {
 
@@ -61,8 +61,17 @@ int main(int argc, char** argv) {
     print_help();
     return argc < 2 ? 2 : 0;
   }
-  for (const auto& c : kCommands)
-    if (std::strcmp(argv[1], c.name) == 0) return c.run(argc - 2, argv + 2);
+  for (const auto& c : kCommands) {
+    if (std::strcmp(argv[1], c.name) != 0) continue;
+    // Commands report their own errors; this catches what one lets escape,
+    // so no input ever ends in std::terminate or an exception's bare text.
+    try {
+      return c.run(argc - 2, argv + 2);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "hadynet %s: %s\n", c.name, hadynet::cli::error_text(e).c_str());
+      return 1;
+    }
+  }
   std::fprintf(stderr, "hadynet: unknown command '%s' (see hadynet --help)\n", argv[1]);
   return 2;
 }

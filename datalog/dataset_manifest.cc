@@ -112,9 +112,9 @@ DatasetManifest parse_dataset_manifest(std::string_view text, const std::string&
     if (log.contains("rows")) {
       const json& rows = log.at("rows");
       constexpr unsigned long long kMaxRows = 1ull << 53;
-      if (!rows.is_number_integer() || (rows.is_number_integer() && !rows.is_number_unsigned() &&
-                                        rows.get<long long>() < 0)) {
-        wrong_type(file, where + ".rows", rows, "a whole number >= 0");
+      if (!rows.is_number_integer()) wrong_type(file, where + ".rows", rows, "a whole number >= 0");
+      if (!rows.is_number_unsigned() && rows.get<long long>() < 0) {
+        fail(file, "field '" + where + ".rows': expected a whole number >= 0, got " + rows.dump());
       }
       const unsigned long long n = rows.get<unsigned long long>();
       if (n > kMaxRows) {
