@@ -54,8 +54,11 @@ bool uart_read_byte(std::uint8_t& byte) noexcept;
 // Sends `size` bytes; returns when the last one is in the transmitter.
 void uart_write(const std::uint8_t* data, std::size_t size) noexcept;
 
-// The nine loadcell readings, in newtons. False (and `newtons` unchanged)
-// if the board has no loadcells or no complete scan has arrived yet.
+// The nine loadcell readings, in newtons; reading k is the model's channel
+// "fc<k>" (firmware/app/channel_layout.h). The scaling from the sensor to
+// newtons is the board's data (boards/<board>/). False (and `newtons`
+// unchanged) if the board has no loadcells or no complete scan has arrived
+// yet. mps2-an386 has no ADC and returns synthetic readings.
 bool read_loadcells(float (&newtons)[kLoadcells]) noexcept;
 
 // Bytes of stack the firmware has used so far (high-water mark of a pattern

@@ -4,8 +4,9 @@
 //     non-empty received frame (the bytes between two delimiters) gets
 //     exactly one reply (a lone delimiter gets none);
 //   * a byte that is not a delimiter never executes anything;
-//   * an error reply, or no reply, leaves the runtime byte for byte as it
-//     was, and the sequence state too;
+//   * an error reply, or no reply, leaves the runtime and the autonomous
+//     loop (firmware/app/period_loop.h) byte for byte as they were, and the
+//     sequence state too;
 //   * a success reply echoes the expected number (any number before the
 //     first executed request and for reset) and advances it by one.
 // A violation aborts (the fuzzer reports it with the input). Shared by the
@@ -23,6 +24,8 @@
 #include <cstring>
 #include <new>
 #include <span>
+#include <type_traits>
+#include <utility>
 
 #include "firmware/core/hadynet_runtime.h"
 #include "firmware/link/device_link.h"
@@ -168,8 +171,16 @@ class LinkFuzzHarness {
     frame_replies_ = 0;
   }
 
-  void snapshot() { std::memcpy(&before_, runtime_, sizeof(Runtime)); }
-  void check_unchanged() const { check(std::memcmp(&before_, runtime_, sizeof(Runtime)) == 0); }
+  // The device's state a refused frame must not touch: the runtime and the
+  // autonomous loop (latest record, tare offsets, held muscle state).
+  void snapshot() {
+    std::memcpy(&before_, runtime_, sizeof(Runtime));
+    std::memcpy(&loop_before_, &link_->loop(), sizeof(Loop));
+  }
+  void check_unchanged() const {
+    check(std::memcmp(&before_, runtime_, sizeof(Runtime)) == 0);
+    check(std::memcmp(&loop_before_, &link_->loop(), sizeof(Loop)) == 0);
+  }
 
   static void check(bool ok) {
     if (!ok) std::abort();
@@ -180,7 +191,9 @@ class LinkFuzzHarness {
     alignas(DeviceLink<FuzzModel>) unsigned char link[sizeof(DeviceLink<FuzzModel>)];
   };
   Storage storage_;
+  using Loop = std::remove_reference_t<decltype(std::declval<DeviceLink<FuzzModel>&>().loop())>;
   alignas(Runtime) unsigned char before_[sizeof(Runtime)];
+  alignas(Loop) unsigned char loop_before_[sizeof(Loop)];
   Runtime* runtime_ = nullptr;
   DeviceLink<FuzzModel>* link_ = nullptr;
   std::size_t replies_ = 0;

@@ -1,6 +1,7 @@
 // mps2-an386 (Cortex-M4F, CMSDK peripherals; QEMU -M mps2-an386): UART0 at
 // 115200 baud with an interrupt-driven receive buffer, SysTick on the 25 MHz
-// SYSCLK. No loadcells. Memory sizes and the clock: board.cmake.
+// SYSCLK. No ADC: synthetic loadcell readings (synthetic_loadcells.h).
+// Memory sizes and the clock: board.cmake.
 #include <cstddef>
 #include <cstdint>
 
@@ -9,6 +10,7 @@
 #include "boards/common/cortex_m.h"
 #include "boards/common/irq_vectors.h"
 #include "boards/common/rx_ring.h"
+#include "boards/mps2-an386/synthetic_loadcells.h"
 
 namespace hadynet::board {
 namespace {
@@ -40,6 +42,8 @@ static_assert(kBaudDiv >= 16, "CMSDK UART needs BAUDDIV >= 16");
 // QEMU delivering a burst faster than any baud rate) is never dropped.
 RxRing<2048> g_rx;
 
+std::uint32_t g_loadcell_scans = 0;  // read_loadcells() calls so far: the synthetic scan index
+
 constexpr Description kDescription = {
     config::kName, config::kCoreClockHz, config::kCoreClockHz, config::kFlashBytes, config::kRamBytes,
 };
@@ -66,7 +70,12 @@ void uart_write(const std::uint8_t* data, std::size_t size) noexcept {
   }
 }
 
-bool read_loadcells(float (&)[kLoadcells]) noexcept { return false; }
+// Scan n = the n-th call (synthetic_loadcells.h); always available.
+bool read_loadcells(float (&newtons)[kLoadcells]) noexcept {
+  mps2::synthetic_loadcells(g_loadcell_scans, newtons);
+  ++g_loadcell_scans;
+  return true;
+}
 
 }  // namespace hadynet::board
 

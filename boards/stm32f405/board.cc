@@ -12,6 +12,7 @@
 #include "boards/common/irq_vectors.h"
 #include "boards/common/rx_ring.h"
 #include "boards/stm32f405/clock_tree.h"
+#include "boards/stm32f405/loadcell_calibration.h"
 #include "boards/stm32f405/loadcells.h"
 #include "boards/stm32f405/stm32f405_registers.h"
 
@@ -78,8 +79,8 @@ bool read_loadcells(float (&newtons)[kLoadcells]) noexcept {
   std::uint16_t counts[kLoadcells];
   if (!stm32::loadcell_counts(counts)) return false;
   for (int i = 0; i < kLoadcells; ++i) {
-    newtons[i] = (static_cast<float>(counts[i]) - stm32::kLoadcellOffsetCounts[i]) *
-                 stm32::kLoadcellNewtonsPerCount[i];
+    const float volts = static_cast<float>(counts[i]) * stm32::kAdcVoltsPerCount;
+    newtons[i] = (volts - stm32::kLoadcellZeroVolts[i]) * stm32::kLoadcellNewtonsPerVolt[i];
   }
   return true;
 }

@@ -16,12 +16,7 @@ namespace hadynet::board::stm32 {
 // ADC1 input of loadcell i (the scan order).
 inline constexpr std::uint8_t kLoadcellChannel[kLoadcells] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
 
-// newtons = (counts - offset) * gain. PLACEHOLDERS until the hand's loadcell
-// amplifier is specified: mid-scale zero, +-50 N over the 12-bit range.
-inline constexpr float kLoadcellOffsetCounts[kLoadcells] = {2048, 2048, 2048, 2048, 2048, 2048, 2048, 2048, 2048};
-inline constexpr float kLoadcellNewtonsPerCount[kLoadcells] = {
-    100.0f / 4096, 100.0f / 4096, 100.0f / 4096, 100.0f / 4096, 100.0f / 4096,
-    100.0f / 4096, 100.0f / 4096, 100.0f / 4096, 100.0f / 4096};
+// Counts to newtons: loadcell_calibration.h.
 
 // Configures the pins, ADC1 and DMA2 and starts the continuous scan
 // (peripheral clocks must be running: configure_clocks() first).

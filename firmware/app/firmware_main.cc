@@ -1,10 +1,13 @@
-// The firmware: the q15 runtime behind the UART, and the 5 Hz loop.
+// The firmware: the q15 runtime behind the UART, and its own 5 Hz loop.
 // Portable: the board (boards/board.h) is whichever one the build links.
 //
 //   loop:
 //     every received byte -> UartEndpoint::receive() -> reply bytes -> UART
 //     (uart_endpoint.h: THE place where the link plugs in)
-//     every 0.2 s (SysTick)  -> the periodic job: read the loadcells
+//     every 0.2 s (SysTick) -> the period (period_loop.h): the board's
+//       loadcells + the newest muscle state from the link -> one runtime
+//       step -> the period record (period_record.h), which the link sends
+//       on request (0x08) and the USB telemetry takes from latest().
 //
 // All state is static (no heap); the runtime is constructed before main()
 // by the start-up code's static constructors.
@@ -12,7 +15,8 @@
 #include <span>
 
 #include "boards/board.h"
-#include "firmware/app/loadcell_snapshot.h"
+#include "firmware/app/channel_layout.h"
+#include "firmware/app/period_loop.h"
 #include "firmware/app/uart_endpoint.h"
 #include "firmware/core/hadynet_runtime.h"
 #include "hadynet_model_q15.h"
@@ -20,23 +24,25 @@
 namespace {
 
 using Model = hadynet::model_q15::Model;
+using Loop = hadynet::app::PeriodLoop<Model>;
+
+// Board reading k is the model's loadcell k ("fc<k>"): the counts must agree.
+static_assert(hadynet::app::ChannelLayout<Model>::kLoadcells == hadynet::board::kLoadcells,
+              "the model's loadcell channels (fc<k>) and the board's loadcells differ in number");
 
 hadynet::firmware::HadynetRuntime<Model> g_runtime;
-hadynet::app::LoadcellSnapshot g_loadcells;
 hadynet::app::UartEndpoint<Model> g_endpoint(g_runtime);
-std::uint32_t g_period = 0;
 
-// The 5 Hz job. The runtime's step is driven by sensor frames from the link
-// (the host owns the robot's sensors today); what the board measures itself
-// is sampled here (protocol version 1 does not carry it yet).
+// The 5 Hz job: one period of the autonomous loop, its work timed against
+// the period (overruns are counted in the records).
 void periodic() noexcept {
-  ++g_period;
-  float newtons[hadynet::board::kLoadcells];
-  if (hadynet::board::read_loadcells(newtons)) {
-    for (int i = 0; i < hadynet::board::kLoadcells; ++i) g_loadcells.newtons[i] = newtons[i];
-    g_loadcells.period = g_period;
-    g_loadcells.valid = true;
-  }
+  const std::uint32_t start = hadynet::board::ticks();
+  Loop::LoadcellReading reading;
+  reading.valid = hadynet::board::read_loadcells(reading.newtons);
+  Loop& loop = g_endpoint.loop();
+  loop.run_period(reading, hadynet::board::overrun_periods());
+  const std::uint32_t ticks_per_period = hadynet::board::description().tick_hz / hadynet::board::kPeriodHz;
+  loop.end_period(hadynet::board::ticks() - start, ticks_per_period);
 }
 
 }  // namespace

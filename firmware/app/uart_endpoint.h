@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <span>
 
+#include "firmware/app/period_loop.h"
 #include "firmware/core/hadynet_runtime.h"
 #include "firmware/link/device_link.h"
 
@@ -28,6 +29,10 @@ class UartEndpoint {
   // One received byte in; the bytes to send back (possibly none), valid
   // until the next call.
   std::span<const std::uint8_t> receive(std::uint8_t byte) noexcept { return link_.receive(byte); }
+
+  // The autonomous 5 Hz loop the link feeds (muscle states, tare) and
+  // reports (period records); firmware_main.cc runs its periods.
+  PeriodLoop<M>& loop() noexcept { return link_.loop(); }
 
  private:
   link::DeviceLink<M> link_;

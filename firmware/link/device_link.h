@@ -2,7 +2,8 @@
 // transmit out. StreamDecoder (COBS, hard size limit) feeds LinkDispatcher;
 // each reply is COBS-encoded and delimited. A board's transport calls
 // receive() for every byte from its UART and sends what it returns. All
-// buffers are members, sized at compile time (about 1.5 KiB).
+// buffers are members, sized at compile time (about 1.5 KiB, plus the
+// autonomous loop's state, ~0.5 KiB for the hand's model).
 #ifndef HADYNET_FIRMWARE_LINK_DEVICE_LINK_H_
 #define HADYNET_FIRMWARE_LINK_DEVICE_LINK_H_
 
@@ -46,6 +47,9 @@ class DeviceLink {
   }
 
   const LinkDispatcher<M>& dispatcher() const noexcept { return dispatcher_; }
+  // The autonomous 5 Hz loop the link feeds (firmware/app/period_loop.h).
+  app::PeriodLoop<M>& loop() noexcept { return dispatcher_.loop(); }
+  const app::PeriodLoop<M>& loop() const noexcept { return dispatcher_.loop(); }
   const StreamDecoder& decoder() const noexcept { return decoder_; }
 
  private:

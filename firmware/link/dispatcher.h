@@ -11,7 +11,15 @@
 //
 // Robustness: a frame that is not executed gets an error reply (0x7F) and
 // changes nothing — not the runtime (history, plan, PB, mode), not the
-// sequence expectation.
+// autonomous loop (muscle state, tare offsets, records), not the sequence
+// expectation.
+//
+// The autonomous 5 Hz loop (firmware/app/period_loop.h) belongs to the
+// dispatcher: the link feeds it muscle states (0x06) and tare requests
+// (0x07) and reads its latest record (0x08); the firmware's main loop runs
+// its periods through loop(). A sensor frame (0x02) or a reset (0x05) makes
+// the loop forget its muscle state, so the two ways of stepping the runtime
+// never interleave.
 #ifndef HADYNET_FIRMWARE_LINK_DISPATCHER_H_
 #define HADYNET_FIRMWARE_LINK_DISPATCHER_H_
 
@@ -19,6 +27,8 @@
 #include <cstdint>
 #include <span>
 
+#include "firmware/app/channel_layout.h"
+#include "firmware/app/period_loop.h"
 #include "firmware/core/hadynet_runtime.h"
 #include "firmware/core/model_contract.h"
 #include "firmware/link/frame.h"
@@ -31,7 +41,7 @@ class LinkDispatcher {
  public:
   using Runtime = firmware::HadynetRuntime<M>;
 
-  explicit LinkDispatcher(Runtime& runtime) noexcept : runtime_(runtime) {}
+  explicit LinkDispatcher(Runtime& runtime) noexcept : runtime_(runtime), loop_(runtime) {}
 
   // Handles one decoded frame; writes the reply frame (decoded, not yet
   // COBS-encoded) into `reply` and returns its size (always > 0).
@@ -61,6 +71,7 @@ class LinkDispatcher {
       case MessageType::kSensorFrame: {
         firmware::SensorFrame<M> in;
         if (const Status s = decode_sensor_frame<M>(f.payload, in); !s.ok()) return refuse(s);
+        loop_.forget_muscle_state();
         const firmware::StepResult<M> out = runtime_.step(in);
         payload_size = encode_step_result<M>(out, payload);
         break;
@@ -86,6 +97,29 @@ class LinkDispatcher {
       case MessageType::kReset: {
         if (const Status s = decode_empty(f.payload); !s.ok()) return refuse(s);
         runtime_.reset();
+        loop_.forget_muscle_state();
+        break;
+      }
+      case MessageType::kMuscleState: {
+        app::MuscleState<M> in;
+        if (const Status s = decode_muscle_state<M>(f.payload, in); !s.ok()) return refuse(s);
+        payload_size = encode_muscle_state_ack(loop_.receive_muscle_state(in), payload);
+        break;
+      }
+      case MessageType::kTare: {
+        TareAction action{};
+        if (const Status s = decode_tare(f.payload, action); !s.ok()) return refuse(s);
+        if (action == TareAction::kZero) {
+          if (!loop_.tare()) return refuse({ErrorCode::kNotReady, "tare: no loadcell reading yet"});
+        } else {
+          loop_.clear_tare();
+        }
+        payload_size = encode_tare_ack<M>(loop_.tare_offsets_N(), payload);
+        break;
+      }
+      case MessageType::kPeriodResultRequest: {
+        if (const Status s = decode_empty(f.payload); !s.ok()) return refuse(s);
+        payload_size = encode_period_result<M>(loop_.latest(), payload);
         break;
       }
       default:  // is_request_type() admits no other type
@@ -108,6 +142,11 @@ class LinkDispatcher {
   std::uint16_t expected_sequence() const noexcept { return expected_; }
 
   const Runtime& runtime() const noexcept { return runtime_; }
+
+  // The autonomous loop: the main loop runs its periods (run_period,
+  // end_period) and takes its records here.
+  app::PeriodLoop<M>& loop() noexcept { return loop_; }
+  const app::PeriodLoop<M>& loop() const noexcept { return loop_; }
 
  private:
   static constexpr InfoReply kInfo = info_of<M>();
@@ -139,6 +178,7 @@ class LinkDispatcher {
   }
 
   Runtime& runtime_;
+  app::PeriodLoop<M> loop_;
   bool synchronised_ = false;
   std::uint16_t expected_ = 0;
 };

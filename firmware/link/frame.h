@@ -47,18 +47,24 @@ enum class MessageType : std::uint8_t {
   kSetPb = 0x03,
   kSetMode = 0x04,
   kReset = 0x05,
+  kMuscleState = 0x06,         // the host's half of the autonomous loop's frame
+  kTare = 0x07,                // loadcell offsets
+  kPeriodResultRequest = 0x08,  // the autonomous loop's latest period record
   kError = 0x7F,  // reply to any request that was not executed
   kInfo = 0x81,
   kStepResult = 0x82,
   kSetPbAck = 0x83,
   kSetModeAck = 0x84,
   kResetAck = 0x85,
+  kMuscleStateAck = 0x86,
+  kTareAck = 0x87,
+  kPeriodResult = 0x88,
 };
 inline constexpr std::uint8_t kReplyBit = 0x80;  // reply type = request type | kReplyBit
 
 constexpr bool is_request_type(std::uint8_t type) noexcept {
   return type >= static_cast<std::uint8_t>(MessageType::kInfoRequest) &&
-         type <= static_cast<std::uint8_t>(MessageType::kReset);
+         type <= static_cast<std::uint8_t>(MessageType::kPeriodResultRequest);
 }
 constexpr MessageType reply_type_of(MessageType request) noexcept {
   return static_cast<MessageType>(static_cast<std::uint8_t>(request) | kReplyBit);
@@ -75,6 +81,7 @@ enum class ErrorCode : std::uint8_t {
   kBadPayloadLength = 6,  // longer than its length field says, or the wrong payload size for its type
   kBadValue = 7,          // a payload field out of range (PB state, non-finite PB, mode, PB kind)
   kOutOfOrder = 8,        // sequence number is not the expected one
+  kNotReady = 9,          // well-formed, but the device cannot do it yet (tare before any loadcell reading)
 };
 
 // ---- little-endian field access with bounds checks

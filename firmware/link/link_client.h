@@ -92,6 +92,21 @@ class LinkClient {
 
   std::size_t reset(std::span<std::uint8_t> wire) noexcept { return request(MessageType::kReset, 0, wire); }
 
+  // The host's half of the autonomous loop's next frame (reply 0x86).
+  std::size_t muscle_state(const app::MuscleState<M>& state, std::span<std::uint8_t> wire) noexcept {
+    return request(MessageType::kMuscleState, encode_muscle_state<M>(state, payload()), wire);
+  }
+
+  // Loadcell offsets: zero them at the latest reading, or clear them (reply 0x87).
+  std::size_t tare(TareAction action, std::span<std::uint8_t> wire) noexcept {
+    return request(MessageType::kTare, encode_tare(action, payload()), wire);
+  }
+
+  // The autonomous loop's latest period record (reply 0x88).
+  std::size_t period_result_request(std::span<std::uint8_t> wire) noexcept {
+    return request(MessageType::kPeriodResultRequest, 0, wire);
+  }
+
   // Any frame, valid or not, with the given header fields (tests, the fuzz
   // corpus tool); does not touch the sequence number.
   std::size_t raw_frame(std::uint8_t version, std::uint8_t type, std::uint16_t sequence,

@@ -15,6 +15,8 @@
 #include <cstdint>
 #include <span>
 
+#include "firmware/app/channel_layout.h"
+#include "firmware/app/period_record.h"
 #include "firmware/core/hadynet_runtime.h"
 #include "firmware/core/model_contract.h"
 #include "firmware/link/frame.h"
@@ -29,6 +31,8 @@ inline constexpr std::size_t kInfoPayloadMax = 8 + 2 + 1 + 1 + 8 * 2 + 1 + 4 + 1
 inline constexpr std::size_t kSetModePayload = 1;
 inline constexpr std::size_t kSetPbStatePayload = 1 + 2;
 inline constexpr std::size_t kErrorPayloadMax = 1 + 2 + 1 + kMaxReason;
+inline constexpr std::size_t kTarePayload = 1;
+inline constexpr std::size_t kMuscleStateAckPayload = 4;
 
 // Payload sizes (bytes) for model M; the build fails if M is too large for
 // version-1 frames.
@@ -37,7 +41,15 @@ struct PayloadSizes {
   static constexpr std::size_t kSensorFrame = 4 * (M::kY + M::kU);
   static constexpr std::size_t kStepResult = 1 + 4 * M::kY + 4 + 4 * M::kU;
   static constexpr std::size_t kSetPbValues = 1 + 4 * M::kPb;
+  // The autonomous loop's messages (channel_layout.h: kMuscleY observed
+  // channels that are not loadcells, kLoadcells loadcells).
+  static constexpr std::size_t kMuscleState = 4 * (app::ChannelLayout<M>::kMuscleY + M::kU);
+  static constexpr std::size_t kTareAck = 4 * app::ChannelLayout<M>::kLoadcells;
+  static constexpr std::size_t kPeriodResult =
+      4 + 4 + 1 + 2 + 4 + 4 + 4 + 4 * (app::ChannelLayout<M>::kLoadcells + 1 + M::kY + M::kU);
   static_assert(kSensorFrame <= kMaxPayload && kStepResult <= kMaxPayload && kSetPbValues <= kMaxPayload,
+                "the model's messages exceed the protocol's kMaxPayload");
+  static_assert(kMuscleState <= kMaxPayload && kTareAck <= kMaxPayload && kPeriodResult <= kMaxPayload,
                 "the model's messages exceed the protocol's kMaxPayload");
 };
 static_assert(kInfoPayloadMax <= kMaxPayload && kErrorPayloadMax <= kMaxPayload);
@@ -259,6 +271,124 @@ constexpr Status decode_set_mode(std::span<const std::uint8_t> in, firmware::Mod
 constexpr Status decode_empty(std::span<const std::uint8_t> in) noexcept {
   if (!in.empty()) return {ErrorCode::kBadPayloadLength, "payload must be empty"};
   return {};
+}
+
+// ---- 0x06 muscle state: y_muscle[kMuscleY], u_prev[kU] (f32, physical
+// units; app::ChannelLayout: the observed channels that are not loadcells,
+// in y order). Non-finite values are passed on, as in a sensor frame.
+
+template <firmware::GeneratedModel M>
+constexpr std::size_t encode_muscle_state(const app::MuscleState<M>& m, std::span<std::uint8_t> out) noexcept {
+  ByteWriter w(out);
+  for (const float v : m.y) w.f32(v);
+  for (const float v : m.u_prev) w.f32(v);
+  return w.ok() ? w.size() : 0;
+}
+
+template <firmware::GeneratedModel M>
+constexpr Status decode_muscle_state(std::span<const std::uint8_t> in, app::MuscleState<M>& m) noexcept {
+  if (in.size() != PayloadSizes<M>::kMuscleState) return {ErrorCode::kBadPayloadLength, "muscle state: wrong size"};
+  ByteReader rd(in);
+  for (float& v : m.y) v = rd.f32();
+  for (float& v : m.u_prev) v = rd.f32();
+  return {};
+}
+
+// 0x86 muscle state ack: u32, the sequence number of the period record that
+// will use this muscle state fresh (the next one).
+constexpr std::size_t encode_muscle_state_ack(std::uint32_t first_record, std::span<std::uint8_t> out) noexcept {
+  ByteWriter w(out);
+  w.u32(first_record);
+  return w.ok() ? w.size() : 0;
+}
+
+constexpr bool decode_muscle_state_ack(std::span<const std::uint8_t> in, std::uint32_t& first_record) noexcept {
+  if (in.size() != kMuscleStateAckPayload) return false;
+  ByteReader rd(in);
+  first_record = rd.u32();
+  return rd.ok();
+}
+
+// ---- 0x07 tare: action u8 (0: offsets := the latest loadcell reading,
+// 1: offsets := 0). 0x87 ack: the offsets now in use, f32[kLoadcells], N.
+
+enum class TareAction : std::uint8_t { kZero = 0, kClear = 1 };
+
+constexpr std::size_t encode_tare(TareAction action, std::span<std::uint8_t> out) noexcept {
+  ByteWriter w(out);
+  w.u8(static_cast<std::uint8_t>(action));
+  return w.ok() ? w.size() : 0;
+}
+
+constexpr Status decode_tare(std::span<const std::uint8_t> in, TareAction& action) noexcept {
+  if (in.size() != kTarePayload) return {ErrorCode::kBadPayloadLength, "tare: wrong size"};
+  if (in[0] > static_cast<std::uint8_t>(TareAction::kClear)) return {ErrorCode::kBadValue, "tare: unknown action"};
+  action = static_cast<TareAction>(in[0]);
+  return {};
+}
+
+// (Loadcell arrays hold app::ChannelLayout<M>::kLoadcellSlots entries; the
+// first kLoadcells are on the wire.)
+template <firmware::GeneratedModel M>
+constexpr std::size_t encode_tare_ack(const float (&offsets_N)[app::ChannelLayout<M>::kLoadcellSlots],
+                                      std::span<std::uint8_t> out) noexcept {
+  ByteWriter w(out);
+  for (int k = 0; k < app::ChannelLayout<M>::kLoadcells; ++k) w.f32(offsets_N[k]);
+  return w.size() == PayloadSizes<M>::kTareAck && w.ok() ? w.size() : 0;
+}
+
+template <firmware::GeneratedModel M>
+constexpr bool decode_tare_ack(std::span<const std::uint8_t> in,
+                               float (&offsets_N)[app::ChannelLayout<M>::kLoadcellSlots]) noexcept {
+  if (in.size() != PayloadSizes<M>::kTareAck) return false;
+  ByteReader rd(in);
+  for (float& v : offsets_N) v = 0.0f;
+  for (int k = 0; k < app::ChannelLayout<M>::kLoadcells; ++k) offsets_N[k] = rd.f32();
+  return rd.ok();
+}
+
+// ---- 0x08 period result request: empty. 0x88 period result: the loop's
+// latest app::PeriodRecord, fields in its order: sequence u32, period u32,
+// mode u8, flags u16, muscle_state_age u32, overruns u32, missed_periods u32,
+// loadcells_N[kLoadcells] f32, d f32, prediction[kY] f32, command[kU] f32.
+
+template <firmware::GeneratedModel M>
+constexpr std::size_t encode_period_result(const app::PeriodRecord<M>& r, std::span<std::uint8_t> out) noexcept {
+  ByteWriter w(out);
+  w.u32(r.sequence);
+  w.u32(r.period);
+  w.u8(static_cast<std::uint8_t>(r.mode));
+  w.u16(r.flags);
+  w.u32(r.muscle_state_age);
+  w.u32(r.overruns);
+  w.u32(r.missed_periods);
+  for (int k = 0; k < app::ChannelLayout<M>::kLoadcells; ++k) w.f32(r.loadcells_N[k]);
+  w.f32(r.d);
+  for (const float v : r.prediction) w.f32(v);
+  for (const float v : r.command) w.f32(v);
+  return w.ok() ? w.size() : 0;
+}
+
+// False for a wrong size, an unknown mode or unknown flag bits.
+template <firmware::GeneratedModel M>
+constexpr bool decode_period_result(std::span<const std::uint8_t> in, app::PeriodRecord<M>& r) noexcept {
+  if (in.size() != PayloadSizes<M>::kPeriodResult) return false;
+  ByteReader rd(in);
+  r.sequence = rd.u32();
+  r.period = rd.u32();
+  const std::uint8_t mode = rd.u8();
+  r.mode = static_cast<firmware::Mode>(mode);
+  r.flags = rd.u16();
+  r.muscle_state_age = rd.u32();
+  r.overruns = rd.u32();
+  r.missed_periods = rd.u32();
+  for (float& v : r.loadcells_N) v = 0.0f;
+  for (int k = 0; k < app::ChannelLayout<M>::kLoadcells; ++k) r.loadcells_N[k] = rd.f32();
+  r.d = rd.f32();
+  for (float& v : r.prediction) v = rd.f32();
+  for (float& v : r.command) v = rd.f32();
+  return rd.ok() && mode <= static_cast<std::uint8_t>(firmware::Mode::kControl) &&
+         (r.flags & ~app::kRecordKnownFlags) == 0;
 }
 
 // ---- 0x7F error: code u8, offending sequence number u16, reason (u8 length + ASCII)

@@ -174,7 +174,7 @@ TEST_F(LinkRobustness, OversizeFrames) {
 }
 
 TEST_F(LinkRobustness, UnknownTypes) {
-  for (int type : {0x00, 0x06, 0x42, 0x7E, 0x7F, 0x80, 0x81, 0x82, 0x85, 0xFF}) {
+  for (int type : {0x00, 0x09, 0x42, 0x7E, 0x7F, 0x80, 0x81, 0x82, 0x85, 0x86, 0x88, 0xFF}) {
     expect_rejected({"type " + std::to_string(type), encode_wire(frame(static_cast<std::uint8_t>(type), {})),
                      ErrorCode::kUnknownType, true});
   }
