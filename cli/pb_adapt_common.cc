@@ -41,6 +41,11 @@ std::vector<AdaptedState> adapt_each_state(const trainer::HadynetModel& model,
     std::iota(ids.begin(), ids.end(), 0);
     out.push_back({g.state, g.object, data.size(),
                    trainer::adapt_pb(model, data, ids, start, options)});
+    if (!out.back().result.pb.allFinite()) {
+      // Never print or store a NaN PB as a result.
+      throw std::runtime_error("state '" + g.state + "': PB adaptation diverged (the PB is not finite); try a "
+                               "smaller --lr");
+    }
   }
   return out;
 }
