@@ -39,7 +39,8 @@ enum class UsbFuzzOp : std::uint8_t {
   kPowerOn = 8,      // -
   kClassControl = 9,  // interface byte, request byte, value u16, length byte, data (OUT) — a whole transfer
   kEnumerate = 10,   // -
-  kCount = 11,
+  kSpuriousCompletion = 11,  // endpoint byte, bytes u8: a completion outside the seam's contract
+  kCount = 12,
 };
 
 // Echoes each received byte as 1..3 bytes (cheap stand-in for the link).
@@ -167,6 +168,10 @@ class UsbFuzzHarness {
           controller_.bus_reset();
           controller_.control({0x00, request::kSetAddress, 7, 0, 0}, {}, {});
           controller_.control({0x00, request::kSetConfiguration, 1, 0, 0}, {}, {});
+          break;
+        case UsbFuzzOp::kSpuriousCompletion:
+          if (!take(2, a)) return;
+          controller_.inject(ControllerEvent::transfer_complete(static_cast<EndpointAddress>(a[0] & 0x8F), a[1]));
           break;
         case UsbFuzzOp::kCount:
           break;

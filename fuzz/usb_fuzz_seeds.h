@@ -72,7 +72,7 @@ inline Bytes dfu_download(bool fault) {
   }
   class_control(b, 4, 3, true, 0, {}, 6);
   class_control(b, 4, 2, true, 0, {}, 256);  // UPLOAD
-  class_control(b, 4, 4, false, 0, {});      // CLRSTATUS
+  if (fault) class_control(b, 4, 4, false, 0, {});  // CLRSTATUS (leaves dfuERROR)
   return b;
 }
 
