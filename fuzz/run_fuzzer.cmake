@@ -1,10 +1,10 @@
 # Runs a libFuzzer target for a bounded time from its seed corpus; fails on
 # any finding (crash, sanitizer report, oracle abort, timeout).
 #   cmake -DFUZZER=<fuzzer> -DCORPUS=<seed dir> -DWORK=<scratch dir> -DSECONDS=<n> [-DMAX_LEN=<bytes>]
-#         -P run_link_fuzzer.cmake
+#         -P run_fuzzer.cmake
 foreach(var FUZZER CORPUS WORK SECONDS)
   if(NOT DEFINED ${var})
-    message(FATAL_ERROR "run_link_fuzzer: set ${var}")
+    message(FATAL_ERROR "run_fuzzer: set ${var}")
   endif()
 endforeach()
 
@@ -22,7 +22,7 @@ execute_process(
   OUTPUT_VARIABLE out
   ERROR_VARIABLE out)
 string(REGEX MATCH "stat::number_of_executed_units: *[0-9]+" runs "${out}")
-message("run_link_fuzzer: ${FUZZER}: ${runs}")
+message("run_fuzzer: ${FUZZER}: ${runs}")
 if(NOT result EQUAL 0)
   message(FATAL_ERROR "${FUZZER} failed (${result}); artifacts in ${WORK}\n${out}")
 endif()
