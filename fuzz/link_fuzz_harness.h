@@ -63,8 +63,9 @@ class LinkFuzzHarness {
   void run(const std::uint8_t* data, std::size_t size) {
     frame_bytes_ = 0;
     frame_replies_ = 0;
+    streamed_ = 0;
     std::size_t pos = 0;
-    while (pos < size) {
+    while (pos < size && streamed_ < kMaxStreamBytes) {
       const std::uint8_t kind = data[pos];
       std::size_t length = 0;
       if (pos + 1 < size) length = data[pos + 1];
@@ -117,6 +118,8 @@ class LinkFuzzHarness {
   }
 
   void send(std::uint8_t byte) {
+    if (streamed_ == kMaxStreamBytes) return;  // the input's budget is spent
+    ++streamed_;
     const bool delimiter = byte == 0;
     if (delimiter) snapshot();
     const bool was_synchronised = link_->dispatcher().synchronised();
@@ -198,6 +201,7 @@ class LinkFuzzHarness {
   DeviceLink<FuzzModel>* link_ = nullptr;
   std::size_t replies_ = 0;
   std::size_t executed_ = 0;
+  std::size_t streamed_ = 0;       // bytes sent to the device for this input (<= kMaxStreamBytes)
   std::size_t frame_bytes_ = 0;    // non-delimiter bytes since the last delimiter
   std::size_t frame_replies_ = 0;  // replies since the last delimiter
 };
