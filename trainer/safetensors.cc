@@ -549,6 +549,10 @@ File parse(std::string_view bytes, const std::string& origin) {
     header = Json::parse(text, std::ref(checker));
   } catch (const Json::parse_error& e) {
     throw FormatError(origin, std::string("header is not valid JSON: ") + e.what());
+  } catch (const Json::exception& e) {
+    // out_of_range 406: a number beyond double's range (found by model_fuzzer).
+    throw FormatError(origin, std::string("header is not readable JSON: ") +
+                                  (e.id == 406 ? "a number beyond the range of a double" : e.what()));
   }
   if (!header.is_object()) {
     throw FormatError(

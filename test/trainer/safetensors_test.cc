@@ -705,5 +705,16 @@ TEST_F(SafetensorsFiles, ParseErrorsOfReadFileNamePath) {
   }
 }
 
+// Found by model_fuzzer (issue 19; the input is fuzz/corpus/model/
+// regression_number_overflow.safetensors): a header number beyond double's
+// range threw the JSON library's out_of_range past parse(), which ended the
+// program with std::terminate. It must be a FormatError like every other
+// malformed header.
+TEST(Safetensors, HeaderNumberBeyondDoubleIsAFormatError) {
+  expect_rejected(file_bytes(R"({"__metadata__":{"a":"b"},"x":{"dtype":"F32","shape":[1e400],"data_offsets":[0,4]}})",
+                             std::string(4, '\0')),
+                  {"header is not readable JSON: a number beyond the range of a double"});
+}
+
 }  // namespace
 }  // namespace hadynet::trainer::safetensors
