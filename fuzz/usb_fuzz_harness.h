@@ -16,11 +16,13 @@
 #include <cstdlib>
 #include <span>
 
+#include "firmware/app/period_record.h"
 #include "firmware/flash/simulated_nor_flash.h"
 #include "firmware/link/crc32.h"
 #include "firmware/usb/dfu_image.h"
 #include "firmware/usb/hadynet_usb_device.h"
 #include "firmware/usb/host/fake_controller.h"
+#include "firmware/usb/telemetry_decoder.h"
 #include "hadynet_model_q15.h"
 
 namespace hadynet::usb::fuzz {
@@ -33,7 +35,7 @@ enum class UsbFuzzOp : std::uint8_t {
   kInToken = 2,      // endpoint byte
   kOutToken = 3,     // endpoint byte, length byte (% 65), data
   kService = 4,      // -
-  kPublish = 5,      // sequence u8
+  kPublish = 5,      // sequence u8 (an app::PeriodRecord: sequence, period, low flag bits)
   kSuspendResume = 6,  // flag byte
   kFlashFault = 7,   // kind byte (bit 0: power cut / write error), distance byte
   kPowerOn = 8,      // -
@@ -108,7 +110,10 @@ class UsbFuzzHarness {
           if (!take(1, a)) return;
           std::uint8_t packet[64];
           std::size_t n = 0;
-          controller_.in_token(static_cast<EndpointAddress>(a[0] & 0x8F), packet, n);
+          const EndpointAddress ep = static_cast<EndpointAddress>(a[0] & 0x8F);
+          if (controller_.in_token(ep, packet, n) == host::Handshake::kAck && ep == composite::kHidReportIn) {
+            telemetry_.push(std::span<const std::uint8_t>(packet, n));
+          }
           if (n > 64) violated("IN packet larger than 64");
           break;
         }
@@ -127,9 +132,10 @@ class UsbFuzzHarness {
           break;
         case UsbFuzzOp::kPublish: {
           if (!take(1, a)) return;
-          TelemetryRecord<Q> r;
+          app::PeriodRecord<Q> r;
           r.sequence = a[0];
           r.period = a[0];
+          r.flags = static_cast<std::uint16_t>(a[0] & app::kRecordKnownFlags);
           device_.publish(r);
           break;
         }
@@ -210,6 +216,11 @@ class UsbFuzzHarness {
     if (cdc.tx_pending() > Device::Cdc::kTxCapacity) violated("CDC ring overflow");
     if (cdc.rx_pending() > 64) violated("CDC rx beyond a packet");
     if (cdc.dropped_reply_bytes() != 0) violated("CDC dropped reply bytes");
+    // Sets may arrive incomplete (halt, reset, a lost transfer), but every
+    // report the device sends is well-formed and every whole set decodes.
+    if (telemetry_.stats().bad_reports != 0 || telemetry_.stats().bad_payloads != 0) {
+      violated("HID telemetry report the host decoder refuses");
+    }
   }
 
   // Header written last: a slot whose header reads well-formed holds a
@@ -230,6 +241,7 @@ class UsbFuzzHarness {
   EchoEndpoint endpoint_;
   NullDetach detach_;
   Device device_;
+  TelemetryDecoder<Q> telemetry_;  // the host side of what EP 0x83 sent
 };
 
 }  // namespace hadynet::usb::fuzz

@@ -112,7 +112,7 @@ inline Bytes cdc_traffic() {
   }
   op(b, UsbFuzzOp::kPublish);
   b.push_back(1);
-  in_tokens(b, 0x83, 3);
+  in_tokens(b, 0x83, static_cast<int>(TelemetryLayout<Q>::kParts));  // one whole report set
   return b;
 }
 

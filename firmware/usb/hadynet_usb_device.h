@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <span>
 
+#include "firmware/app/period_record.h"
 #include "firmware/core/model_contract.h"
 #include "firmware/flash/flash_device.h"
 #include "firmware/usb/cdc_acm.h"
@@ -95,7 +96,8 @@ class HadynetUsbDevice {
 
   void start() noexcept { device_.start(); }
   void service() noexcept { device_.service(); }
-  void publish(const TelemetryRecord<M>& record) noexcept { hid_.publish(record); }
+  // Each period: the loop's record (PeriodLoop::latest() after end_period()).
+  void publish(const app::PeriodRecord<M>& record) noexcept { hid_.publish(record); }
 
   UsbDevice& device() noexcept { return device_; }
   const UsbDevice& device() const noexcept { return device_; }

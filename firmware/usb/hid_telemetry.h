@@ -1,6 +1,7 @@
 // HID telemetry (HID 1.11): a vendor-defined interface with one interrupt IN
 // endpoint that sends one report set (telemetry_report.h) per published
-// record, i.e. per control period.
+// record: the app::PeriodRecord of each period of the firmware's 5 Hz loop
+// (PeriodLoop::latest() after end_period()).
 //
 // publish() while a set is still being sent keeps the newest record as
 // pending and sends it next; a pending record replaced by a newer one is
@@ -18,8 +19,8 @@
 #include <cstdint>
 #include <span>
 
+#include "firmware/app/period_record.h"
 #include "firmware/usb/device_controller.h"
-#include "firmware/usb/telemetry_record.h"
 #include "firmware/usb/telemetry_report.h"
 #include "firmware/usb/usb_function.h"
 #include "firmware/usb/usb_spec.h"
@@ -74,9 +75,8 @@ class HidTelemetry final : public UsbFunction {
   explicit HidTelemetry(const HidTelemetryLayout& layout) noexcept : layout_(layout) {}
 
   // The newest period's record; sent as soon as the endpoint is free.
-  void publish(const TelemetryRecord<M>& record) noexcept {
+  void publish(const app::PeriodRecord<M>& record) noexcept {
     latest_ = record;
-    has_latest_ = true;
     if (controller_ == nullptr) return;
     if (part_ < Layout::kParts) {  // a set is on its way
       if (has_pending_) ++overwritten_;
@@ -102,8 +102,8 @@ class HidTelemetry final : public UsbFunction {
         if (!s.is_in() || s.value != (hid::kReportTypeInput << 8) || s.length == 0) break;
         {
           static_assert(kSetBytes <= kControlBufferSize, "a report set must fit the control buffer");
-          TelemetryRecord<M> r = has_latest_ ? latest_ : TelemetryRecord<M>{};
-          encode_telemetry_reports<M>(r, buffer.template first<kSetBytes>());
+          // Before the first publish(): the empty record (sequence 0).
+          encode_telemetry_reports<M>(latest_, buffer.template first<kSetBytes>());
           return ControlReply::data_in(kTelemetryReportSize);  // part 0
         }
       case hid::kSetIdle:
@@ -188,8 +188,7 @@ class HidTelemetry final : public UsbFunction {
 
   HidTelemetryLayout layout_;
   DeviceController* controller_ = nullptr;  // set while configured
-  TelemetryRecord<M> latest_{};
-  bool has_latest_ = false;
+  app::PeriodRecord<M> latest_{};
   bool has_pending_ = false;
   bool halted_ = false;
   std::size_t part_ = Layout::kParts;  // the part on its way; kParts: idle

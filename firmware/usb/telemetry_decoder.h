@@ -1,12 +1,16 @@
 // Host side of the HID telemetry (telemetry_report.h): 64-byte reports in,
-// whole TelemetryRecords out, drops counted from the sequence numbers. Pure
-// code (no I/O, no heap) for `hadynet monitor` and the tests.
+// whole app::PeriodRecords out (decoded by link::decode_period_result, as a
+// 0x88 reply is), drops counted from the sequence numbers. Pure code (no
+// I/O, no heap) for `hadynet monitor` and the tests.
 //
-// Counting: a record is delivered when all parts of its set arrived in order.
-// `dropped` adds, for each delivered record, the sequence numbers skipped
-// since the previous delivered one (sets lost whole or in part). A sequence
-// number lower than the previous one is a device restart (counted in
-// `restarts`, no drops); an equal one a duplicate (ignored).
+// Counting: a record is delivered when all parts of its set arrived in order
+// and its payload decodes (right mode and flag bits, the payload's sequence
+// equal to the header's; otherwise the set counts in `bad_payloads` and is
+// not delivered). `dropped` adds, for each delivered record, the sequence
+// numbers skipped since the previous delivered one (sets lost whole or in
+// part, or not decodable). A sequence number lower than the previous one is
+// a device restart (counted in `restarts`, no drops); an equal one a
+// duplicate (ignored).
 #ifndef HADYNET_FIRMWARE_USB_TELEMETRY_DECODER_H_
 #define HADYNET_FIRMWARE_USB_TELEMETRY_DECODER_H_
 
@@ -14,7 +18,8 @@
 #include <cstdint>
 #include <span>
 
-#include "firmware/usb/telemetry_record.h"
+#include "firmware/app/period_record.h"
+#include "firmware/link/messages.h"
 #include "firmware/usb/telemetry_report.h"
 
 namespace hadynet::usb {
@@ -23,6 +28,7 @@ struct TelemetryStats {
   std::uint64_t records = 0;          // delivered records
   std::uint64_t dropped = 0;          // sequence numbers never delivered between delivered records
   std::uint64_t bad_reports = 0;      // wrong size, version, part count or part length
+  std::uint64_t bad_payloads = 0;     // whole sets whose payload did not decode (not delivered)
   std::uint64_t incomplete_sets = 0;  // sets abandoned because a part was missing
   std::uint64_t duplicates = 0;
   std::uint64_t restarts = 0;
@@ -32,12 +38,14 @@ template <firmware::GeneratedModel M>
 class TelemetryDecoder {
  public:
   using Layout = TelemetryLayout<M>;
+  // kBadReport: this report was malformed, or it completed a set whose
+  // payload did not decode.
   enum class Event : std::uint8_t { kNone, kRecord, kBadReport };
 
   // One input report as read from the device (hidraw: 64 bytes).
   Event push(std::span<const std::uint8_t> report) noexcept {
     if (report.size() != kTelemetryReportSize || report[0] != kTelemetryFormatVersion || report[2] != Layout::kParts ||
-        report[1] >= Layout::kParts || report[3] != part_length(report[1])) {
+        report[1] >= Layout::kParts || report[3] != Layout::part_length(report[1])) {
       ++stats_.bad_reports;
       return Event::kBadReport;
     }
@@ -62,17 +70,17 @@ class TelemetryDecoder {
     return deliver(sequence);
   }
 
-  const TelemetryRecord<M>& record() const noexcept { return record_; }
+  // The newest delivered record (all zero before the first).
+  const app::PeriodRecord<M>& record() const noexcept { return record_; }
   const TelemetryStats& stats() const noexcept { return stats_; }
 
  private:
-  static constexpr std::size_t part_length(std::size_t part) noexcept {
-    const std::size_t begin = part * kTelemetryPartPayload;
-    return Layout::kPayloadSize - begin < kTelemetryPartPayload ? Layout::kPayloadSize - begin
-                                                                : kTelemetryPartPayload;
-  }
-
   Event deliver(std::uint32_t sequence) noexcept {
+    if (!link::decode_period_result<M>(std::span<const std::uint8_t>(payload_, Layout::kPayloadSize), candidate_) ||
+        candidate_.sequence != sequence) {
+      ++stats_.bad_payloads;
+      return Event::kBadReport;
+    }
     if (have_last_) {
       const auto diff = static_cast<std::int32_t>(sequence - last_sequence_);
       if (diff == 0) {
@@ -87,7 +95,7 @@ class TelemetryDecoder {
     }
     have_last_ = true;
     last_sequence_ = sequence;
-    decode_telemetry_payload<M>(payload_, sequence, record_);
+    record_ = candidate_;
     ++stats_.records;
     return Event::kRecord;
   }
@@ -98,7 +106,8 @@ class TelemetryDecoder {
   std::size_t next_part_ = 0;
   bool have_last_ = false;
   std::uint32_t last_sequence_ = 0;
-  TelemetryRecord<M> record_{};
+  app::PeriodRecord<M> candidate_{};  // the set being decoded
+  app::PeriodRecord<M> record_{};
   TelemetryStats stats_{};
 };
 
