@@ -266,7 +266,7 @@ void check_magnitudes(const LogTable& table, std::span<const std::size_t> column
 }
 
 double log_dt_s(const LogTable& table, const std::string& file_for_errors) {
-  return rules::check_required_metadata(table.metadata, file_for_errors);
+  return rules::check_dt_s(table.metadata, file_for_errors);
 }
 
 LogTable parse_log(std::string_view text, const std::string& file_for_errors) {

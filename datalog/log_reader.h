@@ -23,8 +23,8 @@ LogTable parse_log(std::string_view text, const std::string& file_for_errors);
 LogTable read_log(const std::filesystem::path& path);
 
 // The control period of `table` (its '# dt_s:' line), seconds, checked as
-// the reader checks it: LogError naming that line when missing or outside
-// [rules::kMinDtS, rules::kMaxDtS].
+// the reader checks it (and nothing else of the metadata): LogError naming
+// that line when missing or outside [rules::kMinDtS, rules::kMaxDtS].
 double log_dt_s(const LogTable& table, const std::string& file_for_errors);
 
 // Throws LogError at the first value of `columns` (indices into

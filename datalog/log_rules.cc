@@ -52,6 +52,10 @@ double check_required_metadata(const LogMetadata& metadata, const std::string& f
                        "; the supported format_version is " + std::to_string(kFormatVersion));
   }
 
+  return check_dt_s(metadata, file);
+}
+
+double check_dt_s(const LogMetadata& metadata, const std::string& file) {
   const auto dt = metadata.get("dt_s");
   if (!dt) missing(file, "dt_s", "0.2");
   const auto dt_s = parse_finite_number(*dt);

@@ -29,6 +29,10 @@ inline std::size_t header_line(const LogTable& table) {
 inline constexpr double kMinDtS = 1e-9;
 inline constexpr double kMaxDtS = 1e6;
 
+// Checks `dt_s` alone (present, within [kMinDtS, kMaxDtS]) and returns it in
+// seconds; the error points at its line, or at the whole file when missing.
+double check_dt_s(const LogMetadata& metadata, const std::string& file);
+
 // Checks `format`, `format_version` and `dt_s` (present, valid) and returns
 // dt_s in seconds. Errors point at the entry's line (its position + 1) or at
 // the whole file (line 0) when a key is missing.
