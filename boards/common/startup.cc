@@ -1,5 +1,5 @@
 // Cortex-M start-up shared by every board: the core part of the vector
-// table, Reset_Handler (FPU on, .data copied, .bss zeroed, stack painted,
+// table, Reset_Handler (the board's early-boot hook, FPU on, .data copied, .bss zeroed, stack painted,
 // static constructors, main) and the default exception handlers, which halt.
 // The board appends its interrupt vectors (section .isr_vector.irq, right
 // after this table; see sections.ld). There is no heap: the linker script
@@ -70,6 +70,12 @@ HADYNET_WEAK_HANDLER(SysTick_Handler)
 
 [[noreturn]] void Reset_Handler();
 
+// The board's first word at reset, before the FPU, the vector table offset,
+// .data and .bss are set up (so it may read only .noinit and registers, and
+// must not rely on static initialisers). It may leave for another program
+// (stm32f405: the ROM bootloader after a DFU_DETACH). Default: nothing.
+__attribute__((weak)) void hadynet_board_early_boot() {}
+
 // ARMv7-M B1.5.3: word 0 is the initial stack pointer, words 1..15 the
 // system exceptions; the board's external interrupts follow.
 struct CoreVectorTable {
@@ -100,6 +106,7 @@ __attribute__((section(".isr_vector.core"), used)) const CoreVectorTable g_core_
 
 [[noreturn]] void Reset_Handler() {
   namespace cm = hadynet::board::cortex_m;
+  hadynet_board_early_boot();
   // The FPU first: the code below and everything after may use it.
   cm::reg(cm::kScbCpacr) |= cm::kCpacrCp10Cp11Full;
   cm::data_sync_barrier();

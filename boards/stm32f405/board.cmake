@@ -10,18 +10,26 @@ set(BOARD_CORE_CLOCK_HZ 168000000)
 # External interrupts of the STM32F405 (NVIC lines 0..81).
 set(BOARD_IRQ_COUNT 82)
 # Memory regions: "NAME ORIGIN BYTES ATTRIBUTES KIND", KIND flash or ram.
-#   FLASH at 0x08000000 (aliased at 0 when booting from flash);
+#   FLASH at 0x08000000 (aliased at 0 when booting from flash): the
+#     firmware's sectors 0..7 (512 KiB) only; sectors 8..11 hold the model
+#     slots (firmware/flash/stm32f405_flash_layout.h), so an image that
+#     grows into them fails to link instead of being overwritten by a model;
 #   SRAM (SRAM1 112 KiB + SRAM2 16 KiB, contiguous): data, bss (with the DMA
 #     buffer), then the stack;
 #   CCM (core-coupled, no DMA access): nothing yet. QEMU 7.2's netduinoplus2
 #     maps 192 KiB of SRAM at 0x20000000 and no CCM, so an image that used
 #     the CCM would fault there.
 set(BOARD_MEMORY
-  "FLASH 0x08000000 1048576 rx flash"
+  "FLASH 0x08000000 524288 rx flash"
   "SRAM 0x20000000 131072 rwx ram"
   "CCM 0x10000000 65536 rw ram")
 set(BOARD_REGION_TEXT FLASH)
 set(BOARD_REGION_DATA SRAM)
 set(BOARD_REGION_STACK SRAM)
 set(BOARD_STACK_BYTES 32768)
-set(BOARD_SOURCES board.cc clock_tree.cc loadcells.cc)
+set(BOARD_SOURCES board.cc clock_tree.cc loadcells.cc
+  # The USB device port (boards/board_usb.h): OTG FS driver, embedded flash
+  # behind the DFU model slots, DFU_DETACH into the ROM bootloader.
+  usb_port.cc otg_fs_controller.cc flash_controller.cc system_bootloader.cc)
+# The firmware image carries the USB device (firmware/app/usb_link.cc).
+set(BOARD_HAS_USB TRUE)

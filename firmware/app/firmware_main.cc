@@ -1,23 +1,29 @@
-// The firmware: the q15 runtime behind the UART, and its own 5 Hz loop.
-// Portable: the board (boards/board.h) is whichever one the build links.
+// The firmware: the q15 runtime behind the UART and (on a board with one)
+// the USB device, and its own 5 Hz loop. Portable: the board
+// (boards/board.h) is whichever one the build links, and so is the USB side
+// (usb_link.h: usb_link.cc or usb_link_none.cc).
 //
 //   loop:
 //     every received byte -> UartEndpoint::receive() -> reply bytes -> UART
 //     (uart_endpoint.h: THE place where the link plugs in)
+//     usb_service(): controller events; CDC-ACM bytes -> a second link port
+//       on the same dispatcher (same runtime and loop) -> bulk IN; DFU work
 //     every 0.2 s (SysTick) -> the period (period_loop.h): the board's
 //       loadcells + the newest muscle state from the link -> one runtime
 //       step -> the period record (period_record.h), which the link sends
-//       on request (0x08) and the USB telemetry takes from latest().
+//       on request (0x08) and usb_publish() sends as HID telemetry.
 //
 // All state is static (no heap); the runtime is constructed before main()
 // by the start-up code's static constructors.
 #include <cstdint>
 #include <span>
+#include <type_traits>
 
 #include "boards/board.h"
 #include "firmware/app/channel_layout.h"
 #include "firmware/app/period_loop.h"
 #include "firmware/app/uart_endpoint.h"
+#include "firmware/app/usb_link.h"
 #include "firmware/core/hadynet_runtime.h"
 #include "hadynet_model_q15.h"
 
@@ -27,6 +33,7 @@ using Model = hadynet::model_q15::Model;
 using Loop = hadynet::app::PeriodLoop<Model>;
 
 // Board reading k is the model's loadcell k ("fc<k>"): the counts must agree.
+static_assert(std::is_same_v<Model, hadynet::app::FirmwareModel>, "usb_link.h serves the firmware's model");
 static_assert(hadynet::app::ChannelLayout<Model>::kLoadcells == hadynet::board::kLoadcells,
               "the model's loadcell channels (fc<k>) and the board's loadcells differ in number");
 
@@ -43,18 +50,21 @@ void periodic() noexcept {
   loop.run_period(reading, hadynet::board::overrun_periods());
   const std::uint32_t ticks_per_period = hadynet::board::description().tick_hz / hadynet::board::kPeriodHz;
   loop.end_period(hadynet::board::ticks() - start, ticks_per_period);
+  hadynet::app::usb_publish(loop.latest());
 }
 
 }  // namespace
 
 int main() {
   hadynet::board::init();
+  hadynet::app::usb_start(g_endpoint.dispatcher());
   for (;;) {
     std::uint8_t byte;
     while (hadynet::board::uart_read_byte(byte)) {
       const std::span<const std::uint8_t> reply = g_endpoint.receive(byte);
       if (!reply.empty()) hadynet::board::uart_write(reply.data(), reply.size());
     }
+    hadynet::app::usb_service();
     if (hadynet::board::period_elapsed()) periodic();
   }
 }

@@ -34,6 +34,10 @@ class UartEndpoint {
   // reports (period records); firmware_main.cc runs its periods.
   PeriodLoop<M>& loop() noexcept { return link_.loop(); }
 
+  // The device state behind the link, for a second byte stream on it (the
+  // USB CDC-ACM port, firmware/app/usb_link.h).
+  link::LinkDispatcher<M>& dispatcher() noexcept { return link_.dispatcher(); }
+
  private:
   link::DeviceLink<M> link_;
 };

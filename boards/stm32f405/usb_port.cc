@@ -1,0 +1,82 @@
+// stm32f405's USB device port (boards/board_usb.h): the OTG FS driver on
+// PA11/PA12 without VBUS sensing (PA9 is USART1 TX on this board, and a
+// device powered by its own supply sees VBUS only when plugged: the host
+// then finds the pull-up), the embedded flash behind the DFU model slots
+// (firmware/flash/stm32f405_flash_layout.h), the ROM bootloader as the
+// DFU_DETACH target, and the 96-bit unique ID as the serial number.
+//
+// The driver is polled from the main loop (usb_poll()); the OTG_FS
+// interrupt stays disabled. At most one main-loop pass (one control period's
+// work, ~0.1 s worst case) lies between the core's events and their
+// handling: the core NAKs meanwhile, which USB hosts retry (a control
+// transfer may take up to 5 s by USB 2.0 §9.2.6.4).
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+
+#include "board_config.h"
+#include "boards/board_usb.h"
+#include "boards/stm32f405/flash_controller.h"
+#include "boards/stm32f405/otg_fs_controller.h"
+#include "boards/stm32f405/system_bootloader.h"
+#include "firmware/flash/stm32f405_flash_layout.h"
+
+namespace hadynet::board {
+namespace {
+
+namespace layout = flash::stm32f405;
+
+static_assert(config::kFLASHOrigin + config::kFLASHBytes <=
+                  layout::kFlashBase + std::min(layout::kModelSlotAOffset, layout::kModelSlotBOffset),
+              "the firmware's flash region (board.cmake) overlaps a model slot");
+
+// RM0090 §39.1: the 96-bit unique device ID, read-only, 12 bytes.
+constexpr std::uintptr_t kUniqueIdAddress = 0x1FFF7A10;
+
+stm32::otg::OtgFsMmio g_otg_registers;
+stm32::Stm32f405OtgFsHooks g_otg_hooks;
+stm32::OtgFsController<stm32::otg::OtgFsMmio> g_otg(g_otg_registers, g_otg_hooks,
+                                                     stm32::OtgFsOptions{.vbus_sensing = false,
+                                                                         .ahb_clock_hz = config::kCoreClockHz});
+stm32::FlashController g_flash(stm32::flash_interface_registers(), stm32::flash_memory_window(),
+                               config::kCoreClockHz);
+stm32::SystemBootloaderDetach g_detach;
+
+// Alt 0 receives a model into slot B; alt 1 reads slot A (the provisional
+// active slot until the model-update issue defines the boot rule).
+constexpr usb::DfuTarget kModelSlots[usb::composite::kDfuAlternates] = {
+    {{layout::kModelSlotBOffset, layout::kModelSlotSize}, /*can_download=*/true, /*can_upload=*/true},
+    {{layout::kModelSlotAOffset, layout::kModelSlotSize}, /*can_download=*/false, /*can_upload=*/true},
+};
+
+std::uint8_t g_unique_id[usb::kUniqueIdBytes];
+
+constexpr UsbPort kPort{g_otg, g_flash, std::span<const usb::DfuTarget, usb::composite::kDfuAlternates>(kModelSlots),
+                        g_detach, std::span<const std::uint8_t, usb::kUniqueIdBytes>(g_unique_id)};
+
+// True once the core, clocked, reports its AHB master idle (GRSTCTL.AHBIDL,
+// 1 whenever the core is idle after a reset; RM0090 §34.16.3), within a
+// bounded number of reads. An emulator that maps no OTG FS core (QEMU's
+// netduinoplus2 reads zeros there) never does.
+bool core_answers() noexcept {
+  g_otg_hooks.enable_clocks_and_pins();
+  for (std::uint32_t read = 0; read < decltype(g_otg)::kPollLimit; ++read) {
+    if ((g_otg_registers.read(stm32::otg::kGrstctl) & stm32::otg::kGrstctlAhbIdle) != 0) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+const UsbPort* usb_port() noexcept {
+  if (!core_answers()) return nullptr;
+  // The unique ID, as the MCU stores it (byte 0 at the lowest address). Read
+  // only on the real MCU: QEMU maps nothing there (a bus fault).
+  const auto* id = reinterpret_cast<const volatile std::uint8_t*>(kUniqueIdAddress);
+  for (std::size_t i = 0; i < usb::kUniqueIdBytes; ++i) g_unique_id[i] = id[i];
+  return &kPort;
+}
+
+void usb_poll() noexcept { g_otg.poll(); }
+
+}  // namespace hadynet::board
