@@ -37,6 +37,8 @@ constexpr Command kCommands[] = {
      hadynet::cli::run_replay},
     {"link", "talk to a device running the firmware over its serial link (info, reset, mode, pb)",
      hadynet::cli::run_link},
+    {"devices", "list the HADYNET MCUs on USB (serial, firmware, model hash) and STM32 ROM bootloaders",
+     hadynet::cli::run_devices},
     {"stabilize",
      "host-sim: the grasp stabiliser in closed loop with the MuJoCo hand under a scripted disturbance (E with/without)",
      hadynet::cli::run_stabilize},
