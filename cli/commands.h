@@ -16,6 +16,7 @@ int run_detect(int argc, char** argv);
 int run_replay(int argc, char** argv);
 int run_link(int argc, char** argv);
 int run_devices(int argc, char** argv);
+int run_monitor(int argc, char** argv);
 int run_stabilize(int argc, char** argv);
 int run_measure_ranges(int argc, char** argv);
 int run_codegen(int argc, char** argv);

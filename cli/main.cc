@@ -39,6 +39,8 @@ constexpr Command kCommands[] = {
      hadynet::cli::run_link},
     {"devices", "list the HADYNET MCUs on USB (serial, firmware, model hash) and STM32 ROM bootloaders",
      hadynet::cli::run_devices},
+    {"monitor", "the MCU's telemetry over USB: a line per period, drops counted, logs and a plot",
+     hadynet::cli::run_monitor},
     {"stabilize",
      "host-sim: the grasp stabiliser in closed loop with the MuJoCo hand under a scripted disturbance (E with/without)",
      hadynet::cli::run_stabilize},
