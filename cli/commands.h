@@ -17,6 +17,7 @@ int run_replay(int argc, char** argv);
 int run_link(int argc, char** argv);
 int run_devices(int argc, char** argv);
 int run_monitor(int argc, char** argv);
+int run_flash(int argc, char** argv);
 int run_stabilize(int argc, char** argv);
 int run_measure_ranges(int argc, char** argv);
 int run_codegen(int argc, char** argv);

@@ -41,6 +41,8 @@ constexpr Command kCommands[] = {
      hadynet::cli::run_devices},
     {"monitor", "the MCU's telemetry over USB: a line per period, drops counted, logs and a plot",
      hadynet::cli::run_monitor},
+    {"flash", "firmware (or --model a model) into the MCU over USB: erase, write, read back, verify",
+     hadynet::cli::run_flash},
     {"stabilize",
      "host-sim: the grasp stabiliser in closed loop with the MuJoCo hand under a scripted disturbance (E with/without)",
      hadynet::cli::run_stabilize},
