@@ -15,7 +15,7 @@ packages=(
   # firmware cross build and emulation (python3: the QEMU test runner, test/boards/qemu_run.py)
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm python3
   # host USB tools and their tests
-  libusb-1.0-0-dev libhidapi-dev umockdev libumockdev-dev
+  libusb-1.0-0-dev libhidapi-dev umockdev libumockdev-dev dfu-util
   # link fuzzer (fuzz/): clang with libFuzzer and the sanitizer runtimes
   clang libclang-rt-dev
 )
