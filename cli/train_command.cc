@@ -6,10 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <stdexcept>
 #include <thread>
 
@@ -24,6 +22,7 @@
 #include "trainer/deploy_prep.h"
 #include "trainer/model_file.h"
 #include "trainer/training.h"
+#include "trainer/training_record.h"
 
 namespace hadynet::cli {
 namespace fs = std::filesystem;
@@ -49,15 +48,6 @@ std::string duration(double seconds) {
   } else {
     std::snprintf(buf, sizeof buf, "%ldm%02lds", s / 60, s % 60);
   }
-  return buf;
-}
-
-std::string utc_now() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
   return buf;
 }
 
@@ -166,23 +156,9 @@ int run_train(int argc, char** argv) {
     std::vector<trainer::LogSequence> sequences;
     for (const std::string& path : paths) sequences.push_back(trainer::read_sequence(path, layout));
 
-    // PB table: one row per state, sorted by name; one object label per state.
-    std::map<std::string, std::string> object_of_state;
-    for (const auto& seq : sequences) {
-      const auto [it, inserted] = object_of_state.emplace(seq.state, seq.object);
-      if (!inserted && it->second != seq.object) {
-        throw std::runtime_error(seq.file + ": state '" + seq.state + "' has object '" +
-                                 seq.object + "' here but '" + it->second + "' in another log");
-      }
-    }
-    std::vector<trainer::PbState> states;
-    std::map<std::string, int> row_of_state;
-    for (const auto& [state, object] : object_of_state) {
-      row_of_state[state] = static_cast<int>(states.size());
-      states.push_back({state, object});
-    }
-    std::vector<int> state_of_sequence;
-    for (const auto& seq : sequences) state_of_sequence.push_back(row_of_state.at(seq.state));
+    const trainer::PbStateTable pb_table = trainer::pb_state_table(sequences);
+    const std::vector<trainer::PbState>& states = pb_table.states;
+    const std::vector<int>& state_of_sequence = pb_table.state_of_sequence;
 
     const trainer::Normalization norm = trainer::fit_normalization(sequences, layout);
     const trainer::WindowDataset data(sequences, state_of_sequence, layout, norm,
@@ -192,22 +168,9 @@ int run_train(int argc, char** argv) {
     trainer::HadynetModel model =
         trainer::new_model(layout, norm, states, static_cast<int>(*pb), static_cast<int>(*hidden),
                            static_cast<int>(*steps), options.seed);
-    model.provenance = {{"data_hash", trainer::content_hash(paths)},
-                        {"git_commit", HADYNET_GIT_COMMIT},
-                        {"hadynet_version", HADYNET_VERSION},
-                        {"logs", std::to_string(paths.size())},
-                        {"created_utc", utc_now()}};
-    model.hyper_parameters = {{"epochs", std::to_string(options.epochs)},
-                              {"batch", std::to_string(options.batch)},
-                              {"steps", std::to_string(*steps)},
-                              {"lr", opt.get("lr")},
-                              {"optimizer", "Adam(beta1=0.9, beta2=0.999, eps=1e-8)"},
-                              {"seed", std::to_string(options.seed)},
-                              {"variable_pb", options.variable_pb ? "true" : "false"},
-                              {"held_out_fraction", opt.get("held-out")},
-                              {"train_windows", std::to_string(split.train.size())},
-                              {"held_out_windows", std::to_string(split.held_out.size())},
-                              {"loss", "MSE, standardised units"}};
+    model.provenance = trainer::training_provenance(paths, HADYNET_GIT_COMMIT, HADYNET_VERSION);
+    model.hyper_parameters = trainer::training_hyper_parameters(
+        options, {static_cast<int>(*steps), opt.get("lr"), opt.get("held-out"), split.train.size(), split.held_out.size()});
 
     trainer::TrainingState state;
     if (opt.has("resume")) {

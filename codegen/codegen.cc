@@ -13,9 +13,10 @@
 #include <limits>
 #include <map>
 #include <set>
-#include <unistd.h>
 #include <utility>
 
+#include "datalog/atomic_file.h"
+#include "datalog/content_hash.h"
 #include "firmware/core/fixed_point.h"
 #include "trainer/derived_inputs.h"
 #include "trainer/deploy_prep.h"
@@ -627,15 +628,6 @@ Eigen::MatrixXd whitening_matrix(const Eigen::MatrixXd& inverse) {
   return lambda.cwiseSqrt().asDiagonal() * v.transpose();
 }
 
-std::uint64_t fnv1a64(std::string_view bytes) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (const char c : bytes) {
-    h ^= static_cast<unsigned char>(c);
-    h *= 0x100000001b3ULL;
-  }
-  return h;
-}
-
 Formats choose_formats(const HadynetModel& model, const CodegenOptions& options) {
   check_model(model);
   check_options(model, options);
@@ -1068,7 +1060,7 @@ LoadedModel load_model_file(const std::string& path) {
   }
   LoadedModel loaded{trainer::model_from_safetensors(file, path), {}};
   loaded.identity.file_name = fs::path(path).filename().string();
-  loaded.identity.hash = fnv1a64(bytes);
+  loaded.identity.hash = datalog::fnv1a64(bytes);
   return loaded;
 }
 
@@ -1085,23 +1077,10 @@ WriteResult write_header(const std::string& dir, const GeneratedHeader& header) 
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw std::runtime_error(dir + ": cannot create the directory: " + ec.message());
-  const fs::path tmp =
-      fs::path(dir) / ("." + header.file_name + ".tmp-" + std::to_string(::getpid()));
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out.write(header.text.data(), static_cast<std::streamsize>(header.text.size()));
-    out.close();
-    if (!out) {
-      fs::remove(tmp, ec);
-      throw std::runtime_error(tmp.string() + ": cannot write");
-    }
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw std::runtime_error(path.string() + ": cannot rename the temporary file onto it: " +
-                             ec.message());
+  try {
+    datalog::write_file_atomically(path, header.text);
+  } catch (const datalog::AtomicWriteError& e) {
+    throw std::runtime_error(std::string("cannot write the generated header: ") + e.what());
   }
   result.changed = true;
   return result;

@@ -110,13 +110,10 @@ Formats choose_formats(const trainer::HadynetModel& model, const CodegenOptions&
 // 1e-9) or not positive definite.
 Eigen::MatrixXd whitening_matrix(const Eigen::MatrixXd& inverse);
 
-// FNV-1a 64 of bytes (the model hash, kModelHash).
-std::uint64_t fnv1a64(std::string_view bytes);
-
 // Where the model came from, stamped into the header.
 struct ModelIdentity {
   std::string file_name;  // shown in the header comment (a base name keeps it build-dir independent)
-  std::uint64_t hash = 0; // fnv1a64 of the model file's bytes
+  std::uint64_t hash = 0; // datalog::fnv1a64 of the model file's bytes (kModelHash)
 };
 
 struct GeneratedHeader {

@@ -1,14 +1,10 @@
 #include "datalog/log_writer.h"
 
-#include <fcntl.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
-#include <cerrno>
 #include <cmath>
-#include <system_error>
 
+#include "datalog/atomic_file.h"
 #include "datalog/log_reader.h"
 #include "datalog/log_rules.h"
 
@@ -97,93 +93,13 @@ std::string format_log(const LogTable& table, const std::string& file_for_errors
   return out;
 }
 
-namespace {
-
-// Removes the temporary file unless release()d.
-class TemporaryFile {
- public:
-  explicit TemporaryFile(std::filesystem::path path) : path_(std::move(path)) {}
-  TemporaryFile(const TemporaryFile&) = delete;
-  TemporaryFile& operator=(const TemporaryFile&) = delete;
-  ~TemporaryFile() {
-    if (!released_) ::unlink(path_.c_str());
-  }
-  void release() { released_ = true; }
-
- private:
-  std::filesystem::path path_;
-  bool released_ = false;
-};
-
-std::atomic<unsigned> temporary_counter{0};
-
-}  // namespace
-
 void write_log(const std::filesystem::path& path, const LogTable& table) {
   const std::string file = path.string();
   const std::string text = format_log(table, file);
-  const auto fail = [&](std::string_view what, int error) {
-    return LogError(file, 0, 0, "",
-                    "cannot write log file: " + std::string(what) + ": " +
-                        std::generic_category().message(error));
-  };
-
-  if (!path.has_filename()) throw LogError(file, 0, 0, "", "cannot write log file: no file name");
-  const std::filesystem::path folder =
-      path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-
-  // A name no other writer uses: hidden, same folder (rename stays atomic),
-  // process id plus a per-process counter; O_EXCL guards against leftovers.
-  int fd = -1;
-  std::filesystem::path temporary_path;
-  for (int attempt = 0; fd < 0; ++attempt) {
-    std::string name(1, '.');
-    name += path.filename().string();
-    name += ".tmp-";
-    name += std::to_string(::getpid());
-    name += '-';
-    name += std::to_string(temporary_counter.fetch_add(1));
-    temporary_path = folder / name;
-    fd = ::open(temporary_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    const int error = errno;
-    if (fd < 0 && (error != EEXIST || attempt >= 100)) {
-      throw fail("create temporary file " + temporary_path.string(), error);
-    }
-  }
-  TemporaryFile temporary(temporary_path);
-
-  std::size_t written = 0;
-  while (written < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
-    if (n < 0) {
-      const int error = errno;
-      if (error == EINTR) continue;
-      ::close(fd);
-      throw fail("write " + temporary_path.string(), error);
-    }
-    written += static_cast<std::size_t>(n);
-  }
-  if (::fsync(fd) != 0) {
-    const int error = errno;
-    ::close(fd);
-    throw fail("fsync " + temporary_path.string(), error);
-  }
-  if (::close(fd) != 0) {
-    const int error = errno;
-    throw fail("close " + temporary_path.string(), error);
-  }
-  if (::rename(temporary_path.c_str(), path.c_str()) != 0) {
-    const int error = errno;
-    throw fail("rename " + temporary_path.string() + " to " + file, error);
-  }
-  temporary.release();
-
-  // Make the rename itself durable. Best effort: the file is already complete
-  // under its final name, so a failure here is not reported.
-  const int folder_fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (folder_fd >= 0) {
-    ::fsync(folder_fd);
-    ::close(folder_fd);
+  try {
+    write_file_atomically(path, text);
+  } catch (const AtomicWriteError& e) {
+    throw LogError(file, 0, 0, "", std::string("cannot write log file: ") + e.what());
   }
 }
 

@@ -13,7 +13,7 @@ set(host_fuzz_flags -std=c++20 -O2 -g -fno-omit-frame-pointer ${fuzz_sanitize}
     -Wall -Wextra -Wno-unknown-pragmas)
 
 set(fuzz_datalog_sources "")
-foreach(f dataset_manifest log_error log_reader log_rules log_table log_writer)
+foreach(f atomic_file dataset_manifest log_error log_reader log_rules log_table log_writer)
   list(APPEND fuzz_datalog_sources "${PROJECT_SOURCE_DIR}/datalog/${f}.cc")
 endforeach()
 hadynet_fuzzer(log_fuzzer

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "datalog/content_hash.h"
 #include "datalog/log_limits.h"
 #include "datalog/log_reader.h"
 #include "trainer/derived_inputs.h"
@@ -193,13 +194,8 @@ std::vector<std::string> expand_log_paths(const std::vector<std::string>& args) 
 }
 
 std::string content_hash(const std::vector<std::string>& paths) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  const auto mix = [&h](const char* data, std::size_t n) {
-    for (std::size_t i = 0; i < n; ++i) {
-      h ^= static_cast<unsigned char>(data[i]);
-      h *= 0x100000001b3ULL;
-    }
-  };
+  datalog::Fnv1a64 h;
+  const auto mix = [&h](const char* data, std::size_t n) { h.update(std::string_view(data, n)); };
   std::vector<char> buffer(1 << 16);
   for (const std::string& path : paths) {
     const std::string name = std::filesystem::path(path).filename().string();
@@ -212,7 +208,7 @@ std::string content_hash(const std::vector<std::string>& paths) {
     }
   }
   char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h.value()));
   return hex;
 }
 

@@ -5,7 +5,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <cerrno>
 #include <charconv>
@@ -18,6 +17,8 @@
 #include <system_error>
 #include <tuple>
 #include <utility>
+
+#include "datalog/atomic_file.h"
 
 namespace hadynet::trainer::safetensors {
 
@@ -338,23 +339,6 @@ class HeaderParser {
 
 // ---- writing ----
 
-std::atomic<unsigned> temporary_counter{0};
-
-// Removes a temporary file unless released.
-class TemporaryFile {
- public:
-  explicit TemporaryFile(std::string path) : path_(std::move(path)) {}
-  TemporaryFile(const TemporaryFile&) = delete;
-  TemporaryFile& operator=(const TemporaryFile&) = delete;
-  ~TemporaryFile() {
-    if (!path_.empty()) ::unlink(path_.c_str());
-  }
-  void release() { path_.clear(); }
-
- private:
-  std::string path_;
-};
-
 // Throws unless `s` is valid UTF-8 (as nlohmann's dump() would on output).
 void check_utf8(const std::string& s, const std::string& what, const std::string& origin) {
   try {
@@ -621,65 +605,10 @@ File read_file(const std::string& path) { return parse(read_bytes(path), path); 
 
 void write_file(const std::string& path, const File& file) {
   const std::string bytes = serialize(file, path);
-  const auto fail = [&](const std::string& what, int error) {
-    return FormatError(path, "cannot write safetensors file: " + what + ": " +
-                                 std::generic_category().message(error));
-  };
-
-  const std::filesystem::path target(path);
-  if (!target.has_filename()) {
-    throw FormatError(path, "cannot write safetensors file: no file name");
-  }
-  const std::filesystem::path folder =
-      target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
-
-  // Hidden, in the same directory (so the rename is atomic), unique per
-  // process and call; O_EXCL never reuses a leftover.
-  int fd = -1;
-  std::string temporary_path;
-  for (int attempt = 0; fd < 0; ++attempt) {
-    temporary_path =
-        (folder / ("." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                   std::to_string(temporary_counter.fetch_add(1))))
-            .string();
-    fd = ::open(temporary_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    const int error = errno;
-    if (fd < 0 && (error != EEXIST || attempt >= 100))
-      throw fail("create " + temporary_path, error);
-  }
-  TemporaryFile temporary(temporary_path);
-
-  std::size_t written = 0;
-  while (written < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
-    if (n < 0) {
-      const int error = errno;
-      if (error == EINTR) continue;
-      ::close(fd);
-      throw fail("write " + temporary_path, error);
-    }
-    written += static_cast<std::size_t>(n);
-  }
-  if (::fsync(fd) != 0) {
-    const int error = errno;
-    ::close(fd);
-    throw fail("fsync " + temporary_path, error);
-  }
-  if (::close(fd) != 0) {
-    const int error = errno;
-    throw fail("close " + temporary_path, error);
-  }
-  if (::rename(temporary_path.c_str(), path.c_str()) != 0) {
-    const int error = errno;
-    throw fail("rename " + temporary_path + " to " + path, error);
-  }
-  temporary.release();
-
-  // Make the rename durable. Best effort: the complete file is already in place.
-  const int folder_fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (folder_fd >= 0) {
-    ::fsync(folder_fd);
-    ::close(folder_fd);
+  try {
+    datalog::write_file_atomically(path, bytes);
+  } catch (const datalog::AtomicWriteError& e) {
+    throw FormatError(path, std::string("cannot write safetensors file: ") + e.what());
   }
 }
 

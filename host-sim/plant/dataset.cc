@@ -11,6 +11,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include "datalog/atomic_file.h"
 #include "datalog/log_writer.h"
 
 namespace hadynet::plant {
@@ -118,13 +119,11 @@ DatasetSummary collect_dataset(const std::vector<ExperimentSpec>& specs, const C
     summary.physics_steps += physics[i];
   }
   const fs::path manifest_path = options.out_dir / "manifest.json";
-  const fs::path tmp = options.out_dir / ".manifest.json.tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    out << manifest.dump(2) << '\n';
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+  try {
+    datalog::write_file_atomically(manifest_path, manifest.dump(2) + "\n");
+  } catch (const datalog::AtomicWriteError& e) {
+    throw std::runtime_error(std::string("cannot write the dataset manifest: ") + e.what());
   }
-  fs::rename(tmp, manifest_path);
   summary.logs = static_cast<int>(specs.size());
   summary.wall_seconds = elapsed();
   return summary;

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "trainer/derived_inputs.h"
+#include "trainer/residual/analysis.h"
 
 namespace hadynet::trainer::residual {
 
@@ -22,11 +23,6 @@ std::string join(const std::vector<std::string>& v) {
   std::string s;
   for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + v[i];
   return s;
-}
-
-std::string verdict_of(const Attribution& a) {
-  const auto w = a.winner();
-  return w ? w->effect + ": " + w->label : "no significant effect";
 }
 
 }  // namespace
@@ -348,7 +344,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   std::vector<Eigen::VectorXf> before_pbs;
   for (const auto& log : data.logs) before_pbs.push_back(log.pb);
   result.before = held_out_error(model, eval_logs(model, before_pbs));
-  result.before.verdict = verdict_of(attribution);
+  result.before.verdict = verdict_text(attribution);
 
   if (aug == nullptr) {
     result.status = "no significant effect";
@@ -440,7 +436,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     }
   }
   LibraryOptions lib;
-  result.after.verdict = verdict_of(attribute(again, enumerate_hypotheses(again, lib), attribution.options));
+  result.after.verdict = verdict_text(attribute(again, enumerate_hypotheses(again, lib), attribution.options));
   result.model = std::move(after);
   result.changed = true;
   result.status = "fixed";

@@ -1,0 +1,69 @@
+#include "trainer/residual/analysis.h"
+
+#include <stdexcept>
+
+namespace hadynet::trainer::residual {
+
+Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, const AnalysisOptions& options) {
+  Analysis a;
+  a.max_lag = options.max_lag;
+  a.data = compute_residuals(model, logs, options.pb_choice);
+  a.horizon = horizon_metrics(model, a.data, options.horizon > 0 ? options.horizon : model.train_steps);
+  if (!a.horizon.rmse.allFinite()) {
+    throw std::runtime_error("the model's prediction is not finite on these logs (float32 overflow in the "
+                             "network); no residual can be analysed");
+  }
+  const auto& d = a.data;
+  const std::size_t ny = d.y_names.size(), nu = d.u_names.size();
+  a.with_inputs.assign(ny, {});
+  a.with_observed.assign(ny, std::vector<CrossCorrelation>(ny));
+  std::vector<Segments> inputs, observed;
+  for (std::size_t j = 0; j < nu; ++j) inputs.push_back(input_segments(d, static_cast<int>(j)));
+  for (std::size_t j = 0; j < ny; ++j) observed.push_back(observed_segments(d, static_cast<int>(j)));
+  for (std::size_t c = 0; c < ny; ++c) {
+    const Segments r = residual_segments(d, static_cast<int>(c));
+    a.whiteness.push_back(whiteness(r, a.max_lag));
+    for (std::size_t j = 0; j < nu; ++j) a.with_inputs[c].push_back(cross_correlate(r, inputs[j], a.max_lag));
+    for (std::size_t j = 0; j < ny; ++j)
+      if (j != c) a.with_observed[c][j] = cross_correlate(r, observed[j], a.max_lag);
+  }
+  a.attribution = attribute(d, enumerate_hypotheses(d, options.library), options.attribution);
+  a.verdict = verdict_text(a.attribution);
+  return a;
+}
+
+std::string verdict_text(const Attribution& attribution) {
+  const auto w = attribution.winner();
+  if (!w) return "no significant effect";
+  std::string v = w->effect + ": " + w->label;
+  const auto family = attribution.winner_family();
+  if (family.size() > 1) {
+    v += "; also significant:";
+    for (std::size_t i = 1; i < family.size(); ++i) {
+      v += (i > 1 ? ", " : " ");
+      v += family[i].label;
+    }
+  }
+  return v;
+}
+
+const HypothesisResult* hypothesis_to_show(const Attribution& attribution) {
+  if (!attribution.ranked.empty() && attribution.ranked.front().significant) return &attribution.ranked.front();
+  const HypothesisResult* best = nullptr;
+  for (const auto& r : attribution.ranked)
+    if (r.testable && (best == nullptr || r.explained_std > best->explained_std)) best = &r;
+  return best;
+}
+
+Segments fitted_segments(const ResidualData& data, const HypothesisResult& result) {
+  Segments out;
+  for (const auto& log : data.logs) {
+    const Features f = features(result.hypothesis, log);
+    Eigen::VectorXd p = f.z * result.coef;
+    p.head(f.first_valid).setZero();
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+}  // namespace hadynet::trainer::residual

@@ -1,0 +1,59 @@
+// The analysis half of the residual loop as one call (docs/residual.md): a
+// model's residuals over logs, its multi-step fit, the residual tests
+// (whiteness, independence) and the effect library's attribution, with one
+// verdict text. `hadynet residual` is a shell around analyse() and the
+// report writers (cli/residual_report.h); tests and benchmarks call it the
+// same way.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "trainer/hadynet_model.h"
+#include "trainer/residual/attribution.h"
+#include "trainer/residual/effects.h"
+#include "trainer/residual/residuals.h"
+#include "trainer/residual/whiteness.h"
+
+namespace hadynet::trainer::residual {
+
+struct AnalysisOptions {
+  std::string pb_choice = "auto";  // compute_residuals(): auto, state, adapt, zero, a state, values
+  int horizon = 0;                 // multi-step horizon in steps; 0: the model's N_train
+  int max_lag = kDefaultMaxLag;    // whiteness lags 1..L, independence -L..L
+  LibraryOptions library;          // which hypotheses are enumerated
+  AttributionOptions attribution;  // how they are fitted and tested
+};
+
+// Everything the analysis computes.
+struct Analysis {
+  ResidualData data;
+  HorizonMetrics horizon;
+  int max_lag = kDefaultMaxLag;
+  std::vector<Whiteness> whiteness;                         // per y channel
+  std::vector<std::vector<CrossCorrelation>> with_inputs;    // [c][j]: residual of y_c with u_j
+  std::vector<std::vector<CrossCorrelation>> with_observed;  // [c][j]: with y_j (j != c; [c][c] empty)
+  Attribution attribution;
+  std::string verdict;  // verdict_text(attribution)
+};
+
+// Runs the whole analysis. Throws std::runtime_error naming the log or the
+// bad PB text (compute_residuals), or when the model's prediction is not
+// finite on these logs (never a table of NaN with a verdict under it).
+Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, const AnalysisOptions& options);
+
+// The one wording of a verdict: "no significant effect", or
+// "<effect>: <winner's label>; also significant: <label>, ..." listing the
+// rest of the winner's family (the same effect on other channels).
+std::string verdict_text(const Attribution& attribution);
+
+// The hypothesis a report shows in detail: the winner when there is one,
+// else the testable hypothesis that explains most in standardised units
+// (labelled "not significant"); nullptr when nothing was testable.
+const HypothesisResult* hypothesis_to_show(const Attribution& attribution);
+
+// The fitted prediction Z beta of a hypothesis, per log (0 where the
+// regressors are undefined).
+Segments fitted_segments(const ResidualData& data, const HypothesisResult& result);
+
+}  // namespace hadynet::trainer::residual
