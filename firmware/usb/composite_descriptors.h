@@ -106,7 +106,7 @@ constexpr DescriptorBytes build_configuration() noexcept {
   // DFU runtime (firmware through the ROM bootloader).
   d.interface(kDfuRuntimeInterface, 0, 0, dfu::kClassApplicationSpecific, dfu::kSubclassDfu, dfu::kProtocolRuntime,
               string_index::kDfuRuntime);
-  d.dfu_functional(kDfuRuntimeAttributes, kDfuRomTransferSize);
+  d.dfu_functional(kDfuRuntimeAttributes, kDfuTransferSize);
   // DFU mode (model images), one functional descriptor after each alternate.
   d.interface(kDfuModeInterface, 0, 0, dfu::kClassApplicationSpecific, dfu::kSubclassDfu, dfu::kProtocolDfuMode,
               string_index::kDfuSlotInactive);

@@ -25,10 +25,13 @@ class DetachHook {
   ~DetachHook() = default;
 };
 
-// wDetachTimeOut (ms) and wTransferSize (the ROM DfuSe bootloader's, bytes)
-// in the runtime functional descriptor.
+// wDetachTimeOut (ms) in the runtime functional descriptor. Its wTransferSize
+// is the model interface's (kDfuTransferSize, dfu_mode.h), not the ROM
+// bootloader's: dfu-util 0.11 takes the first DFU functional descriptor of
+// the configuration for every interface, so a larger value here would make
+// it send blocks the model interface STALLs. The ROM bootloader reports its
+// own after DFU_DETACH re-enumerates the MCU.
 inline constexpr std::uint16_t kDfuDetachTimeoutMs = 1000;
-inline constexpr std::uint16_t kDfuRomTransferSize = 2048;
 
 class DfuRuntime final : public UsbFunction {
  public:

@@ -1,5 +1,5 @@
 // The firmware's USB device through the real libusb (1.0.26) and the Linux
-// usbfs backend, served by the umockdev fixture (umockdev_usb_device.h). Run
+// usbfs backend, served by the umockdev testbed (usb_testbed.h) with the hand (hand_device.h). Run
 // under umockdev-wrapper (CTest does). Expected values are written from
 // docs/usb.md and the specs, not taken from the firmware's tables; all are
 // exact (descriptors, bytes, records bit for bit). Every libusb call that
@@ -24,34 +24,36 @@
 #include "firmware/link/messages.h"
 #include "firmware/link/stream_decoder.h"
 #include "firmware/usb/telemetry_decoder.h"
-#include "test/usb_host/umockdev_usb_device.h"
+#include "test/usb_host/hand_device.h"
+#include "test/usb_host/test_records.h"
+#include "test/usb_host/usb_testbed.h"
 
 namespace hadynet::usb::host_testing {
 namespace {
 
 constexpr unsigned kTimeoutMs = 1000;
-constexpr std::uint16_t kVid = 0x1209;
-constexpr std::uint16_t kPid = 0x0001;
 
 class UsbHost : public ::testing::Test {
  protected:
   void SetUp() override {
-    device_ = std::make_unique<UmockdevUsbDevice>();
-    ASSERT_TRUE(device_->ok()) << device_->error();
+    bus_ = std::make_unique<UsbTestbed>();
+    ASSERT_TRUE(bus_->ok()) << bus_->error();
+    hand_ = std::make_shared<HandDevice>();
+    ASSERT_TRUE(bus_->plug(kHandDevnum, hand_)) << bus_->error();
     ASSERT_EQ(libusb_init(&ctx_), 0);
   }
   void TearDown() override {
     if (handle_ != nullptr) libusb_close(handle_);
     if (ctx_ != nullptr) libusb_exit(ctx_);
-    if (device_ != nullptr) {
-      const UmockdevUsbStats st = device_->stats();
+    if (bus_ != nullptr) {
+      const UsbNodeStats st = bus_->stats(kHandDevnum);
       RecordProperty("usbfs_ioctls", std::to_string(st.ioctls));
       RecordProperty("urbs", std::to_string(st.urbs_submitted) + " submitted, " + std::to_string(st.urbs_reaped) +
                                  " reaped, " + std::to_string(st.urbs_discarded) + " discarded, " +
                                  std::to_string(st.naks) + " NAKs");
-      EXPECT_EQ(device_->stats().unknown_ioctls, 0u) << "last: 0x" << std::hex << device_->stats().last_unknown_ioctl;
+      EXPECT_EQ(st.unknown_ioctls, 0u) << "last: 0x" << std::hex << st.last_unknown_ioctl;
     }
-    device_.reset();
+    bus_.reset();
   }
 
   // Opens 1209:0001 into handle_ (fails the test if it cannot).
@@ -67,7 +69,12 @@ class UsbHost : public ::testing::Test {
     return std::string(reinterpret_cast<const char*>(text), static_cast<std::size_t>(n));
   }
 
-  std::unique_ptr<UmockdevUsbDevice> device_;
+  void publish(const app::PeriodRecord<Q>& r) {
+    bus_->locked([&] { hand_->publish(r); });
+  }
+
+  std::unique_ptr<UsbTestbed> bus_;
+  std::shared_ptr<HandDevice> hand_;
   libusb_context* ctx_ = nullptr;
   libusb_device_handle* handle_ = nullptr;
 };
@@ -84,8 +91,8 @@ TEST_F(UsbHost, DeviceListHasExactlyTheHand) {
     ASSERT_EQ(libusb_get_device_descriptor(list[i], &d), 0);
     if (d.idVendor != kVid || d.idProduct != kPid) continue;
     ++hands;
-    EXPECT_EQ(libusb_get_bus_number(list[i]), device_->busnum());
-    EXPECT_EQ(libusb_get_device_address(list[i]), device_->devnum());
+    EXPECT_EQ(libusb_get_bus_number(list[i]), UsbTestbed::kBusnum);
+    EXPECT_EQ(libusb_get_device_address(list[i]), kHandDevnum);
     EXPECT_EQ(libusb_get_device_speed(list[i]), LIBUSB_SPEED_FULL);
   }
   EXPECT_EQ(n, 1);
@@ -188,10 +195,11 @@ TEST_F(UsbHost, WireDescriptorsEqualSysfsAndStringsReadBack) {
   std::vector<std::uint8_t> buffer(1024);
   int n = libusb_get_descriptor(handle_, LIBUSB_DT_DEVICE, 0, buffer.data(), 18);
   ASSERT_EQ(n, 18) << libusb_error_name(n);
-  EXPECT_EQ(std::vector<std::uint8_t>(buffer.begin(), buffer.begin() + n), device_->device_descriptor());
+  EXPECT_EQ(std::vector<std::uint8_t>(buffer.begin(), buffer.begin() + n),
+            bus_->enumerated(kHandDevnum).device_descriptor);
   n = libusb_get_descriptor(handle_, LIBUSB_DT_CONFIG, 0, buffer.data(), static_cast<int>(buffer.size()));
   ASSERT_GT(n, 0) << libusb_error_name(n);
-  EXPECT_EQ(std::vector<std::uint8_t>(buffer.begin(), buffer.begin() + n), device_->configuration_descriptor());
+  EXPECT_EQ(std::vector<std::uint8_t>(buffer.begin(), buffer.begin() + n), bus_->enumerated(kHandDevnum).configuration);
 
   EXPECT_EQ(string_descriptor(1), "HADYNET project");
   EXPECT_EQ(string_descriptor(2), "HADYNET forearm");
@@ -210,8 +218,6 @@ TEST_F(UsbHost, WireDescriptorsEqualSysfsAndStringsReadBack) {
   ASSERT_EQ(libusb_get_configuration(handle_, &configuration), 0);
   EXPECT_EQ(configuration, 1);
 }
-
-app::PeriodRecord<Q> record(std::uint32_t sequence);
 
 // ---- (b) the link over the CDC bulk endpoints ----
 
@@ -312,7 +318,7 @@ TEST_F(UsbHost, ClearHaltOnTheHidEndpointKeepsTelemetryFlowing) {
   open();
   ASSERT_EQ(libusb_claim_interface(handle_, 2), 0);
   ASSERT_EQ(libusb_clear_halt(handle_, 0x83), 0);
-  device_->publish(record(1));
+  publish(record(1));
   std::uint8_t report[64];
   int got = 0;
   TelemetryDecoder<Q> decoder;
@@ -358,7 +364,7 @@ TEST_F(UsbHost, BackToBackRequestsAreFlowControlledNotLost) {
   libusb_fill_bulk_transfer(t, handle_, 0x02, out.data(), static_cast<int>(out.size()), on_async_done, &done,
                             5 * kTimeoutMs);
   ASSERT_EQ(libusb_submit_transfer(t), 0);
-  const std::uint64_t naks_before_reading = device_->stats().naks;
+  const std::uint64_t naks_before_reading = bus_->stats(kHandDevnum).naks;
 
   link::StreamDecoder rx;
   int replies = 0;
@@ -453,45 +459,12 @@ TEST_F(UsbHost, DfuDetachReachesTheBoardHook) {
   open();
   ASSERT_EQ(libusb_claim_interface(handle_, 3), 0);
   EXPECT_EQ(libusb_control_transfer(handle_, kDfuOut, 0, 1000, 3, nullptr, 0, kTimeoutMs), 0);
-  EXPECT_EQ(device_->detach_requests(), 1);
+  int detaches = 0;
+  bus_->locked([&] { detaches = hand_->detach_requests(); });
+  EXPECT_EQ(detaches, 1);
 }
 
 // ---- (c) HID telemetry over the interrupt endpoint ----
-
-app::PeriodRecord<Q> record(std::uint32_t sequence) {
-  app::PeriodRecord<Q> r;
-  r.sequence = sequence;
-  r.period = sequence + 2;
-  r.mode = sequence % 2 == 0 ? firmware::Mode::kDetect : firmware::Mode::kControl;
-  r.flags = static_cast<std::uint16_t>(app::kRecordPredictionValid | app::kRecordDistanceValid | app::kRecordStepped |
-                                       (sequence % 2 == 0 ? 0 : app::kRecordContact | app::kRecordCommandValid));
-  r.muscle_state_age = sequence % 3;
-  r.overruns = 1;
-  r.missed_periods = 2;
-  for (int i = 0; i < app::PeriodRecord<Q>::kLoadcells; ++i) r.loadcells_N[i] = 0.25f * float(i) - float(sequence);
-  r.d = sequence == 2 ? -0.0f : 3.5f * float(sequence);
-  for (int i = 0; i < Q::kY; ++i) r.prediction[i] = float(i) / 7.0f + float(sequence);
-  std::uint32_t nan_bits = 0x7FC01234u + sequence;  // a NaN payload must survive
-  std::memcpy(&r.prediction[0], &nan_bits, sizeof nan_bits);
-  if (r.has(app::kRecordCommandValid)) {
-    for (int i = 0; i < Q::kU; ++i) r.command[i] = -float(i) * 0.125f;
-  }
-  return r;
-}
-
-void expect_same_bits(const app::PeriodRecord<Q>& got, const app::PeriodRecord<Q>& want) {
-  EXPECT_EQ(got.sequence, want.sequence);
-  EXPECT_EQ(got.period, want.period);
-  EXPECT_EQ(got.mode, want.mode);
-  EXPECT_EQ(got.flags, want.flags);
-  EXPECT_EQ(got.muscle_state_age, want.muscle_state_age);
-  EXPECT_EQ(got.overruns, want.overruns);
-  EXPECT_EQ(got.missed_periods, want.missed_periods);
-  EXPECT_EQ(std::memcmp(got.loadcells_N, want.loadcells_N, sizeof want.loadcells_N), 0);
-  EXPECT_EQ(std::memcmp(&got.d, &want.d, sizeof want.d), 0);
-  EXPECT_EQ(std::memcmp(got.prediction, want.prediction, sizeof want.prediction), 0);
-  EXPECT_EQ(std::memcmp(got.command, want.command, sizeof want.command), 0);
-}
 
 TEST_F(UsbHost, HidReportsDecodeToThePublishedRecords) {
   open();
@@ -502,12 +475,12 @@ TEST_F(UsbHost, HidReportsDecodeToThePublishedRecords) {
   // the URB.
   EXPECT_EQ(libusb_interrupt_transfer(handle_, 0x83, report, sizeof report, &got, 50), LIBUSB_ERROR_TIMEOUT);
   EXPECT_EQ(got, 0);
-  EXPECT_EQ(device_->stats().urbs_discarded, 1u);
+  EXPECT_EQ(bus_->stats(kHandDevnum).urbs_discarded, 1u);
 
   TelemetryDecoder<Q> decoder;
   for (std::uint32_t sequence = 1; sequence <= 3; ++sequence) {
     const app::PeriodRecord<Q> sent = record(sequence);
-    device_->publish(sent);
+    publish(sent);
     bool delivered = false;
     for (int part = 0; part < 4 && !delivered; ++part) {  // the hand's model: 4 reports per record
       const int r = libusb_interrupt_transfer(handle_, 0x83, report, sizeof report, &got, kTimeoutMs);
@@ -529,8 +502,8 @@ TEST_F(UsbHost, HidReportsDecodeToThePublishedRecords) {
 TEST_F(UsbHost, InjectedStallFailsOneTransferOnly) {
   open();
   ASSERT_EQ(libusb_claim_interface(handle_, 2), 0);
-  device_->fail_next_transfer(0x83, EPIPE);
-  device_->publish(record(1));
+  bus_->fail_next_transfer(kHandDevnum, 0x83, EPIPE);
+  publish(record(1));
   std::uint8_t report[64];
   int got = 0;
   EXPECT_EQ(libusb_interrupt_transfer(handle_, 0x83, report, sizeof report, &got, kTimeoutMs), LIBUSB_ERROR_PIPE);
@@ -547,7 +520,7 @@ TEST_F(UsbHost, UnplugCompletesPendingTransfersWithNoDevice) {
   libusb_transfer* t = libusb_alloc_transfer(0);
   libusb_fill_interrupt_transfer(t, handle_, 0x83, report, sizeof report, on_async_done, &done, 5 * kTimeoutMs);
   ASSERT_EQ(libusb_submit_transfer(t), 0);  // nothing published: stays pending
-  device_->unplug();
+  bus_->unplug(kHandDevnum);
   for (int i = 0; i < 100 && !done.done; ++i) {
     timeval tv{0, 10000};
     libusb_handle_events_timeout_completed(ctx_, &tv, nullptr);
@@ -561,15 +534,11 @@ TEST_F(UsbHost, UnplugCompletesPendingTransfersWithNoDevice) {
 
 // ---- hidapi's libusb backend (what `hadynet monitor` uses) ----
 
-std::string narrow(const wchar_t* w) {
-  std::string out;
-  for (; w != nullptr && *w != 0; ++w) out.push_back(static_cast<char>(*w));
-  return out;
-}
-
 TEST(UsbHostHidapi, EnumeratesTheTelemetryInterfaceAndReadsRecords) {
-  UmockdevUsbDevice device;
-  ASSERT_TRUE(device.ok()) << device.error();
+  UsbTestbed bus;
+  ASSERT_TRUE(bus.ok()) << bus.error();
+  auto hand = std::make_shared<HandDevice>();
+  ASSERT_TRUE(bus.plug(kHandDevnum, hand)) << bus.error();
   ASSERT_EQ(hid_init(), 0);
   hid_device_info* list = hid_enumerate(kVid, kPid);
   int found = 0;
@@ -590,7 +559,7 @@ TEST(UsbHostHidapi, EnumeratesTheTelemetryInterfaceAndReadsRecords) {
   TelemetryDecoder<Q> decoder;
   for (std::uint32_t sequence = 1; sequence <= 3; ++sequence) {
     const app::PeriodRecord<Q> sent = record(sequence);
-    device.publish(sent);
+    bus.locked([&] { hand->publish(sent); });
     bool delivered = false;
     for (int part = 0; part < 4 && !delivered; ++part) {
       std::uint8_t report[64];
@@ -604,7 +573,8 @@ TEST(UsbHostHidapi, EnumeratesTheTelemetryInterfaceAndReadsRecords) {
   EXPECT_EQ(decoder.stats().dropped, 0u);
   hid_close(h);
   hid_exit();  // its libusb context exits before the device goes
-  EXPECT_EQ(device.stats().unknown_ioctls, 0u) << "last: 0x" << std::hex << device.stats().last_unknown_ioctl;
+  EXPECT_EQ(bus.stats(kHandDevnum).unknown_ioctls, 0u) << "last: 0x" << std::hex
+                                                       << bus.stats(kHandDevnum).last_unknown_ioctl;
 }
 
 }  // namespace

@@ -46,6 +46,13 @@ std::vector<const DfuseSector*> FirmwareFlasher::plan(const FirmwareImage& image
                              "). Nothing was written.");
   };
   if (image.bytes.empty()) throw FlashError(3, "the image is empty. Nothing was written.");
+  // Checked here, before anything is erased: wTransferSize 0 would never
+  // advance, and DfuSe block numbers (from 2) are 16 bits.
+  if (transfer_size_ == 0) throw FlashError(7, "the device's wTransferSize is 0. Nothing was written.");
+  if ((image.bytes.size() + transfer_size_ - 1) / transfer_size_ > 0xFFFF - 1) {  // blocks 2 .. 0xFFFF
+    throw FlashError(3, "the image needs more than 65534 blocks of wTransferSize (" + std::to_string(transfer_size_) +
+                            " bytes). Nothing was written.");
+  }
   std::vector<const DfuseSector*> sectors;
   for (std::uint64_t at = start; at < end;) {
     const DfuseSector* s = layout_.sector_at(static_cast<std::uint32_t>(at));
@@ -80,7 +87,6 @@ FlashResult FirmwareFlasher::write_and_verify(const FirmwareImage& image) {
     const std::size_t total = image.bytes.size();
     progress_({FlashPhase::kWrite, 0, total});
     for (std::size_t offset = 0, block = 2; offset < total; offset += transfer_size_, ++block) {
-      if (block > 0xFFFF) throw FlashError(3, "the image needs more than 65533 blocks of wTransferSize");
       const std::size_t n = std::min<std::size_t>(transfer_size_, total - offset);
       at = image.address + static_cast<std::uint32_t>(offset);
       client_.download(static_cast<std::uint16_t>(block), std::span(image.bytes).subspan(offset, n));
