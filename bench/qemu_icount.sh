@@ -12,7 +12,7 @@
 #
 # Usage: bench/qemu_icount.sh [IMAGE_DIR]
 #   IMAGE_DIR: images/ of a cross build (default build/cortex-m4/images; build
-#   it with scripts/build.sh cortex-m4 -DHADYNET_CODEGEN_EXECUTABLE=...).
+#   it with scripts/build.sh release && scripts/build.sh cortex-m4).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

@@ -15,7 +15,7 @@
 #
 # Usage: bench/usb_icount.sh [IMAGE_DIR]
 #   IMAGE_DIR: images/ of a cross build (default build/cortex-m4/images; build
-#   it with cmake --preset cortex-m4 -DHADYNET_CODEGEN_EXECUTABLE=...
+#   it with cmake --preset cortex-m4 (after the release build: its codegen)
 #   && cmake --build --preset cortex-m4 --target mps2-an386-bench-usb).
 # Environment: QEMU (default qemu-system-arm), OBJDUMP (default
 # arm-none-eabi-objdump).

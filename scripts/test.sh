@@ -11,10 +11,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 scripts/setup.sh
-# The release suite runs the cross build's images under QEMU.
-scripts/build.sh release -DHADYNET_FIRMWARE_IMAGE_DIR="$PWD/build/cortex-m4/images"
-# The cross build generates its model headers with the host's codegen tool.
-scripts/build.sh cortex-m4 -DHADYNET_CODEGEN_EXECUTABLE="$PWD/build/release/codegen/hadynet-codegen"
+# The presets chain the builds: the cross build generates its model headers
+# with build/release's codegen, and the release suite runs
+# build/cortex-m4/images under QEMU (CMakePresets.json).
+scripts/build.sh release
+scripts/build.sh cortex-m4
 echo "cross build (cortex-m4): ok"
 ctest --preset release
 scripts/build.sh debug
