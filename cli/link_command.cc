@@ -115,11 +115,9 @@ int run_link(int argc, char** argv) {
     std::fprintf(stderr, "hadynet link: give one of --device, --tcp, --qemu and an ACTION (see --help)\n");
     return 2;
   }
-  const std::string numeric = opt.get("numeric");
-  if (numeric != "q15" && numeric != "f32") {
-    std::fprintf(stderr, "hadynet link: --numeric must be q15 or f32\n");
-    return 2;
-  }
+  const auto parsed_numeric = opt.get_numeric("numeric");
+  if (!parsed_numeric) return 2;
+  const std::string numeric = firmware::numeric_name(*parsed_numeric);
   try {
     std::unique_ptr<tools::QemuProcess> qemu;
     std::unique_ptr<tools::FdStream> own;

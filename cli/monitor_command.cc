@@ -197,11 +197,9 @@ int run_monitor(int argc, char** argv) {
   }
   const auto duration = opt.get_double("duration", 0, 1e7);
   if (!duration) return 2;
-  const std::string numeric = opt.get("numeric");
-  if (numeric != "q15" && numeric != "f32") {
-    std::fprintf(stderr, "hadynet monitor: --numeric must be q15 or f32\n");
-    return 2;
-  }
+  const auto parsed_numeric = opt.get_numeric("numeric");
+  if (!parsed_numeric) return 2;
+  const std::string numeric = firmware::numeric_name(*parsed_numeric);
   try {
     return numeric == "q15" ? monitor<model_q15::Model>(opt, *duration) : monitor<model_f32::Model>(opt, *duration);
   } catch (const std::exception& e) {

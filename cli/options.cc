@@ -122,6 +122,16 @@ std::optional<long long> Options::get_int(const std::string& name, long long min
   return v;
 }
 
+std::optional<firmware::Numeric> Options::get_numeric(const std::string& name) const {
+  const std::string text = get(name);
+  firmware::Numeric n{};
+  if (!firmware::parse_numeric(text, n)) {
+    std::fprintf(stderr, "%s: --%s must be q15 or f32, not '%s'\n", program_name().c_str(), name.c_str(), text.c_str());
+    return std::nullopt;
+  }
+  return n;
+}
+
 std::optional<double> Options::get_double(const std::string& name, double min, double max) const {
   const std::string text = get(name);
   double v = 0;

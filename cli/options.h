@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "firmware/core/model_contract.h"
+
 namespace hadynet::cli {
 
 class Options {
@@ -38,6 +40,8 @@ class Options {
   // Typed getters: print an error naming the option and return nullopt.
   std::optional<long long> get_int(const std::string& name, long long min, long long max) const;
   std::optional<double> get_double(const std::string& name, double min, double max) const;
+  // "q15" or "f32" (firmware::parse_numeric); prints the error otherwise.
+  std::optional<firmware::Numeric> get_numeric(const std::string& name) const;
 
  private:
   struct Spec {

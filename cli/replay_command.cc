@@ -104,15 +104,10 @@ int run_replay(int argc, char** argv) {
   if (opt.help_requested()) return 0;
 
   hostsim::ReplayOptions ro;
-  const std::string numeric = opt.get("numeric");
-  if (numeric == "q15") {
-    ro.numeric = hostsim::ReplayNumeric::kQ15;
-  } else if (numeric == "f32") {
-    ro.numeric = hostsim::ReplayNumeric::kF32;
-  } else {
-    std::fprintf(stderr, "hadynet replay: --numeric must be q15 or f32, not '%s'\n", numeric.c_str());
-    return 2;
-  }
+  const auto parsed_numeric = opt.get_numeric("numeric");
+  if (!parsed_numeric) return 2;
+  ro.numeric = *parsed_numeric;
+  const std::string numeric = firmware::numeric_name(ro.numeric);
   const hostsim::CompiledModelInfo info = hostsim::compiled_model_info(ro.numeric);
   if (opt.has("info")) {
     std::printf("compiled model (%s): %s, hash %016llx\n", numeric.c_str(), info.generator.c_str(),

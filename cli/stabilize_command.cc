@@ -182,15 +182,9 @@ int run_stabilize(int argc, char** argv) {
     std::fprintf(stderr, "hadynet stabilize: --disturbance: %s\n", error.c_str());
     return 2;
   }
-  const std::string numeric = opt.get("numeric");
-  if (numeric == "q15") {
-    co.numeric = hostsim::ReplayNumeric::kQ15;
-  } else if (numeric == "f32") {
-    co.numeric = hostsim::ReplayNumeric::kF32;
-  } else {
-    std::fprintf(stderr, "hadynet stabilize: --numeric must be q15 or f32, not '%s'\n", numeric.c_str());
-    return 2;
-  }
+  const auto numeric = opt.get_numeric("numeric");
+  if (!numeric) return 2;
+  co.numeric = *numeric;
   if (opt.has("control-epochs")) {
     const auto v = opt.get_int("control-epochs", 0, 100);
     if (!v) return 2;
@@ -264,7 +258,7 @@ int run_stabilize(int argc, char** argv) {
     const Window early{1, std::min<std::size_t>(20, n) + 1};
     const Window late{n / 2 + 1, n + 1};
     std::printf("stabilize: %s, seed %llu, %s, %d steps of 0.2 s; PB: %s\n", state_name.c_str(),
-                static_cast<unsigned long long>(co.seed), numeric.c_str(), co.steps, pb_note.c_str());
+                static_cast<unsigned long long>(co.seed), firmware::numeric_name(co.numeric), co.steps, pb_note.c_str());
     std::printf("disturbance: %s\n", co.disturbance.describe().c_str());
     std::printf("mean E [N^2]         %14s %14s\n", early.label().c_str(), late.label().c_str());
     if (without)
@@ -284,7 +278,7 @@ int run_stabilize(int argc, char** argv) {
     if (opt.has("csv")) std::printf("per-step results -> %s\n", opt.get("csv").c_str());
 
     if (opt.has("plot")) {
-      const std::string title = "stabilize: " + state_name + " seed " + std::to_string(co.seed) + " (" + numeric +
+      const std::string title = "stabilize: " + state_name + " seed " + std::to_string(co.seed) + " (" + firmware::numeric_name(co.numeric) +
                                 "), PB " + (co.pb_state.empty() ? std::string("default") : co.pb_state) + ", " +
                                 co.disturbance.describe();
       const std::string err = stabilize_plot(without_ptr, with, title, opt.get("plot"));

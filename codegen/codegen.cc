@@ -570,8 +570,6 @@ std::vector<std::string> option_words(const CodegenOptions& o) {
 
 // ---- public ----------------------------------------------------------------
 
-const char* numeric_name(Numeric numeric) { return numeric == Numeric::kQ15 ? "q15" : "f32"; }
-
 std::string namespace_of(const CodegenOptions& options) {
   if (!options.ns.empty()) return options.ns;
   return std::string("hadynet::model_") + numeric_name(options.numeric);

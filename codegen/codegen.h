@@ -24,8 +24,7 @@ namespace hadynet::codegen {
 
 using Numeric = hadynet::firmware::Numeric;
 
-// "q15" or "f32".
-const char* numeric_name(Numeric numeric);
+using hadynet::firmware::numeric_name;  // "q15" or "f32"
 
 // The model (or the options) cannot be generated; what() names the problem.
 class UnsupportedModel : public std::runtime_error {

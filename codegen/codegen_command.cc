@@ -90,13 +90,9 @@ int run_codegen_command(const std::string& program, const std::string& command, 
     return 2;
   }
   CodegenOptions options;
-  if (opt.get("numeric") == "q15") {
-    options.numeric = Numeric::kQ15;
-  } else if (opt.get("numeric") == "f32") {
-    options.numeric = Numeric::kF32;
+  if (const auto numeric = opt.get_numeric("numeric")) {
+    options.numeric = *numeric;
   } else {
-    std::fprintf(stderr, "%s: --numeric must be q15 or f32, got '%s'\n", who.c_str(),
-                 opt.get("numeric").c_str());
     return 2;
   }
   options.ns = opt.get("namespace");

@@ -35,11 +35,26 @@
 
 #include <concepts>
 #include <cstdint>
+#include <string_view>
 #include <type_traits>
 
 namespace hadynet::firmware {
 
 enum class Numeric { kQ15, kF32 };
+
+// The one spelling of a numeric in options, file names and messages.
+constexpr const char* numeric_name(Numeric n) noexcept { return n == Numeric::kQ15 ? "q15" : "f32"; }
+// "q15" or "f32"; false (and `out` untouched) for anything else.
+constexpr bool parse_numeric(std::string_view text, Numeric& out) noexcept {
+  if (text == "q15") {
+    out = Numeric::kQ15;
+  } else if (text == "f32") {
+    out = Numeric::kF32;
+  } else {
+    return false;
+  }
+  return true;
+}
 
 // The generator version the core was written against; codegen writes the
 // same number into kGeneratorVersion and the core rejects other versions at

@@ -97,7 +97,7 @@ double ClosedLoopRun::mean_error(std::size_t begin, std::size_t end) const {
 }
 
 ClosedLoopRun run_closed_loop(const ClosedLoopOptions& options) {
-  return options.numeric == ReplayNumeric::kQ15 ? run_with<model_q15::Model>(options)
+  return options.numeric == firmware::Numeric::kQ15 ? run_with<model_q15::Model>(options)
                                                 : run_with<model_f32::Model>(options);
 }
 

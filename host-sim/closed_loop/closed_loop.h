@@ -23,7 +23,7 @@ struct ClosedLoopOptions {
   plant::Disturbance disturbance = plant::default_strike();
   int steps = 100;           // control periods after the grasp
   bool control = true;       // false: hold (u = 0), the firmware only observes
-  ReplayNumeric numeric = ReplayNumeric::kQ15;
+  firmware::Numeric numeric = firmware::Numeric::kQ15;
   std::string pb_state;      // PB table state the stabiliser predicts with ("": the default PB)
   int control_epochs = -1;   // -1: the model's default
   int control_truncation = -1;

@@ -193,12 +193,12 @@ void append_float(std::string& s, double v) {
 
 }  // namespace
 
-CompiledModelInfo compiled_model_info(ReplayNumeric numeric) {
-  return numeric == ReplayNumeric::kQ15 ? info_of<model_q15::Model>() : info_of<model_f32::Model>();
+CompiledModelInfo compiled_model_info(firmware::Numeric numeric) {
+  return numeric == firmware::Numeric::kQ15 ? info_of<model_q15::Model>() : info_of<model_f32::Model>();
 }
 
 ReplayResult replay_log(const datalog::LogTable& log, const std::string& file, const ReplayOptions& options) {
-  return options.numeric == ReplayNumeric::kQ15 ? replay_with<model_q15::Model>(log, file, options)
+  return options.numeric == firmware::Numeric::kQ15 ? replay_with<model_q15::Model>(log, file, options)
                                                 : replay_with<model_f32::Model>(log, file, options);
 }
 

@@ -15,7 +15,6 @@
 
 namespace hadynet::hostsim {
 
-enum class ReplayNumeric { kQ15, kF32 };
 
 // Where the firmware runs: the core compiled into this program (host-sim),
 // a firmware image in QEMU, or any device on a byte stream (a serial port),
@@ -23,7 +22,7 @@ enum class ReplayNumeric { kQ15, kF32 };
 enum class ReplayTarget { kHostSim, kQemu, kStream };
 
 struct ReplayOptions {
-  ReplayNumeric numeric = ReplayNumeric::kQ15;
+  firmware::Numeric numeric = firmware::Numeric::kQ15;
   firmware::Mode mode = firmware::Mode::kDetect;  // mode before control_from
   int control_from = -1;       // row at which control mode starts (y_ref = y of that row); -1 never
   int pb_state = -1;           // PB table row; -1: the model's default (detection PB)
@@ -67,7 +66,7 @@ struct CompiledModelInfo {
   int control_horizon = 0, control_epochs = 0, control_truncation = 0;
   std::vector<std::string> y_names, u_names, state_names;
 };
-CompiledModelInfo compiled_model_info(ReplayNumeric numeric);
+CompiledModelInfo compiled_model_info(firmware::Numeric numeric);
 
 // Replays `log` (read from `file`, named in errors). Throws
 // std::runtime_error naming the file if the log lacks a channel of the

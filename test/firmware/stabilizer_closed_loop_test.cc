@@ -21,7 +21,7 @@ hostsim::ClosedLoopRun run(bool control, bool disturbed) {
   o.pb_state = "Cylinder/i0/w0";  // the nearest trained state's PB (recognition's answer)
   o.steps = 100;
   o.control = control;
-  o.numeric = hostsim::ReplayNumeric::kQ15;
+  o.numeric = firmware::Numeric::kQ15;
   if (!disturbed) o.disturbance = plant::Disturbance{};
   return hostsim::run_closed_loop(o);
 }
