@@ -29,17 +29,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::vector<std::string> split_commas(const std::string& text) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t end = std::min(text.find(',', start), text.size());
-    if (end > start) out.push_back(text.substr(start, end - start));
-    start = end + 1;
-  }
-  return out;
-}
-
 std::string duration(double seconds) {
   char buf[32];
   const long s = std::lround(seconds);
@@ -113,7 +102,10 @@ int run_train(int argc, char** argv) {
   opt.value("seed", "N", "seed of the initial weights and of the shuffling", "1");
   opt.value("pb", "N", "PB size", "8");
   opt.value("hidden", "N", "LSTM units", "128");
-  opt.value("delta-groups", "LIST", "channel groups whose step differences join x", "l,th");
+  opt.value("delta-groups", "LIST",
+            "channel groups whose step differences join x: a comma-separated list, none, or auto (the logs'\n"
+            "'delta_groups' metadata, e.g. l,th in the hand's logs; none when the logs do not name any)",
+            "auto");
   opt.value("held-out", "F", "fraction of each log's windows held out for the held-out loss", "0.1");
   opt.value("threads", "N", "threads for matrix products (0: all cores; 1 is faster when the cores are busy)", "0");
   opt.flag("constant-pb", "keep every PB at 0 (the paper's 'constant PB' comparison)");
@@ -150,11 +142,14 @@ int run_train(int argc, char** argv) {
 
   try {
     const std::vector<std::string> paths = trainer::expand_log_paths(opt.positional());
-    const datalog::LogTable first = datalog::read_log(paths.front());
-    const trainer::FeatureLayout layout =
-        trainer::feature_layout(first, paths.front(), split_commas(opt.get("delta-groups")));
+    std::vector<datalog::LogTable> tables;
+    for (const std::string& path : paths) tables.push_back(datalog::read_log(path));
+    const trainer::FeatureLayout layout = trainer::feature_layout(
+        tables.front(), paths.front(), trainer::delta_groups_for(opt.get("delta-groups"), tables, paths));
     std::vector<trainer::LogSequence> sequences;
-    for (const std::string& path : paths) sequences.push_back(trainer::read_sequence(path, layout));
+    for (std::size_t i = 0; i < paths.size(); ++i)
+      sequences.push_back(trainer::log_sequence(tables[i], paths[i], layout));
+    tables.clear();
 
     const trainer::PbStateTable pb_table = trainer::pb_state_table(sequences);
     const std::vector<trainer::PbState>& states = pb_table.states;

@@ -193,6 +193,39 @@ std::vector<std::string> expand_log_paths(const std::vector<std::string>& args) 
   return paths;
 }
 
+namespace {
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, comma - start);
+    if (!item.empty()) out.push_back(item);
+    start = comma + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> delta_groups_for(const std::string& choice, const std::vector<datalog::LogTable>& tables,
+                                          const std::vector<std::string>& files) {
+  if (choice == "none") return {};
+  if (choice != "auto") return split_list(choice);
+  if (tables.empty()) return {};
+  const auto first = tables.front().metadata.get(kDeltaGroupsKey);
+  for (std::size_t i = 1; i < tables.size(); ++i) {
+    const auto here = tables[i].metadata.get(kDeltaGroupsKey);
+    if (here != first) {
+      throw std::runtime_error(files.at(i) + ": metadata '" + kDeltaGroupsKey + "' is " +
+                               (here ? "'" + *here + "'" : "absent") + " but " + (first ? "'" + *first + "'" : "absent") +
+                               " in " + files.front() + "; give --delta-groups");
+    }
+  }
+  return first ? split_list(*first) : std::vector<std::string>{};
+}
+
 std::string content_hash(const std::vector<std::string>& paths) {
   datalog::Fnv1a64 h;
   const auto mix = [&h](const char* data, std::size_t n) { h.update(std::string_view(data, n)); };

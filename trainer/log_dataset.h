@@ -18,8 +18,9 @@
 
 namespace hadynet::trainer {
 
-// The paper's choice: differences of muscle lengths and wrist angles.
-inline const std::vector<std::string> kDefaultDeltaGroups = {"l", "th"};
+// The log metadata key naming the delta groups of a log's producer, e.g.
+// "l,th" for the hand (docs/log-format.md); absent: none.
+inline constexpr const char* kDeltaGroupsKey = "delta_groups";
 
 // Channel names of x, u and y. Equal layouts mean interchangeable logs.
 struct FeatureLayout {
@@ -78,6 +79,15 @@ Eigen::VectorXd initial_state(const FeatureLayout& layout, const LogSequence& se
 // searched recursively), sorted by path, duplicates removed. Throws
 // std::runtime_error for a missing path or when nothing is found.
 std::vector<std::string> expand_log_paths(const std::vector<std::string>& args);
+
+// The delta groups for training on `tables` (read from `files`, same order):
+//   "auto"  the logs' `delta_groups` metadata, which must be the same in
+//           every log (none when no log has it);
+//   "none"  no delta groups;
+//   else    a comma-separated list of observed groups.
+// Throws std::runtime_error naming the first log that disagrees.
+std::vector<std::string> delta_groups_for(const std::string& choice, const std::vector<datalog::LogTable>& tables,
+                                          const std::vector<std::string>& files);
 
 // Identifies a dataset: FNV-1a 64 over, per path in the given order, the
 // file name (not the folder) and the bytes. 16 hex digits. Throws

@@ -97,6 +97,9 @@ ExperimentResult run_experiment(const ExperimentSpec& spec) {
   meta.set("wear", wear_text(spec.wear_level));
   meta.set("seed", std::to_string(spec.seed));
   meta.set("units", "t=s l=mm f=N fc=N th=rad u=mm");
+  // Muscle lengths and wrist angles integrate the commands: the model sees
+  // their step differences too (the paper's x; `hadynet train` reads this).
+  meta.set("delta_groups", "l,th");
   meta.set("source", "hadynet collect: MuJoCo hand plant (host-sim/plant)");
   if (spec.declare_effects) meta.set("effects", hand.effects.describe());
 

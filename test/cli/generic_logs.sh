@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Issue 12 ("hand defaults break other logs"): `hadynet train` on (u, y) logs
+# that are not the hand's, with the defaults. Before: the default
+# --delta-groups l,th failed on logs without an `l` group, and
+# `--delta-groups none` was read as a group name. Now the delta groups come
+# from the logs' `delta_groups` metadata (none when absent).
+#   generic_logs.sh HADYNET WORKDIR
+set -uo pipefail
+hadynet=$1 work=$2
+rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 2
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+
+# Two logs of a damped spring driven by u0: observed groups `pos` and `vel`.
+python3 - <<'PY'
+import math
+def log(path, seed, extra=""):
+    with open(path, "w") as f:
+        f.write("# format: hadynet-log\n# format_version: 1\n# dt_s: 0.1\n# state: s%d\n%s" % (seed, extra))
+        f.write("t,pos0,vel0,u0\n")
+        p = v = 0.0
+        for r in range(120):
+            u = math.sin(0.3 * r + seed)
+            f.write("%.1f,%.6f,%.6f,%.6f\n" % (0.1 * r, p, v, u))
+            v += 0.1 * (u - 2.0 * p - 0.5 * v)
+            p += 0.1 * v
+log("a.csv", 1)
+log("b.csv", 2)
+log("c.csv", 3, "# delta_groups: pos\n")
+PY
+mkdir -p plain tagged mixed
+cp a.csv b.csv plain/
+cp c.csv tagged/
+cp a.csv c.csv mixed/
+small=(--epochs 1 --batch 10 --steps 3 --hidden 8 --pb 2 --quiet)
+
+# Defaults on logs without an `l` group: trains (exit 0), no delta group.
+out=$("$hadynet" train plain --out plain.safetensors "${small[@]}" 2>&1) || fail "train with defaults: $out"
+[[ -s plain.safetensors ]] || fail "train with defaults wrote no model"
+# `none` is no delta group, not a group called "none".
+out=$("$hadynet" train plain --out none.safetensors --delta-groups none "${small[@]}" 2>&1) || fail "--delta-groups none: $out"
+# The logs' metadata names them: the model's x has dpos0.
+out=$("$hadynet" train tagged --out tagged.safetensors "${small[@]}" 2>&1) || fail "train tagged: $out"
+grep -qa 'dpos0' tagged.safetensors || fail "the tagged logs' delta group is not in the model's x"
+grep -qa 'dpos0' plain.safetensors && fail "untagged logs got a delta group"
+# Logs that disagree: refused, naming the log and the way out.
+out=$("$hadynet" train mixed --out mixed.safetensors "${small[@]}" 2>&1); status=$?
+[[ $status -eq 1 ]] || fail "mixed metadata: exit $status, expected 1"
+[[ "$out" == *"c.csv: metadata 'delta_groups' is 'pos' but absent in"*"give --delta-groups"* ]] || fail "mixed metadata message: $out"
+# An explicit list still names a group the logs lack.
+out=$("$hadynet" train plain --out x.safetensors --delta-groups l "${small[@]}" 2>&1); status=$?
+[[ $status -eq 1 && "$out" == *"delta group 'l' is not an observed channel group"* ]] || fail "--delta-groups l: exit $status: $out"
+
+echo "generic_logs: $failures failed"
+[[ $failures -eq 0 ]]
