@@ -135,6 +135,7 @@ ControlReply DfuseRomInterface::get_status(std::span<std::uint8_t> buffer) noexc
   switch (state_) {
     case dfu::State::kDnloadSync:  // run what the DNLOAD stored; report busy
       result_ = pending_ == Pending::kCommand ? run_command() : run_write();
+      datasheet_poll_ms_ += poll_ms_;
       pending_ = Pending::kNone;
       state_ = dfu::State::kDnBusy;
       break;
@@ -157,10 +158,13 @@ ControlReply DfuseRomInterface::get_status(std::span<std::uint8_t> buffer) noexc
       poll_ms_ = 0;
       break;
   }
+  // 64 bits: a mass erase (~41 s) times a large percent does not wrap.
+  const std::uint64_t scaled = (static_cast<std::uint64_t>(poll_ms_) * poll_percent_ + 99) / 100;
+  const std::uint32_t reported = static_cast<std::uint32_t>(scaled > 0xFFFFFF ? 0xFFFFFF : scaled);  // 24 bits
   buffer[0] = static_cast<std::uint8_t>(status_);
-  buffer[1] = static_cast<std::uint8_t>(poll_ms_);
-  buffer[2] = static_cast<std::uint8_t>(poll_ms_ >> 8);
-  buffer[3] = static_cast<std::uint8_t>(poll_ms_ >> 16);
+  buffer[1] = static_cast<std::uint8_t>(reported);
+  buffer[2] = static_cast<std::uint8_t>(reported >> 8);
+  buffer[3] = static_cast<std::uint8_t>(reported >> 16);
   buffer[4] = static_cast<std::uint8_t>(state_);
   buffer[5] = 0;  // iString
   return ControlReply::data_in(dfu::kStatusSize);

@@ -29,7 +29,10 @@
 // with errTARGET / errADDRESS.
 // bwPollTimeout: erase = the sector's worst-case erase time
 // (stm32f405_flash_layout.h), mass erase = the sum, write = 25 us/byte
-// rounded up to ms, set address and leave 1 ms. Nothing sleeps.
+// rounded up to ms, set address and leave 1 ms. Nothing sleeps here, but a
+// real host sleeps what the device reports: set_poll_timeout_percent()
+// scales the reported value (100 = the datasheet figures above, 0 = no wait
+// at all, e.g. 1 for tests through a real client that must stay fast).
 #ifndef HADYNET_TEST_DFUSE_SIM_DFUSE_ROM_INTERFACE_H_
 #define HADYNET_TEST_DFUSE_SIM_DFUSE_ROM_INTERFACE_H_
 
@@ -83,6 +86,15 @@ class DfuseRomInterface final : public UsbFunction {
   bool set_alternate(std::uint8_t interface, std::uint8_t alternate) noexcept override;
   std::uint8_t alternate(std::uint8_t) const noexcept override { return alternate_; }
 
+  // bwPollTimeout as reported = the worst case x percent / 100, rounded up
+  // to whole ms (so any non-zero percent still asks for >= 1 ms); 0 reports
+  // 0 ms. Default 100. Takes effect from the next GETSTATUS.
+  void set_poll_timeout_percent(std::uint32_t percent) noexcept { poll_percent_ = percent; }
+  std::uint32_t poll_timeout_percent() const noexcept { return poll_percent_; }
+  // Sum of the (unscaled) worst-case bwPollTimeouts of the operations run so
+  // far, ms: what a host honouring the datasheet figures would have slept.
+  std::uint64_t datasheet_poll_ms() const noexcept { return datasheet_poll_ms_; }
+
   dfu::State state() const noexcept { return state_; }
   dfu::Status status() const noexcept { return status_; }
   std::uint32_t address_pointer() const noexcept { return pointer_; }
@@ -115,7 +127,9 @@ class DfuseRomInterface final : public UsbFunction {
   dfu::State state_ = dfu::State::kIdle;
   dfu::Status status_ = dfu::Status::kOk;
   dfu::Status result_ = dfu::Status::kOk;  // of the operation the next GETSTATUS reports
-  std::uint32_t poll_ms_ = 0;
+  std::uint32_t poll_ms_ = 0;               // worst case of the operation, ms (unscaled)
+  std::uint32_t poll_percent_ = 100;         // reported = poll_ms_ x poll_percent_ / 100
+  std::uint64_t datasheet_poll_ms_ = 0;
   std::uint32_t pointer_ = RomFlashModel::kBase;  // the ROM's default: flash start
 
   Pending pending_ = Pending::kNone;

@@ -134,6 +134,23 @@ TEST_F(RomBootloaderTest, SetAddressAndEraseAnswerBusyThenIdle) {
   EXPECT_EQ(sim.flash().erase_count(), 3u);
 }
 
+// The poll-time knob scales what GETSTATUS reports, rounded up to whole ms
+// (1 % of 800 ms = 8; of the 1 ms set-address = 0.01 -> 1; of a 2048-byte
+// write's 52 ms = 0.52 -> 1), 0 % reports 0; the datasheet sum it keeps
+// is unscaled (1 + 800 + 52 + 1 + 800 + 52 ms for the two rounds).
+TEST_F(RomBootloaderTest, PollTimeoutPercentScalesTheReportedWait) {
+  sim.set_poll_timeout_percent(1);
+  run(0, command(0x21, 0x08004000), 1);
+  run(0, command(0x41, 0x08004000), 8);
+  run(2, pattern(2048, 3), 1);
+  sim.set_poll_timeout_percent(0);
+  run(0, command(0x21, 0x08004000), 0);
+  run(0, command(0x41, 0x08004000), 0);
+  run(2, pattern(2048, 3), 0);
+  EXPECT_EQ(sim.dfu().datasheet_poll_ms(), 2u * (1 + 800 + 52));
+  EXPECT_EQ(flash_bytes(0x08004000, 2048), pattern(2048, 3));
+}
+
 TEST_F(RomBootloaderTest, EraseOfOneSectorLeavesItsNeighboursIntact) {
   const Bytes fill(0x30000, 0x5A);  // sectors 0..4 and half of 5
   sim.flash().fill(0x08000000, fill);

@@ -43,6 +43,10 @@ class Stm32RomBootloader final : public EmulatedDevice {
   // Faults take effect from the next request (the leaky cell from the next write).
   void set_faults(const DfuseFaults& faults) noexcept;
 
+  // The reported bwPollTimeout in percent of the datasheet's worst case
+  // (DfuseRomInterface::set_poll_timeout_percent; default 100).
+  void set_poll_timeout_percent(std::uint32_t percent) noexcept { dfu_.set_poll_timeout_percent(percent); }
+
   RomFlashModel& flash() noexcept { return flash_; }
   const DfuseRomInterface& dfu() const noexcept { return dfu_; }
   const UsbDevice& device() const noexcept { return device_; }

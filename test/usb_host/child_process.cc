@@ -38,7 +38,8 @@ std::string ChildResult::describe() const {
 }
 
 ChildResult run_child(UsbTestbed& bus, const std::vector<std::string>& argv, std::chrono::milliseconds timeout,
-                      const std::function<void()>& tick) {
+                      const std::function<void()>& tick,
+                      const std::function<void(const std::string& piece)>& on_stdout) {
   ChildResult r;
   int out_pipe[2], err_pipe[2];
   if (::pipe2(out_pipe, O_CLOEXEC) != 0 || ::pipe2(err_pipe, O_CLOEXEC) != 0) {
@@ -71,7 +72,9 @@ ChildResult run_child(UsbTestbed& bus, const std::vector<std::string>& argv, std
   while (true) {
     bus.pump();
     if (tick) tick();
+    const std::size_t out_before = r.out.size();
     drain(out_pipe[0], r.out);
+    if (on_stdout && r.out.size() > out_before) on_stdout(r.out.substr(out_before));
     drain(err_pipe[0], r.err);
     const pid_t w = ::waitpid(pid, &status, WNOHANG);
     if (w == pid) break;

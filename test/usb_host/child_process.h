@@ -26,8 +26,11 @@ struct ChildResult {
   std::string describe() const;  // for failure messages: exit, time, stderr
 };
 
+// `on_stdout`, if given, sees each piece of the child's stdout as it is read
+// (also kept in ChildResult::out), e.g. to time when a line appears.
 ChildResult run_child(UsbTestbed& bus, const std::vector<std::string>& argv, std::chrono::milliseconds timeout,
-                      const std::function<void()>& tick = {});
+                      const std::function<void()>& tick = {},
+                      const std::function<void(const std::string& piece)>& on_stdout = {});
 
 }  // namespace hadynet::usb::host_testing
 
