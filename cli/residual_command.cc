@@ -30,8 +30,8 @@ using nlohmann::json;
 // The console summary: fit per channel and horizon, whiteness, the top of the ranking, the verdict.
 void print_summary(const rs::Analysis& a, const std::string& pb_choice) {
   const auto& d = a.data;
-  std::printf("%zu logs, %zu channels, PB %s; multi-step fit over %ld window starts\n", d.logs.size(),
-              d.y_names.size(), pb_choice.c_str(), a.horizon.samples);
+  std::printf("%zu logs, %zu channels; multi-step fit over %ld window starts\n%s\n", d.logs.size(),
+              d.y_names.size(), a.horizon.samples, rs::pb_summary(d, pb_choice).c_str());
   std::printf("%-10s %9s %9s %11s %11s %9s %6s\n", "channel", "fit h=1", "RMSE h=1",
               ("fit h=" + std::to_string(a.horizon.horizon)).c_str(),
               ("RMSE h=" + std::to_string(a.horizon.horizon)).c_str(), "LB p", "white");
@@ -45,8 +45,9 @@ void print_summary(const rs::Analysis& a, const std::string& pb_choice) {
   std::printf("\n%ld hypotheses tested; top of the ranking:\n", a.attribution.tested);
   for (std::size_t i = 0; i < a.attribution.ranked.size() && i < 10; ++i) {
     const auto& r = a.attribution.ranked[i];
-    std::printf("  %c %-62s explained %6.3f (std %.4f)  p(Holm) %.2g\n", r.significant ? '*' : ' ', r.label.c_str(),
-                r.explained, r.explained_std, r.p_adjusted);
+    std::printf("  %c %-62s explained %6.3f (std %.4f)  p(Holm) %.2g  %s\n", r.significant ? '*' : ' ',
+                r.label.c_str(), r.explained, r.explained_std, r.p_adjusted,
+                rs::hypothesis_status(r, a.attribution.options));
   }
   std::printf("\nverdict: %s\n", a.verdict.c_str());
 }
@@ -58,13 +59,24 @@ void print_fix(const rs::FixResult& fixed) {
   const rs::HeldOutError& e = fixed.changed ? fixed.after : fixed.before;
   std::printf("held-out 1-step RMSE (%ld rows)   %-10s %11s %11s %11s   LB p before/after\n", fixed.before.samples,
               "channel", "before", "fine-tune", "after");
+  // A figure that was not computed (a new channel has no "before"; nothing
+  // fixed has no "after"; --no-control has no fine-tune) prints as "-".
+  const auto cell = [](bool computed, double v, const char* format) {
+    if (!computed) return std::string("-");
+    char buf[32];
+    std::snprintf(buf, sizeof buf, format, v);
+    return std::string(buf);
+  };
   for (std::size_t c = 0; c < e.channels.size(); ++c) {
     const auto i = static_cast<Eigen::Index>(c);
     const bool old = c < fixed.before.channels.size();
-    std::printf("                                  %-10s %11.4g %11.4g %11.4g   %.2g / %.2g\n", e.channels[c].c_str(),
-                old ? fixed.before.rmse(i) : NAN, fixed.control && old ? fixed.control->rmse(i) : NAN,
-                fixed.changed ? fixed.after.rmse(i) : NAN, old ? fixed.before.whiteness[c].ljung_box.p_value : NAN,
-                fixed.changed ? fixed.after.whiteness[c].ljung_box.p_value : NAN);
+    const bool control = fixed.control.has_value() && old;
+    std::printf("                                  %-10s %11s %11s %11s   %s / %s\n", e.channels[c].c_str(),
+                cell(old, old ? fixed.before.rmse(i) : 0, "%.4g").c_str(),
+                cell(control, control ? fixed.control->rmse(i) : 0, "%.4g").c_str(),
+                cell(fixed.changed, fixed.changed ? fixed.after.rmse(i) : 0, "%.4g").c_str(),
+                cell(old, old ? fixed.before.whiteness[c].ljung_box.p_value : 0, "%.2g").c_str(),
+                cell(fixed.changed, fixed.changed ? fixed.after.whiteness[c].ljung_box.p_value : 0, "%.2g").c_str());
   }
   if (fixed.changed) std::printf("verdict after: %s\n", fixed.after.verdict.c_str());
 }

@@ -124,6 +124,7 @@ nlohmann::json analysis_json(const rs::Analysis& a, const std::string& model_pat
   const auto w = att.winner();
   return {{"model", model_path},
           {"pb", pb_choice},
+          {"pb_summary", rs::pb_summary(d, pb_choice)},
           {"logs", logs},
           {"channels", d.y_names},
           {"inputs", d.u_names},
@@ -252,8 +253,8 @@ std::string markdown(const rs::Analysis& a, const std::string& model_path, const
   const auto& d = a.data;
   const auto& att = a.attribution;
   std::string m = "# Residual analysis\n\n";
-  m += "Model `" + model_path + "`, " + std::to_string(d.logs.size()) + " logs, PB `" + pb_choice +
-       "` (docs/residual.md explains every number).\n\n";
+  m += "Model `" + model_path + "`, " + std::to_string(d.logs.size()) + " logs; " + rs::pb_summary(d, pb_choice) +
+       " (docs/residual.md explains every number).\n\n";
   m += "## Verdict\n\n**" + a.verdict + "**\n\n";
   const auto family = att.winner_family();
   if (!family.empty()) {
@@ -302,13 +303,13 @@ std::string markdown(const rs::Analysis& a, const std::string& model_path, const
        num("%g", att.options.alpha) + "). Significant also requires a held-out explained share >= " +
        num("%g", att.options.min_explained) + " and >= " + num("%g", att.options.min_explained_std) +
        " in standardised units. Ranked by the latter.\n\n"
-       "| rank | hypothesis | effect | held-out explained (share) | standardised | train share | t | p (Holm) | significant |\n"
+       "| rank | hypothesis | effect | held-out explained (share) | standardised | train share | t | p (Holm) | status |\n"
        "|---|---|---|---|---|---|---|---|---|\n";
   for (std::size_t i = 0; i < att.ranked.size() && i < 20; ++i) {
     const auto& r = att.ranked[i];
     m += "| " + std::to_string(i + 1) + " | " + r.label + " | " + r.effect + " | " + num("%.3f", r.explained) + " | " +
          num("%.4f", r.explained_std) + " | " + num("%.3f", r.explained_train) + " | " + num("%.1f", r.t_stat) + " | " +
-         num("%.2g", r.p_adjusted) + " | " + (r.significant ? "yes" : "no") + " |\n";
+         num("%.2g", r.p_adjusted) + " | " + rs::hypothesis_status(r, att.options) + " |\n";
   }
   m += "\n## Effect library\n\n| effect | feature test | parameter | augmentation (--fix) |\n|---|---|---|---|\n";
   for (const auto& e : rs::effect_library())

@@ -51,5 +51,17 @@ out=$("$hadynet" train mixed --out mixed.safetensors "${small[@]}" 2>&1); status
 out=$("$hadynet" train plain --out x.safetensors --delta-groups l "${small[@]}" 2>&1); status=$?
 [[ $status -eq 1 && "$out" == *"delta group 'l' is not an observed channel group"* ]] || fail "--delta-groups l: exit $status: $out"
 
+# The residual loop on them, with --fix: every printed figure is a number or
+# "-" (before: "fine-tune nan  after nan" when nothing was fixed), and the PB
+# each log used is said in words (before: "PB auto" while a PB was adapted).
+out=$("$hadynet" residual plain.safetensors plain --fix --fix-epochs 1 2>&1); status=$?
+[[ $status -eq 0 ]] || fail "residual --fix: exit $status: $(head -3 <<<"$out")"
+grep -qiE '(^|[^a-z])-?nan([^a-z]|$)' <<<"$out" && fail "residual printed NaN: $(grep -iE 'nan' <<<"$out" | head -2)"
+grep -q "^--pb auto: 2 logs with their state's trained PB$" <<<"$out" || fail "no PB summary line: $(head -3 <<<"$out")"
+out=$("$hadynet" residual plain.safetensors tagged 2>&1); status=$?
+[[ $status -eq 0 ]] || fail "residual on an unknown state: exit $status: $(head -3 <<<"$out")"
+grep -q "with a PB adapted to their state's logs (states the model was not trained on)" <<<"$out" \
+  || fail "an adapted PB was not said: $(head -3 <<<"$out")"
+
 echo "generic_logs: $failures failed"
 [[ $failures -eq 0 ]]

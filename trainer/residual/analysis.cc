@@ -1,5 +1,6 @@
 #include "trainer/residual/analysis.h"
 
+#include <map>
 #include <stdexcept>
 
 namespace hadynet::trainer::residual {
@@ -45,6 +46,45 @@ std::string verdict_text(const Attribution& attribution) {
     }
   }
   return v;
+}
+
+std::string pb_summary(const ResidualData& data, const std::string& pb_choice) {
+  std::map<std::string, int> logs_by_source;  // "state X" sources pooled as "trained"
+  int trained = 0, adapted = 0;
+  for (const auto& log : data.logs) {
+    if (log.pb_source.rfind("state ", 0) == 0) {
+      ++trained;
+    } else if (log.pb_source.rfind("adapted", 0) == 0) {
+      ++adapted;
+    } else {
+      ++logs_by_source[log.pb_source];
+    }
+  }
+  const auto logs = [](int n) { return std::to_string(n) + (n == 1 ? " log" : " logs"); };
+  std::string s = "--pb " + pb_choice + ":";
+  std::string sep = " ";
+  if (trained > 0) {
+    s += sep + logs(trained) + " with their state's trained PB";
+    sep = ", ";
+  }
+  if (adapted > 0) {
+    s += sep + logs(adapted) + " with a PB adapted to their state's logs" +
+         (pb_choice == "auto" ? " (states the model was not trained on)" : "");
+    sep = ", ";
+  }
+  for (const auto& [source, n] : logs_by_source) {
+    s += sep + logs(n) + " with PB " + source;
+    sep = ", ";
+  }
+  return s;
+}
+
+const char* hypothesis_status(const HypothesisResult& r, const AttributionOptions& options) {
+  if (r.significant) return "significant";
+  if (!r.testable) return "not testable";
+  if (r.explained < 0) return "over-predicts held out";
+  if (r.p_adjusted < options.alpha) return "below the floors";
+  return "not significant";
 }
 
 const HypothesisResult* hypothesis_to_show(const Attribution& attribution) {

@@ -47,6 +47,17 @@ Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, c
 // rest of the winner's family (the same effect on other channels).
 std::string verdict_text(const Attribution& attribution);
 
+// Which PB each log used, in words: e.g. "--pb auto: 3 logs with their
+// state's trained PB, 1 log with a PB adapted to its state's logs (a state
+// the model was not trained on)". An adapted PB is never left unsaid.
+std::string pb_summary(const ResidualData& data, const std::string& pb_choice);
+
+// What a ranked hypothesis' numbers say, for listings next to its p-value:
+// "significant", "not testable", "over-predicts held out" (its fitted effect
+// raises the held-out residual: explained < 0, whatever p says),
+// "below the floors" (significant p, too little explained) or "not significant".
+const char* hypothesis_status(const HypothesisResult& result, const AttributionOptions& options);
+
 // The hypothesis a report shows in detail: the winner when there is one,
 // else the testable hypothesis that explains most in standardised units
 // (labelled "not significant"); nullptr when nothing was testable.
