@@ -6,6 +6,7 @@ namespace hadynet::cli {
 
 int run_collect(int argc, char** argv);
 int run_validate(int argc, char** argv);
+int run_import(int argc, char** argv);
 int run_plot(int argc, char** argv);
 int run_train(int argc, char** argv);
 int run_adapt(int argc, char** argv);

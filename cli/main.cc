@@ -18,6 +18,7 @@ constexpr Command kCommands[] = {
     {"collect", "record logs from the MuJoCo hand plant (a preset dataset or one experiment)",
      hadynet::cli::run_collect},
     {"validate", "check logs or a dataset folder strictly and print a summary", hadynet::cli::run_validate},
+    {"import", "a plain column CSV (measured data from anywhere) -> a HADYNET log", hadynet::cli::run_import},
     {"plot", "draw a log as a PNG (gnuplot): one panel per channel group", hadynet::cli::run_plot},
     {"train", "train HADYNET and the PB table from logs; write a model file", hadynet::cli::run_train},
     {"adapt", "fit the PB alone to new logs (offline, or --online over a stream)", hadynet::cli::run_adapt},
