@@ -111,6 +111,9 @@ int run_adapt(int argc, char** argv) {
       std::printf("%-22s %-11s %7d %11.5f %11.5f %6.1f%%  %s\n", r.state.c_str(), r.object.c_str(),
                   r.windows, r.result.loss.front(), r.result.loss.back(), r.drop_percent(),
                   format_pb(r.result.pb).c_str());
+      if (r.result.halvings > 0)
+        std::printf("  (the step was halved %d times: --lr %g is too large for these data)\n", r.result.halvings,
+                    adapt->lr);
     }
     if (opt.has("json")) {
       write_adapt_json(opt.get("json"), results);

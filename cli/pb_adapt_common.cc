@@ -58,6 +58,7 @@ void write_adapt_json(const std::string& path, const std::vector<AdaptedState>& 
                  {"windows", r.windows},
                  {"loss", r.result.loss},
                  {"drop_percent", r.drop_percent()},
+                 {"lr_halvings", r.result.halvings},
                  {"pb", std::vector<float>(r.result.pb.data(), r.result.pb.data() + r.result.pb.size())}});
   }
   std::ofstream out(path);

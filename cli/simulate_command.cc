@@ -109,10 +109,14 @@ int run_simulate(int argc, char** argv) {
     }
     Eigen::VectorXf pb;
     if (opt.get("pb") == "adapt") {
-      pb = adapt_each_state(model, {{seq.state, seq.object, {seq}}}, parse_pb(model, opt.get("start")),
-                            *adapt)
-               .front()
-               .result.pb;
+      const trainer::AdaptResult r =
+          adapt_each_state(model, {{seq.state, seq.object, {seq}}}, parse_pb(model, opt.get("start")), *adapt)
+              .front()
+              .result;
+      pb = r.pb;
+      std::printf("PB adapted to %s: loss %.5g -> %.5g in %d epochs%s\n", log_path.c_str(), r.loss.front(),
+                  r.loss.back(), adapt->epochs,
+                  r.halvings > 0 ? (" (step halved " + std::to_string(r.halvings) + " times)").c_str() : "");
     } else {
       pb = parse_pb(model, opt.get("pb"));
     }

@@ -76,6 +76,10 @@ class MomentumSgd {
   void set_trainable(GroupSet trainable) { trainable_ = trainable; }
   GroupSet trainable() const { return trainable_; }
   const Options& options() const { return options_; }
+  // For a step-size safeguard (pb_adaptation.cc): a new rate, and forgetting
+  // the velocity of rejected steps.
+  void set_lr(double lr) { options_.lr = lr; }
+  void reset_momentum() { buf_.clear(); }
 
  private:
   Options options_;

@@ -1,5 +1,7 @@
 #include "trainer/pb_adaptation.h"
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 
@@ -19,20 +21,46 @@ HadynetParams<float> single_pb_params(const HadynetModel& model, const Eigen::Ve
   return p;
 }
 
-// Full-batch MomentumSGD epochs on one gathered batch; appends the loss
-// before each epoch and after the last to `loss`.
-void fit(HadynetParams<float>& params, MomentumSgd<float>& sgd, const WindowBatch<float>& batch,
-         const Matrix<float>& y, int epochs, std::vector<double>& loss) {
+// Full-batch MomentumSGD epochs on one gathered batch with the step-size
+// safeguard (pb_adaptation.h); appends the loss before the first epoch and
+// after each to `loss`. Returns the number of halvings. The rate is restored
+// on return (the caller's optimiser keeps its configured rate).
+int fit(HadynetParams<float>& params, MomentumSgd<float>& sgd, const WindowBatch<float>& batch,
+        const Matrix<float>& y, int epochs, std::vector<double>& loss) {
   HadynetNetwork<float> net;
   HadynetGrads<float> grads;
   Matrix<float> d_y;
+  const double base_lr = sgd.options().lr;
+  int halvings = 0;
+  const std::size_t first = loss.size();
+  double current = static_cast<double>(mse_loss(net.forward(params, batch, BnMode::kEval), y, &d_y));
+  loss.push_back(current);
   for (int e = 0; e < epochs; ++e) {
-    const Matrix<float>& y_hat = net.forward(params, batch, BnMode::kEval);
-    loss.push_back(static_cast<double>(mse_loss(y_hat, y, &d_y)));
-    net.backward(params, d_y, grads);
-    sgd.step(params, grads.params);
+    net.backward(params, d_y, grads);  // at `params`: the last forward was there
+    // The reference: the largest of the last kSafeguardWindow losses of this call.
+    const std::size_t from = std::max(first, loss.size() - std::min<std::size_t>(loss.size() - first, kSafeguardWindow));
+    const double reference = *std::max_element(loss.begin() + static_cast<long>(from), loss.end());
+    const auto kept = params.pb;  // the PB before this epoch's step
+    while (true) {
+      sgd.step(params, grads.params);
+      const double trial = static_cast<double>(mse_loss(net.forward(params, batch, BnMode::kEval), y, &d_y));
+      if (std::isfinite(trial) && trial <= reference) {
+        current = trial;
+        break;
+      }
+      params.pb = kept;
+      sgd.reset_momentum();
+      if (halvings == kMaxHalvings) {  // no step keeps the loss down: stay
+        current = static_cast<double>(mse_loss(net.forward(params, batch, BnMode::kEval), y, &d_y));
+        break;
+      }
+      ++halvings;
+      sgd.set_lr(sgd.options().lr * 0.5);
+    }
+    loss.push_back(current);
   }
-  loss.push_back(static_cast<double>(mse_loss(net.forward(params, batch, BnMode::kEval), y)));
+  sgd.set_lr(base_lr);
+  return halvings;
 }
 
 WindowBatch<float> single_state(WindowBatch<float> batch) {
@@ -51,7 +79,7 @@ AdaptResult adapt_pb(const HadynetModel& model, const WindowDataset& data, std::
   Matrix<float> y;
   data.gather(ids, batch, y);
   AdaptResult result;
-  fit(params, sgd, single_state(std::move(batch)), y, options.epochs, result.loss);
+  result.halvings = fit(params, sgd, single_state(std::move(batch)), y, options.epochs, result.loss);
   result.pb = params.pb.row(0).transpose();
   return result;
 }

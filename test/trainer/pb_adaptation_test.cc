@@ -187,5 +187,28 @@ TEST_F(PbAdaptation, OnlineRejectsBadOptions) {
   EXPECT_THROW(OnlinePbAdapter(model(), Eigen::VectorXf::Zero(5), o), std::invalid_argument);
 }
 
+// The step-size safeguard (pb_adaptation.h). A rate far too large for these
+// data (1000x the default) diverged before (loss growing, a non-finite PB);
+// now the step is halved until the loss stays down: it ends below where it
+// started, finite, and the halvings are reported. Where the default rate
+// suits the data, nothing is halved.
+TEST_F(PbAdaptation, SafeguardHalvesARateThatDiverges) {
+  const Eigen::VectorXf start = pb_of(0);
+  const AdaptResult wild = adapt_pb(model(), data_, ids_, start, AdaptOptions{20, 1000.0, 0.9});
+  EXPECT_GT(wild.halvings, 0);
+  EXPECT_TRUE(wild.pb.allFinite());
+  ASSERT_EQ(wild.loss.size(), 21u);
+  EXPECT_LT(wild.loss.back(), wild.loss.front());
+  // Never above the largest of the previous kSafeguardWindow losses.
+  for (std::size_t e = 1; e < wild.loss.size(); ++e) {
+    const std::size_t from = e > static_cast<std::size_t>(kSafeguardWindow) ? e - kSafeguardWindow : 0;
+    EXPECT_LE(wild.loss[e], *std::max_element(wild.loss.begin() + static_cast<long>(from),
+                                               wild.loss.begin() + static_cast<long>(e)))
+        << "epoch " << e;
+  }
+  const AdaptResult tame = adapt_pb(model(), data_, ids_, start, AdaptOptions{});
+  EXPECT_EQ(tame.halvings, 0);
+}
+
 }  // namespace
 }  // namespace hadynet::trainer::testing
