@@ -28,7 +28,7 @@ namespace rs = trainer::residual;
 using nlohmann::json;
 
 // The console summary: fit per channel and horizon, whiteness, the top of the ranking, the verdict.
-void print_summary(const rs::Analysis& a, const std::string& pb_choice) {
+void print_summary(const rs::Analysis& a, const std::string& pb_choice, bool fixing) {
   const auto& d = a.data;
   std::printf("%zu logs, %zu channels; multi-step fit over %ld window starts\n%s\n", d.logs.size(),
               d.y_names.size(), a.horizon.samples, rs::pb_summary(d, pb_choice).c_str());
@@ -50,13 +50,16 @@ void print_summary(const rs::Analysis& a, const std::string& pb_choice) {
                 rs::hypothesis_status(r, a.attribution.options));
   }
   std::printf("\nverdict: %s\n", a.verdict.c_str());
+  if (a.attribution.winner() && !fixing)
+    std::printf("(the screen's candidate: only --fix, which adds it and compares with fine-tuning alone on held-out\n"
+                " rows, confirms an effect or reports unexplained structure)\n");
 }
 
 // The --fix console table: held-out RMSE before / fine-tune only / after.
 void print_fix(const rs::FixResult& fixed) {
   std::printf("\nfix: %s%s\n", fixed.status.c_str(),
               fixed.augmentation ? (": " + fixed.augmentation->description).c_str() : "");
-  const rs::HeldOutError& e = fixed.changed ? fixed.after : fixed.before;
+  const rs::HeldOutError& e = fixed.tried ? fixed.after : fixed.before;
   std::printf("held-out 1-step RMSE (%ld rows)   %-10s %11s %11s %11s   LB p before/after\n", fixed.before.samples,
               "channel", "before", "fine-tune", "after");
   // A figure that was not computed (a new channel has no "before"; nothing
@@ -74,11 +77,17 @@ void print_fix(const rs::FixResult& fixed) {
     std::printf("                                  %-10s %11s %11s %11s   %s / %s\n", e.channels[c].c_str(),
                 cell(old, old ? fixed.before.rmse(i) : 0, "%.4g").c_str(),
                 cell(control, control ? fixed.control->rmse(i) : 0, "%.4g").c_str(),
-                cell(fixed.changed, fixed.changed ? fixed.after.rmse(i) : 0, "%.4g").c_str(),
+                cell(fixed.tried, fixed.tried ? fixed.after.rmse(i) : 0, "%.4g").c_str(),
                 cell(old, old ? fixed.before.whiteness[c].ljung_box.p_value : 0, "%.2g").c_str(),
-                cell(fixed.changed, fixed.changed ? fixed.after.whiteness[c].ljung_box.p_value : 0, "%.2g").c_str());
+                cell(fixed.tried, fixed.tried ? fixed.after.whiteness[c].ljung_box.p_value : 0, "%.2g").c_str());
   }
-  if (fixed.changed) std::printf("verdict after: %s\n", fixed.after.verdict.c_str());
+  if (fixed.tried) {
+    std::printf("decision: against %s on", fixed.reference.c_str());
+    for (const auto& c : fixed.confirmation_channels) std::printf(" %s", c.c_str());
+    std::printf(": Diebold-Mariano p %.2g: %s\n", fixed.confirmation.p_value,
+                fixed.changed ? "confirmed" : "not confirmed, nothing applied");
+    std::printf("verdict after: %s\n", fixed.after.verdict.c_str());
+  }
 }
 
 }  // namespace
@@ -161,7 +170,7 @@ int run_residual(int argc, char** argv) {
     const std::string& pb_choice = ao.pb_choice;
     const rs::Analysis a = rs::analyse(model, inputs, ao);
     const auto& d = a.data;
-    print_summary(a, pb_choice);
+    print_summary(a, pb_choice, opt.has("fix"));
 
     json j = analysis_json(a, model_path, pb_choice);
     rs::FixOptions fo;

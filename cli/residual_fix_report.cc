@@ -49,10 +49,19 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
   }
   if (f.changed) j["sensor_model"] = f.model.sensor.describe();
   if (f.control) j["control"] = held_out_json(*f.control);
-  if (f.changed) {
+  if (f.tried) {
     j["after"] = held_out_json(f.after);
     j["loss_history"] = f.loss_history;
     j["train_windows"] = f.train_windows;
+    j["confirmation"] = {{"against", f.reference},
+                         {"channels", f.confirmation_channels},
+                         {"test", "Diebold-Mariano, one-sided, Newey-West variance"},
+                         {"mean_loss_difference", f.confirmation.mean},
+                         {"statistic", f.confirmation.stat},
+                         {"bandwidth", f.confirmation.bandwidth},
+                         {"rows", f.confirmation.samples},
+                         {"p_value", f.confirmation.p_value},
+                         {"confirmed", f.changed}};
   }
   return j;
 }
@@ -66,7 +75,7 @@ std::string fix_table(const rs::FixResult& f) {
       if (e.channels[c] == name) return static_cast<int>(c);
     return -1;
   };
-  const rs::HeldOutError& last = f.changed ? f.after : f.before;
+  const rs::HeldOutError& last = f.tried ? f.after : f.before;
   std::string m = "| channel | RMSE before | RMSE fine-tune only | RMSE after | fit before (%) | fit after (%) | "
                   "Ljung-Box p before | after | input lags outside before | after |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& name : last.channels) {
@@ -79,7 +88,7 @@ std::string fix_table(const rs::FixResult& f) {
                        : e->inputs_outside[static_cast<std::size_t>(i)];
       return num(fmt, v);
     };
-    const rs::HeldOutError* after = f.changed ? &f.after : nullptr;
+    const rs::HeldOutError* after = f.tried ? &f.after : nullptr;
     const rs::HeldOutError* ctrl = f.control ? &*f.control : nullptr;
     m += "| " + name + " | " + cell(&f.before, b, "%.4g", 0) + " | " + cell(ctrl, c, "%.4g", 0) + " | " +
          cell(after, a, "%.4g", 0) + " | " + cell(&f.before, b, "%.1f", 1) + " | " + cell(after, a, "%.1f", 1) + " | " +
@@ -101,7 +110,16 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
        " held-out rows, causal 1-step predictions of the measured values). \"Fine-tune only\" is the same "
        "fine-tuning without the augmentation.\n\n";
   m += "Verdict before: " + f.before.verdict + "\n\n";
-  if (f.changed) m += "Verdict after (the augmented model on its own frame): " + f.after.verdict + "\n\n";
+  if (f.tried) {
+    m += "Decision: the augmented model against " + f.reference + " on the held-out rows of ";
+    for (std::size_t i = 0; i < f.confirmation_channels.size(); ++i) m += (i ? ", " : "") + f.confirmation_channels[i];
+    m += " (one-sided Diebold-Mariano test of the standardised squared error, Newey-West variance over " +
+         std::to_string(f.confirmation.bandwidth) + " lags, " + std::to_string(f.confirmation.samples) +
+         " rows): mean loss difference " + num("%.3g", f.confirmation.mean) + ", p " +
+         num("%.2g", f.confirmation.p_value) + ": **" + (f.changed ? "confirmed" : "not confirmed, nothing applied") +
+         "**.\n\n";
+    m += "Verdict after (the augmented model on its own frame): " + f.after.verdict + "\n\n";
+  }
   if (f.changed && !f.model.sensor.empty()) {
     m += "Sensor model of the fixed model (measured channels from the network's):\n\n";
     for (const auto& line : f.model.sensor.describe()) m += "- " + line + "\n";
@@ -114,7 +132,7 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
 
 
 std::string fix_plot(const rs::FixResult& f, const std::string& png) {
-  if (!f.changed) return "";
+  if (!f.tried) return "";
   // Per channel: held-out RMSE after and fine-tune only, relative to before.
   std::string s = "$r << EOD\n";
   for (std::size_t c = 0; c < f.after.channels.size(); ++c) {

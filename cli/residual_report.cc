@@ -339,7 +339,7 @@ void write_report(const std::filesystem::path& dir, const rs::Analysis& a, const
   if (!md) throw std::runtime_error(md_path + ": cannot write");
   md << markdown(a, model_path, pb_choice, pngs);
   std::string fix_png;
-  if (fixed != nullptr && fixed->changed) {
+  if (fixed != nullptr && fixed->tried) {
     plot("fix.png", fix_plot(*fixed, (dir / "fix.png").string()));
     pngs.pop_back();  // shown in the Fix section
     fix_png = "fix.png";

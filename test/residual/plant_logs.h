@@ -4,6 +4,7 @@
 // through ExperimentSpec::effects and declared nowhere in the logs.
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -31,7 +32,10 @@ inline const std::vector<PlantLog> kEffectLogs = {
     {"Cylinder", "random2", 1}, {"Ball", "random2", 2}, {"Gripper", "random2", 0}, {"Cylinder", "random1", 0}};
 
 // The logs recorded with `effect` ("" for clean; plant syntax NAME[=VALUE]).
-inline std::vector<trainer::residual::LogInput> plant_logs(const std::string& effect, int steps = 300) {
+// Seed 1 is the model's training dataset seed; other seeds give fresh noise,
+// motions and encoder zeroings under the same state names.
+inline std::vector<trainer::residual::LogInput> plant_logs(const std::string& effect, int steps = 300,
+                                                           std::uint64_t seed = 1) {
   std::vector<trainer::residual::LogInput> out;
   for (const auto& l : kEffectLogs) {
     plant::ExperimentSpec spec;
@@ -39,7 +43,7 @@ inline std::vector<trainer::residual::LogInput> plant_logs(const std::string& ef
     spec.motion = *plant::parse_motion(l.motion);
     spec.init_id = l.init;
     spec.steps = steps;
-    spec.seed = 1;
+    spec.seed = seed;
     if (!effect.empty()) {
       const std::string err = plant::apply_effect_arg(effect, spec.effects);
       if (!err.empty()) throw std::invalid_argument(err);

@@ -25,6 +25,25 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
+// Per held-out row (one segment per log): the mean over `channels` of the
+// squared error in the model's standardised units (the training loss's).
+Segments standardised_loss(const HadynetModel& model, const HeldOutError& e, const std::vector<std::string>& channels) {
+  Segments out;
+  for (const auto& name : channels) {
+    const int c = index_of(e.channels, name);
+    const int k = index_of(model.layout.y_names, name);
+    if (c < 0 || k < 0) throw std::logic_error("--fix: channel " + name + " missing from a held-out evaluation");
+    const double scale = model.norm.y.std(k);
+    const Segments& r = e.residuals[static_cast<std::size_t>(c)];
+    if (out.empty()) out.assign(r.size(), Eigen::VectorXd());
+    for (std::size_t s = 0; s < r.size(); ++s) {
+      const Eigen::VectorXd sq = (r[s] / scale).array().square().matrix() / static_cast<double>(channels.size());
+      out[s] = out[s].size() == 0 ? sq : (out[s] + sq).eval();
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 bool fix_supported(EffectKind kind) { return kind != EffectKind::kInputDelay; }
@@ -437,6 +456,30 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   }
   LibraryOptions lib;
   result.after.verdict = verdict_text(attribute(again, enumerate_hypotheses(again, lib), attribution.options));
+  result.tried = true;
+
+  // The decision: after against the reference on the channels the effect
+  // was found on (every significant hypothesis of the augmented effect).
+  for (const auto& r : attribution.ranked) {
+    if (!r.significant || r.effect != aug->effect) continue;
+    const std::string& name = data.y_names[static_cast<std::size_t>(r.hypothesis.target)];
+    if (std::find(result.confirmation_channels.begin(), result.confirmation_channels.end(), name) ==
+        result.confirmation_channels.end())
+      result.confirmation_channels.push_back(name);
+  }
+  const HeldOutError& reference = result.control ? *result.control : result.before;
+  result.reference = result.control ? "fine-tuning alone" : "the unchanged model";
+  result.confirmation = diebold_mariano(standardised_loss(model, reference, result.confirmation_channels),
+                                        standardised_loss(model, result.after, result.confirmation_channels));
+  const bool confirmed = result.confirmation.mean > 0 && result.confirmation.p_value < attribution.options.alpha;
+  char p[32];
+  std::snprintf(p, sizeof p, "%.2g", result.confirmation.p_value);
+  if (!confirmed) {
+    result.status = "unexplained structure: adding " + aug->effect + " (" + aug->description + ") did not beat " +
+                    result.reference + " on the held-out rows of the channels it was found on (Diebold-Mariano p " +
+                    p + ")";
+    return result;
+  }
   result.model = std::move(after);
   result.changed = true;
   result.status = "fixed";

@@ -52,6 +52,7 @@
 #include "trainer/residual/residuals.h"
 #include "trainer/residual/fine_tune.h"
 #include "trainer/residual/held_out.h"
+#include "trainer/residual/statistics.h"
 #include "trainer/residual/whiteness.h"
 
 namespace hadynet::trainer::residual {
@@ -116,12 +117,25 @@ std::vector<LogInput> model_frame_logs(const SensorModel& sensor, const std::vec
 HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
                              const std::vector<LogSequence>& train_seqs);
 
+// The decision (issue 12, "decide by what the fix does"): the screen only
+// proposes; the augmented, fine-tuned model is kept only when it beats the
+// fine-tune-only control (or, with control off, the unchanged model) on the
+// held-out rows of the channels the effect was found on: a one-sided
+// Diebold-Mariano test (statistics.h) on the per-row standardised squared
+// error, mean over those channels, at the attribution's alpha. Otherwise the
+// status is "unexplained structure" and no model is produced.
 struct FixResult {
-  std::string status;  // "no significant effect", "not supported: ...", "fixed"
+  // "no significant effect", "not supported: ...", "fixed" (confirmed) or
+  // "unexplained structure: ..." (tried, not confirmed)
+  std::string status;
   std::optional<Augmentation> augmentation;
-  bool changed = false;        // a new model was produced
+  bool tried = false;          // the augmented model was fine-tuned and evaluated (after is valid)
+  bool changed = false;        // confirmed: a new model was produced
   HadynetModel model;          // the augmented, fine-tuned model (the input model if !changed)
-  HeldOutError before, after;  // after: the augmented model (empty if !changed)
+  HeldOutError before, after;  // after: the augmented model (valid if tried)
+  std::vector<std::string> confirmation_channels;  // where the effect was found (the test's channels)
+  std::string reference;                           // "fine-tuning alone" or "the unchanged model"
+  DieboldMariano confirmation;                     // reference's loss minus after's (valid if tried)
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
   std::vector<double> fitted_rates;     // drift: the attribution's rate per channel, before refinement

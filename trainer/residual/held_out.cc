@@ -108,6 +108,7 @@ HeldOutError held_out_error(const HadynetModel& model, const std::vector<HeldOut
     e.fit(c) = ss_total > 0 ? 100.0 * (1.0 - std::sqrt(sum_ee(c) / ss_total)) : 0.0;
     const auto& rc = res[static_cast<std::size_t>(c)];
     e.whiteness.push_back(whiteness(rc, kDefaultMaxLag));
+    e.residuals.push_back(rc);
     int outside = 0;
     for (const auto& u : inp) outside += cross_correlate(rc, u, kDefaultMaxLag).outside;
     e.inputs_outside.push_back(outside);

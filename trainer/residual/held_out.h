@@ -28,6 +28,7 @@ struct HeldOutError {
   std::vector<Whiteness> whiteness;   // Ljung-Box etc. of the held-out 1-step residual, per channel
   std::vector<int> inputs_outside;    // lags -L..L outside the 99 % bound, summed over the inputs
   long samples = 0;                   // held-out rows (all logs)
+  std::vector<Segments> residuals;    // [c]: y - y_hat of channel c on the held-out rows, one segment per log
   std::string verdict;                // attribution on the model's own frame (empty: not run)
 };
 

@@ -204,6 +204,53 @@ LjungBox ljung_box(const Segments& a, int max_lag) {
   return lb;
 }
 
+DieboldMariano diebold_mariano(const Segments& loss_a, const Segments& loss_b, int bandwidth) {
+  if (loss_a.size() != loss_b.size()) throw std::invalid_argument("diebold_mariano: segment counts differ");
+  DieboldMariano r;
+  Segments d;
+  double sum = 0;
+  for (std::size_t i = 0; i < loss_a.size(); ++i) {
+    if (loss_a[i].size() != loss_b[i].size()) throw std::invalid_argument("diebold_mariano: segment sizes differ");
+    d.push_back(loss_a[i] - loss_b[i]);
+    sum += d.back().sum();
+    r.samples += d.back().size();
+  }
+  if (r.samples < 2) return r;
+  const double n = static_cast<double>(r.samples);
+  r.mean = sum / n;
+  // Autocovariances of d about its pooled mean, pairs inside one segment.
+  const auto autocovariance = [&](int k) {
+    double gamma = 0;
+    for (const auto& s : d)
+      for (Eigen::Index t = k; t < s.size(); ++t) gamma += (s(t) - r.mean) * (s(t - k) - r.mean);
+    return gamma / n;
+  };
+  const double gamma0 = autocovariance(0);
+  if (bandwidth >= 0) {
+    r.bandwidth = bandwidth;
+  } else if (gamma0 > 0) {
+    // Andrews (1991), Bartlett kernel, AR(1) plug-in: S = 1.1447 (alpha N)^(1/3),
+    // alpha = 4 rho^2 / ((1 - rho)^2 (1 + rho)^2); at most N / 4 lags.
+    const double rho = std::clamp(autocovariance(1) / gamma0, -0.97, 0.97);
+    const double alpha = 4 * rho * rho / ((1 - rho) * (1 - rho) * (1 + rho) * (1 + rho));
+    r.bandwidth = static_cast<int>(std::min(std::ceil(1.1447 * std::cbrt(alpha * n)), n / 4));
+  }
+  double variance = 0;
+  for (int k = 0; k <= r.bandwidth; ++k) {
+    const double gamma = k == 0 ? gamma0 : autocovariance(k);
+    const double weight = k == 0 ? 1.0 : 2.0 * (1.0 - k / (r.bandwidth + 1.0));
+    variance += weight * gamma;
+  }
+  if (!(variance > 0)) {
+    r.stat = r.mean > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+    r.p_value = r.mean > 0 ? 0.0 : 1.0;
+    return r;
+  }
+  r.stat = r.mean / std::sqrt(variance / n);
+  r.p_value = 0.5 * std::erfc(r.stat / std::sqrt(2.0));
+  return r;
+}
+
 std::vector<double> holm_adjust(const std::vector<double>& p) {
   const std::size_t m = p.size();
   std::vector<std::size_t> order(m);
