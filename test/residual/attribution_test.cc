@@ -129,6 +129,25 @@ TEST(Attribution, AuxChannelAndCrosstalkWin) {
   }
 }
 
+// A rail is where the signal sits: a channel's extreme reached in a few rows
+// only is no saturation candidate (LibraryOptions::min_rail_share).
+TEST(Attribution, AnExtremeReachedOnceIsNoRail) {
+  const ResidualData d = synthetic(8, [](ResidualLog&) {});
+  int rails = 0;
+  for (const auto& h : enumerate_hypotheses(d, {}))
+    if (h.kind == EffectKind::kSaturation && h.target == 0) ++rails;
+  // AR(1) predictions plus noise: a continuous signal, its top and bottom
+  // 5 % of the range hold a handful of rows.
+  EXPECT_EQ(rails, 0);
+  LibraryOptions every_extreme;
+  every_extreme.min_rail_share = 0;
+  every_extreme.rail_band = 0;
+  int forced = 0;
+  for (const auto& h : enumerate_hypotheses(d, every_extreme))
+    if (h.kind == EffectKind::kSaturation && h.target == 0) ++forced;
+  EXPECT_EQ(forced, 0);  // still needs 5 rows at the extreme
+}
+
 TEST(Attribution, SaturationAndDriftWin) {
   // a0 is clipped at +1.5: measured = min(y_hat, 1.5) (rail = the largest measured value).
   const Attribution sat = run(synthetic(8, [](ResidualLog& log) {

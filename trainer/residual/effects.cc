@@ -214,8 +214,19 @@ std::vector<Hypothesis> enumerate_hypotheses(const ResidualData& data, const Lib
       hi = std::max(hi, log.seq.y.row(c).maxCoeff());
     }
     if (hi > lo) {
-      out.push_back({EffectKind::kSaturation, c, -1, 0, +1, hi});
-      out.push_back({EffectKind::kSaturation, c, -1, 0, -1, lo});
+      long rows = 0, at_hi = 0, at_lo = 0;
+      for (const auto& log : data.logs) {
+        const auto y = log.seq.y.row(c).array();
+        rows += y.size();
+        // "At": within rail_band of the channel's range (a saturated sensor still
+        // shows its ADC noise around the rail).
+        const double band = options.rail_band * (hi - lo);
+        at_hi += (y >= hi - band).count();
+        at_lo += (y <= lo + band).count();
+      }
+      const double need = std::max(5.0, options.min_rail_share * static_cast<double>(rows));
+      if (static_cast<double>(at_hi) >= need) out.push_back({EffectKind::kSaturation, c, -1, 0, +1, hi});
+      if (static_cast<double>(at_lo) >= need) out.push_back({EffectKind::kSaturation, c, -1, 0, -1, lo});
     }
     const std::string group = channel_group(data.y_names[static_cast<std::size_t>(c)]);
     for (int s = 0; s < ny; ++s) {

@@ -73,11 +73,23 @@ bool plausible(const Hypothesis& h, double parameter);
 struct LibraryOptions {
   int max_delay = 5;                // delays 1..max_delay steps
   bool crosstalk_same_group = true; // cross-talk sources: channels of the target's group only
+  // A rail is where a signal sits, not merely its extreme: a side of a
+  // channel is a saturation candidate only when at least min_rail_share of
+  // its rows (and at least 5) lie within rail_band of its range from the
+  // extreme: a saturated sensor sits there with its noise on top. (Clean
+  // plant logs, seed 31: a loadcell's maximum of 0.061 N, 7 of 1 200 rows in
+  // that band, was clipped and "confirmed"; real rails: the plant's loadcells
+  // clipped at 2 N put 3-16 % of their rows in it (noise sd 20 mN), its rated
+  // floor at 0 N holds 50-85 % of a contact-free loadcell's rows, the
+  // Cascaded Tanks' 10 V about 5 %.)
+  double min_rail_share = 0.02;
+  double rail_band = 0.05;
 };
 
 // Every hypothesis of the library for these logs: delays per target and
 // delay, friction per target and muscle, drift per target, saturation per
-// target and side (rails: the measured extremes over all logs), cross-talk
+// target and side (rails: the measured extremes over all logs, where the
+// signal sits: min_rail_share), cross-talk
 // per target and source, aux per target and aux channel.
 std::vector<Hypothesis> enumerate_hypotheses(const ResidualData& data, const LibraryOptions& options);
 
