@@ -117,12 +117,15 @@ int run_residual(int argc, char** argv) {
   opt.value("json", "FILE", "write every number as JSON");
   opt.flag("fix", "add the winning effect (sensor delay: time alignment; cross-talk: removal; drift: a bias state;\n"
                   "saturation: clipping; friction: hysteresis inputs; aux channel: an observed channel), fine-tune\n"
-                  "on the first --train-fraction of each log and report before/after on the rest");
+                  "on the first --train-fraction of each log and report before/after on the rest; the effect is\n"
+                  "confirmed (and the model kept) only when it beats fine-tuning alone on the held-out rows of\n"
+                  "the channels it changes (one-sided Diebold-Mariano test at --alpha), else 'unexplained structure'");
   opt.value("out", "FILE", "with --fix: write the augmented model (only when something was fixed)");
   opt.value("fix-epochs", "N", "with --fix: fine-tuning epochs", "20");
   opt.value("fix-lr", "X", "with --fix: Adam learning rate", "0.001");
   opt.value("fix-seed", "N", "with --fix: seed of the window order", "1");
-  opt.flag("no-control", "with --fix: skip the fine-tune-only comparison");
+  opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
+                        "unchanged model, a weaker guard)");
   if (!opt.parse(argc, argv)) return 2;
   if (opt.help_requested()) return 0;
   if (opt.positional().size() < 2) {

@@ -3,8 +3,9 @@
 // dynamics state by MomentumSGD on the full batch (BN in eval mode).
 //
 // Step-size safeguard: the paper's rate (1.0) was chosen on the hand, and on
-// data of another scale it diverges (the Cascaded Tanks: 1.89 V free-run
-// RMSE with an adapted PB against 0.48 V with the trained one). A step is
+// data of another scale it diverges (the Cascaded Tanks, as issue 12
+// reported for its model: 1.89 V free-run RMSE with an adapted PB against
+// 0.48 V with the trained one). A step is
 // kept when the full-batch loss after it is at most the largest of the last
 // kSafeguardWindow losses (a non-monotone test in the style of Grippo,
 // Lampariello and Lucidi 1986: momentum's bounded overshoots pass, growth

@@ -458,14 +458,23 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.after.verdict = verdict_text(attribute(again, enumerate_hypotheses(again, lib), attribution.options));
   result.tried = true;
 
-  // The decision: after against the reference on the channels the effect
-  // was found on (every significant hypothesis of the augmented effect).
-  for (const auto& r : attribution.ranked) {
-    if (!r.significant || r.effect != aug->effect) continue;
-    const std::string& name = data.y_names[static_cast<std::size_t>(r.hypothesis.target)];
+  // The decision: after against the reference on the channels the
+  // augmentation changes (of the model's own channels): the aligned, cleaned,
+  // clipped, drifting or friction channels; for an aux channel, the channels
+  // its significant hypotheses explain.
+  const auto add_channel = [&](const std::string& name) {
+    if (index_of(model.layout.y_names, name) < 0) return;
     if (std::find(result.confirmation_channels.begin(), result.confirmation_channels.end(), name) ==
         result.confirmation_channels.end())
       result.confirmation_channels.push_back(name);
+  };
+  if (aug->kind == EffectKind::kAuxChannel) {
+    const int source = index_of(data.aux_names, aug->channels.at(0));
+    for (const auto& r : attribution.ranked)
+      if (r.significant && r.hypothesis.kind == EffectKind::kAuxChannel && r.hypothesis.source == source)
+        add_channel(data.y_names[static_cast<std::size_t>(r.hypothesis.target)]);
+  } else {
+    for (const auto& name : aug->channels) add_channel(name);
   }
   const HeldOutError& reference = result.control ? *result.control : result.before;
   result.reference = result.control ? "fine-tuning alone" : "the unchanged model";
