@@ -142,14 +142,16 @@ int run_train(int argc, char** argv) {
 
   try {
     const std::vector<std::string> paths = trainer::expand_log_paths(opt.positional());
-    std::vector<datalog::LogTable> tables;
-    for (const std::string& path : paths) tables.push_back(datalog::read_log(path));
-    const trainer::FeatureLayout layout = trainer::feature_layout(
-        tables.front(), paths.front(), trainer::delta_groups_for(opt.get("delta-groups"), tables, paths));
-    std::vector<trainer::LogSequence> sequences;
-    for (std::size_t i = 0; i < paths.size(); ++i)
-      sequences.push_back(trainer::log_sequence(tables[i], paths[i], layout));
-    tables.clear();
+    const std::string delta_choice = opt.get("delta-groups");
+    const datalog::LogTable first = datalog::read_log(paths.front());
+    const trainer::FeatureLayout layout =
+        trainer::feature_layout(first, paths.front(), trainer::delta_groups_for(delta_choice, first));
+    std::vector<trainer::LogSequence> sequences = {trainer::log_sequence(first, paths.front(), layout)};
+    for (std::size_t i = 1; i < paths.size(); ++i) {  // one table in memory at a time
+      const datalog::LogTable table = datalog::read_log(paths[i]);
+      trainer::check_delta_groups_metadata(delta_choice, first, paths.front(), table, paths[i]);
+      sequences.push_back(trainer::log_sequence(table, paths[i], layout));
+    }
 
     const trainer::PbStateTable pb_table = trainer::pb_state_table(sequences);
     const std::vector<trainer::PbState>& states = pb_table.states;

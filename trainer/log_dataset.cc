@@ -209,21 +209,23 @@ std::vector<std::string> split_list(const std::string& text) {
 
 }  // namespace
 
-std::vector<std::string> delta_groups_for(const std::string& choice, const std::vector<datalog::LogTable>& tables,
-                                          const std::vector<std::string>& files) {
+std::vector<std::string> delta_groups_for(const std::string& choice, const datalog::LogTable& first) {
   if (choice == "none") return {};
   if (choice != "auto") return split_list(choice);
-  if (tables.empty()) return {};
-  const auto first = tables.front().metadata.get(kDeltaGroupsKey);
-  for (std::size_t i = 1; i < tables.size(); ++i) {
-    const auto here = tables[i].metadata.get(kDeltaGroupsKey);
-    if (here != first) {
-      throw std::runtime_error(files.at(i) + ": metadata '" + kDeltaGroupsKey + "' is " +
-                               (here ? "'" + *here + "'" : "absent") + " but " + (first ? "'" + *first + "'" : "absent") +
-                               " in " + files.front() + "; give --delta-groups");
-    }
-  }
-  return first ? split_list(*first) : std::vector<std::string>{};
+  const auto groups = first.metadata.get(kDeltaGroupsKey);
+  return groups ? split_list(*groups) : std::vector<std::string>{};
+}
+
+void check_delta_groups_metadata(const std::string& choice, const datalog::LogTable& first,
+                                 const std::string& first_file, const datalog::LogTable& table,
+                                 const std::string& file) {
+  if (choice != "auto") return;
+  const auto expected = first.metadata.get(kDeltaGroupsKey);
+  const auto here = table.metadata.get(kDeltaGroupsKey);
+  if (here == expected) return;
+  throw std::runtime_error(file + ": metadata '" + kDeltaGroupsKey + "' is " + (here ? "'" + *here + "'" : "absent") +
+                           " but " + (expected ? "'" + *expected + "'" : "absent") + " in " + first_file +
+                           "; give --delta-groups");
 }
 
 std::string content_hash(const std::vector<std::string>& paths) {

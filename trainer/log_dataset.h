@@ -80,14 +80,17 @@ Eigen::VectorXd initial_state(const FeatureLayout& layout, const LogSequence& se
 // std::runtime_error for a missing path or when nothing is found.
 std::vector<std::string> expand_log_paths(const std::vector<std::string>& args);
 
-// The delta groups for training on `tables` (read from `files`, same order):
-//   "auto"  the logs' `delta_groups` metadata, which must be the same in
-//           every log (none when no log has it);
+// The delta groups for training, from the option's `choice` and the first log:
+//   "auto"  the log's `delta_groups` metadata (none when it has none); every
+//           other log must say the same (check_delta_groups_metadata);
 //   "none"  no delta groups;
 //   else    a comma-separated list of observed groups.
-// Throws std::runtime_error naming the first log that disagrees.
-std::vector<std::string> delta_groups_for(const std::string& choice, const std::vector<datalog::LogTable>& tables,
-                                          const std::vector<std::string>& files);
+std::vector<std::string> delta_groups_for(const std::string& choice, const datalog::LogTable& first);
+// With "auto": throws std::runtime_error naming `file` when its
+// `delta_groups` metadata differs from the first log's (`first_file`).
+void check_delta_groups_metadata(const std::string& choice, const datalog::LogTable& first,
+                                 const std::string& first_file, const datalog::LogTable& table,
+                                 const std::string& file);
 
 // Identifies a dataset: FNV-1a 64 over, per path in the given order, the
 // file name (not the folder) and the bytes. 16 hex digits. Throws

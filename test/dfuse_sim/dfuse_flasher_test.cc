@@ -26,16 +26,6 @@ constexpr std::uint32_t kFlash = 0x08000000;
 constexpr std::size_t kImageSize = 150 * 1024 + 100;  // sectors 0..3 (16K), 4 (64K), 5 (128K); a short last block
 constexpr std::uint8_t kPattern = 0xA5;               // what the sectors the image does not cover hold
 
-Bytes pseudo_random(std::size_t n, std::uint32_t seed) {
-  Bytes b(n);
-  std::uint32_t x = seed;
-  for (auto& v : b) {
-    x = x * 1664525u + 1013904223u;  // LCG: deterministic test data
-    v = static_cast<std::uint8_t>(x >> 24);
-  }
-  return b;
-}
-
 class FlasherAgainstSimTest : public ::testing::Test {
  protected:
   void SetUp() override {

@@ -40,16 +40,6 @@ Bytes command(std::uint8_t code, std::uint32_t address) {
           static_cast<std::uint8_t>(address >> 16), static_cast<std::uint8_t>(address >> 24)};
 }
 
-Bytes pattern(std::size_t n, std::uint32_t seed) {
-  Bytes b(n);
-  std::uint32_t x = seed;
-  for (auto& v : b) {
-    x = x * 1664525u + 1013904223u;  // LCG: deterministic test data
-    v = static_cast<std::uint8_t>(x >> 24);
-  }
-  return b;
-}
-
 class RomBootloaderTest : public ::testing::Test {
  protected:
   void SetUp() override { ASSERT_TRUE(enumerate(sim.controller())); }
@@ -142,13 +132,13 @@ TEST_F(RomBootloaderTest, PollTimeoutPercentScalesTheReportedWait) {
   sim.set_poll_timeout_percent(1);
   run(0, command(0x21, 0x08004000), 1);
   run(0, command(0x41, 0x08004000), 8);
-  run(2, pattern(2048, 3), 1);
+  run(2, pseudo_random(2048, 3), 1);
   sim.set_poll_timeout_percent(0);
   run(0, command(0x21, 0x08004000), 0);
   run(0, command(0x41, 0x08004000), 0);
-  run(2, pattern(2048, 3), 0);
+  run(2, pseudo_random(2048, 3), 0);
   EXPECT_EQ(sim.dfu().datasheet_poll_ms(), 2u * (1 + 800 + 52));
-  EXPECT_EQ(flash_bytes(0x08004000, 2048), pattern(2048, 3));
+  EXPECT_EQ(flash_bytes(0x08004000, 2048), pseudo_random(2048, 3));
 }
 
 TEST_F(RomBootloaderTest, EraseOfOneSectorLeavesItsNeighboursIntact) {
@@ -162,7 +152,7 @@ TEST_F(RomBootloaderTest, EraseOfOneSectorLeavesItsNeighboursIntact) {
 }
 
 TEST_F(RomBootloaderTest, WriteThenReadBack) {
-  const Bytes data = pattern(2048 + 2048 + 100, 7);
+  const Bytes data = pseudo_random(2048 + 2048 + 100, 7);
   run(0, command(0x21, 0x08010000), 1);
   // 25 us/byte worst case (datasheet, x32): 2048 B -> 51.2 ms, rounded up to 52; 100 B -> 3 ms.
   run(2, Bytes(data.begin(), data.begin() + 2048), 52);

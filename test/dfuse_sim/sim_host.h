@@ -13,11 +13,13 @@
 
 #include "firmware/usb/host/fake_controller.h"
 #include "test/dfuse_sim/stm32_rom_bootloader.h"
+#include "test/usb/test_bytes.h"
 #include "tools/usb/dfu_client.h"
 
 namespace hadynet::usb::host_testing {
 
-using Bytes = std::vector<std::uint8_t>;
+using test_data::Bytes;
+using test_data::pseudo_random;
 
 inline SetupPacket standard_out(std::uint8_t request, std::uint16_t value, std::uint16_t index = 0) {
   return {request_type(false, RequestKind::kStandard, Recipient::kDevice), request, value, index, 0};

@@ -10,11 +10,15 @@
 namespace hadynet::trainer::residual {
 namespace {
 
+// Logs whose PB came from `sources` as compute_residuals labels them.
 ResidualData logs_with(const std::vector<std::string>& sources) {
   ResidualData d;
   for (const auto& s : sources) {
     ResidualLog log;
     log.pb_source = s;
+    log.pb_origin = s.rfind("state ", 0) == 0     ? ResidualLog::PbOrigin::kTrained
+                    : s.rfind("adapted", 0) == 0 ? ResidualLog::PbOrigin::kAdapted
+                                                 : ResidualLog::PbOrigin::kGiven;
     d.logs.push_back(log);
   }
   return d;

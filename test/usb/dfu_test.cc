@@ -8,7 +8,7 @@
 
 #include <cstring>
 
-#include "firmware/link/crc32.h"
+#include "test/usb/test_bytes.h"
 #include "usb_test_device.h"
 
 namespace hadynet::usb::testing {
@@ -16,6 +16,7 @@ namespace {
 
 constexpr std::uint8_t kDfu = composite::kDfuModeInterface;
 constexpr std::uint8_t kRuntime = composite::kDfuRuntimeInterface;
+using test_data::pseudo_random;
 using dfu::State;
 using dfu::Status;
 
@@ -46,29 +47,6 @@ State get_state(UsbTestDevice& dev) {
   Bytes in;
   EXPECT_TRUE(dev.control(dfu_req(true, dfu::kGetState, 0, 1), {}, &in).ok());
   return in.size() == 1 ? static_cast<State>(in[0]) : State::kAppIdle;
-}
-
-// The file sent over DFU: the envelope header assembled here byte by byte
-// (magic "HDIM", version 1, reserved 0, length, CRC-32), then the payload.
-Bytes make_image(const Bytes& payload, std::uint32_t crc_xor = 0, std::uint32_t length_override = 0xFFFFFFFF) {
-  const std::uint32_t crc = link::crc32(payload) ^ crc_xor;
-  const std::uint32_t length = length_override != 0xFFFFFFFF ? length_override
-                                                             : static_cast<std::uint32_t>(payload.size());
-  Bytes f = {'H', 'D', 'I', 'M', 1, 0, 0, 0};
-  for (int k = 0; k < 4; ++k) f.push_back(static_cast<std::uint8_t>(length >> (8 * k)));
-  for (int k = 0; k < 4; ++k) f.push_back(static_cast<std::uint8_t>(crc >> (8 * k)));
-  f.insert(f.end(), payload.begin(), payload.end());
-  return f;
-}
-
-Bytes pseudo_random(std::size_t n, std::uint32_t seed) {
-  Bytes b(n);
-  std::uint32_t x = seed;
-  for (auto& v : b) {
-    x = x * 1664525u + 1013904223u;  // LCG: deterministic test data
-    v = static_cast<std::uint8_t>(x >> 24);
-  }
-  return b;
 }
 
 struct DownloadTrace {
@@ -160,7 +138,7 @@ TEST(UsbDfuMode, DownloadAndUploadRoundTripByteForByte) {
   UsbTestDevice dev;
   dev.enumerate();
   // 150 KiB: crosses slot B's first 128 KiB sector into the second.
-  const Bytes file = make_image(pseudo_random(150 * 1024, 1));
+  const Bytes file = test_data::model_image_file(pseudo_random(150 * 1024, 1));
   const DownloadTrace t = download(dev, file);
   ASSERT_TRUE(t.final_status.ok);
   EXPECT_EQ(t.final_status.state, State::kIdle);
@@ -205,14 +183,14 @@ TEST(UsbDfuMode, AnImageOfExactlyTheSlotSizeFitsAndOneByteMoreDoesNot) {
   dev.enumerate();
   const std::uint32_t max_payload = kSlotB.size - 16;
   // Only the header matters for the size check: send the first block.
-  Bytes header = make_image({}, 0, max_payload + 1);
+  Bytes header = test_data::model_image_file({}, 0, max_payload + 1);
   header.resize(16);
   const DownloadTrace t = download(dev, header);
   EXPECT_EQ(t.final_status.state, State::kError);
   EXPECT_EQ(t.final_status.status, Status::kErrAddress);
   EXPECT_EQ(dev.flash.erase_count(), 0u) << "refused before anything was erased";
   ASSERT_TRUE(dev.control(dfu_req(false, dfu::kClrStatus, 0, 0)).ok());
-  const Bytes full = make_image(pseudo_random(max_payload, 2));
+  const Bytes full = test_data::model_image_file(pseudo_random(max_payload, 2));
   const DownloadTrace ok = download(dev, full);
   EXPECT_EQ(ok.final_status.state, State::kIdle);
   EXPECT_EQ(ok.final_status.status, Status::kOk);
@@ -222,10 +200,10 @@ TEST(UsbDfuMode, AnImageOfExactlyTheSlotSizeFitsAndOneByteMoreDoesNot) {
 TEST(UsbDfuMode, TooLargeImageLeavesThePreviousImageIntact) {
   UsbTestDevice dev;
   dev.enumerate();
-  const Bytes first = make_image(pseudo_random(3000, 3));
+  const Bytes first = test_data::model_image_file(pseudo_random(3000, 3));
   ASSERT_EQ(download(dev, first).final_status.state, State::kIdle);
   const std::uint64_t erases = dev.flash.erase_count();
-  const Bytes huge = make_image(pseudo_random(64, 4), 0, kSlotB.size);  // claims a payload as large as the slot
+  const Bytes huge = test_data::model_image_file(pseudo_random(64, 4), 0, kSlotB.size);  // claims a payload as large as the slot
   const DownloadTrace t = download(dev, huge);
   EXPECT_EQ(t.final_status.status, Status::kErrAddress);
   EXPECT_EQ(t.blocks_sent, 1u);
@@ -237,7 +215,7 @@ TEST(UsbDfuMode, TooLargeImageLeavesThePreviousImageIntact) {
 TEST(UsbDfuMode, BadCrcIsRefusedAtManifestationAndLeavesNoImage) {
   UsbTestDevice dev;
   dev.enumerate();
-  const DownloadTrace t = download(dev, make_image(pseudo_random(5000, 5), /*crc_xor=*/1));
+  const DownloadTrace t = download(dev, test_data::model_image_file(pseudo_random(5000, 5), /*crc_xor=*/1));
   EXPECT_EQ(t.final_status.state, State::kError);
   EXPECT_EQ(t.final_status.status, Status::kErrFile);
   EXPECT_EQ(t.states.back(), State::kError);
@@ -252,7 +230,7 @@ TEST(UsbDfuMode, FlashErrorsBecomeDfuStatusCodes) {
     UsbTestDevice dev;
     dev.enumerate();
     dev.flash.fail_write_at(1);  // the first operation is the slot's first erase
-    const DownloadTrace t = download(dev, make_image(pseudo_random(1000, 6)));
+    const DownloadTrace t = download(dev, test_data::model_image_file(pseudo_random(1000, 6)));
     EXPECT_EQ(t.final_status.state, State::kError);
     EXPECT_EQ(t.final_status.status, Status::kErrErase);
   }
@@ -260,14 +238,14 @@ TEST(UsbDfuMode, FlashErrorsBecomeDfuStatusCodes) {
     UsbTestDevice dev;
     dev.enumerate();
     dev.flash.fail_write_at(3);  // erase, program block 0, program block 1 (fails)
-    const DownloadTrace t = download(dev, make_image(pseudo_random(1000, 6)));
+    const DownloadTrace t = download(dev, test_data::model_image_file(pseudo_random(1000, 6)));
     EXPECT_EQ(t.final_status.state, State::kError);
     EXPECT_EQ(t.final_status.status, Status::kErrWrite);
     EXPECT_EQ(t.blocks_sent, 2u);
     // CLRSTATUS and a new download (the flash works again) succeed.
     ASSERT_TRUE(dev.control(dfu_req(false, dfu::kClrStatus, 0, 0)).ok());
     EXPECT_EQ(get_state(dev), State::kIdle);
-    const Bytes file = make_image(pseudo_random(1000, 7));
+    const Bytes file = test_data::model_image_file(pseudo_random(1000, 7));
     EXPECT_EQ(download(dev, file).final_status.state, State::kIdle);
     EXPECT_EQ(upload(dev), file);
   }
@@ -276,7 +254,7 @@ TEST(UsbDfuMode, FlashErrorsBecomeDfuStatusCodes) {
 TEST(UsbDfuMode, AbortMidwayLeavesNoImageAndANewDownloadWorks) {
   UsbTestDevice dev;
   dev.enumerate();
-  const Bytes file = make_image(pseudo_random(4000, 8));
+  const Bytes file = test_data::model_image_file(pseudo_random(4000, 8));
   for (std::uint16_t b = 0; b < 3; ++b) {
     const Bytes data(file.begin() + 256 * b, file.begin() + 256 * (b + 1));
     ASSERT_TRUE(dev.control(dfu_req(false, dfu::kDnload, b, 256), data).ok());
@@ -295,20 +273,20 @@ TEST(UsbDfuMode, LengthMismatchesBetweenHeaderAndData) {
   {  // more bytes than the header says
     UsbTestDevice dev;
     dev.enumerate();
-    Bytes file = make_image(pseudo_random(300, 9), 0, 200);
+    Bytes file = test_data::model_image_file(pseudo_random(300, 9), 0, 200);
     const DownloadTrace t = download(dev, file);
     EXPECT_EQ(t.final_status.status, Status::kErrAddress);
   }
   {  // fewer: the zero-length DNLOAD comes early
     UsbTestDevice dev;
     dev.enumerate();
-    const DownloadTrace t = download(dev, make_image(pseudo_random(300, 9), 0, 400));
+    const DownloadTrace t = download(dev, test_data::model_image_file(pseudo_random(300, 9), 0, 400));
     EXPECT_EQ(t.final_status.status, Status::kErrNotDone);
   }
   {  // not our envelope
     UsbTestDevice dev;
     dev.enumerate();
-    Bytes file = make_image(pseudo_random(300, 9));
+    Bytes file = test_data::model_image_file(pseudo_random(300, 9));
     file[0] = 'X';
     EXPECT_EQ(download(dev, file).final_status.status, Status::kErrFile);
   }
@@ -317,7 +295,7 @@ TEST(UsbDfuMode, LengthMismatchesBetweenHeaderAndData) {
 TEST(UsbDfuMode, BlockNumbersMustCountUp) {
   UsbTestDevice dev;
   dev.enumerate();
-  const Bytes file = make_image(pseudo_random(1000, 10));
+  const Bytes file = test_data::model_image_file(pseudo_random(1000, 10));
   ASSERT_TRUE(dev.control(dfu_req(false, dfu::kDnload, 7, 256), Bytes(file.begin(), file.begin() + 256)).ok());
   ASSERT_EQ(get_status(dev).state, State::kDnBusy);
   dev.usb->service();
@@ -356,12 +334,12 @@ TEST(UsbDfuMode, RequestsInTheWrongStateStallAndEnterDfuError) {
     EXPECT_EQ(get_state(dev), State::kIdle) << c.what;
   }
   // UPLOAD during a download; GETSTATE while busy.
-  ASSERT_TRUE(dev.control(dfu_req(false, dfu::kDnload, 0, 16), make_image({}, 0, 10)).ok());
+  ASSERT_TRUE(dev.control(dfu_req(false, dfu::kDnload, 0, 16), test_data::model_image_file({}, 0, 10)).ok());
   ASSERT_EQ(get_status(dev).state, State::kDnBusy);
   EXPECT_TRUE(dev.control(dfu_req(true, dfu::kGetState, 0, 1)).stalled());
   EXPECT_EQ(dev.usb->dfu_mode().state(), State::kError);
   ASSERT_TRUE(dev.control(dfu_req(false, dfu::kClrStatus, 0, 0)).ok());
-  ASSERT_TRUE(dev.control(dfu_req(false, dfu::kDnload, 0, 16), make_image({}, 0, 10)).ok());
+  ASSERT_TRUE(dev.control(dfu_req(false, dfu::kDnload, 0, 16), test_data::model_image_file({}, 0, 10)).ok());
   ASSERT_EQ(get_status(dev).state, State::kDnBusy);
   dev.usb->service();
   ASSERT_EQ(get_status(dev).state, State::kDnloadIdle);
@@ -378,7 +356,7 @@ TEST(UsbDfuMode, TheActiveSlotAlternateIsReadOnly) {
   const SetupPacket alt1{request_type(false, RequestKind::kStandard, Recipient::kInterface), request::kSetInterface,
                          1, kDfu, 0};
   ASSERT_TRUE(dev.control(alt1).ok());
-  const Bytes file = make_image(pseudo_random(100, 11));
+  const Bytes file = test_data::model_image_file(pseudo_random(100, 11));
   EXPECT_TRUE(dev.control(dfu_req(false, dfu::kDnload, 0, static_cast<std::uint16_t>(file.size())), file).stalled());
   const DfuStatus s = get_status(dev);
   EXPECT_EQ(s.state, State::kError);
@@ -393,8 +371,8 @@ TEST(UsbDfuMode, PowerCutAtAnyOperationNeverLeavesAHalfImageReadable) {
   // For each operation N of a download over an older image: cut power at N,
   // reboot (power on, new device over the same cells), and read the slot: it
   // must hold either no image or the complete new one (header written last).
-  const Bytes old_file = make_image(pseudo_random(700, 12));
-  const Bytes new_file = make_image(pseudo_random(900, 13));
+  const Bytes old_file = test_data::model_image_file(pseudo_random(700, 12));
+  const Bytes new_file = test_data::model_image_file(pseudo_random(900, 13));
   std::uint64_t operations = 0;
   {
     UsbTestDevice dev;

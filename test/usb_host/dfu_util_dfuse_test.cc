@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "test/dfuse_sim/stm32_rom_bootloader.h"
+#include "test/usb/test_bytes.h"
 #include "test/usb_host/child_process.h"
 #include "test/usb_host/usb_testbed.h"
 
@@ -22,7 +23,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-using Bytes = std::vector<std::uint8_t>;
+using test_data::Bytes;
+using test_data::pseudo_random;
 
 constexpr std::uint8_t kRomDevnum = 5;
 // 1 % of the datasheet's worst-case bwPollTimeout: dfu-util sleeps every
@@ -32,16 +34,6 @@ constexpr std::uint32_t kPollPercent = 1;
 // Tolerance of a dfu-util run: ~0.5 s here; 20 s only catches a hang.
 constexpr auto kChildTimeout = 20s;
 constexpr std::size_t kImageBytes = 100 * 1024 + 123;  // sectors 0..4, a short last block
-
-Bytes pseudo_random(std::size_t n, std::uint32_t seed) {
-  Bytes b(n);
-  std::uint32_t x = seed;
-  for (auto& v : b) {
-    x = x * 1664525u + 1013904223u;  // LCG: deterministic test data
-    v = static_cast<std::uint8_t>(x >> 24);
-  }
-  return b;
-}
 
 class DfuUtilDfuse : public ::testing::Test {
  protected:

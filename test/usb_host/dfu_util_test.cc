@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "firmware/link/crc32.h"
+#include "test/usb/test_bytes.h"
 #include "test/usb_host/child_process.h"
 #include "test/usb_host/hand_device.h"
 #include "test/usb_host/test_records.h"
@@ -30,21 +30,9 @@ using namespace std::chrono_literals;
 // is 5 s. 20 s only catches a hang.
 constexpr auto kChildTimeout = 20s;
 
-// A valid image (docs/usb.md envelope): "HDIM", version 1, reserved 0,
-// payload length, CRC-32 of the payload; then a pseudo-random payload.
+// A valid image (docs/usb.md envelope) with a pseudo-random payload.
 std::vector<std::uint8_t> model_image(std::size_t payload_bytes) {
-  std::vector<std::uint8_t> payload(payload_bytes);
-  std::uint32_t x = 11;
-  for (auto& v : payload) {
-    x = x * 1664525u + 1013904223u;
-    v = static_cast<std::uint8_t>(x >> 24);
-  }
-  const std::uint32_t crc = link::crc32(payload);
-  std::vector<std::uint8_t> image = {'H', 'D', 'I', 'M', 1, 0, 0, 0};
-  for (int k = 0; k < 4; ++k) image.push_back(static_cast<std::uint8_t>(payload.size() >> (8 * k)));
-  for (int k = 0; k < 4; ++k) image.push_back(static_cast<std::uint8_t>(crc >> (8 * k)));
-  for (const std::uint8_t b : payload) image.push_back(b);
-  return image;
+  return test_data::model_image_file(test_data::pseudo_random(payload_bytes, 11));
 }
 
 class DfuUtil : public ::testing::Test {

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "test/dfuse_sim/stm32_rom_bootloader.h"
+#include "test/usb/test_bytes.h"
 #include "test/usb_host/child_process.h"
 #include "test/usb_host/hand_device.h"
 #include "test/usb_host/test_records.h"
@@ -29,7 +30,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-using Bytes = std::vector<std::uint8_t>;
+using test_data::Bytes;
+using test_data::pseudo_random;
 
 constexpr std::uint8_t kRomDevnum = 3;  // where the bootloader appears (the hand is at 2)
 // The sim's bwPollTimeout at 1 % of the datasheet's worst case: a 150 KiB
@@ -44,16 +46,6 @@ constexpr std::uint32_t kPollPercent = 1;
 // catches a hang.
 constexpr auto kChildTimeout = 30s;
 constexpr std::size_t kImageBytes = 150 * 1024;  // sectors 0..5 (0x08000000 .. 0x0803FFFF)
-
-Bytes pseudo_random(std::size_t n, std::uint32_t seed) {
-  Bytes b(n);
-  std::uint32_t x = seed;
-  for (auto& v : b) {
-    x = x * 1664525u + 1013904223u;  // LCG: deterministic test data
-    v = static_cast<std::uint8_t>(x >> 24);
-  }
-  return b;
-}
 
 class CliFlash : public ::testing::Test {
  protected:

@@ -41,6 +41,7 @@
 #include <unistd.h>
 
 #include "test/dfuse_sim/stm32_rom_bootloader.h"
+#include "test/usb/test_bytes.h"
 #include "test/usb_host/child_process.h"
 #include "test/usb_host/hand_device.h"
 #include "test/usb_host/test_records.h"
@@ -57,16 +58,6 @@ constexpr std::uint8_t kHandDevnum = 2;
 constexpr std::uint8_t kFirstRomDevnum = 10;  // one fresh address per run
 constexpr std::size_t kReportsPerRecord = 4;  // docs/usb.md: the hand's model
 constexpr std::uint8_t kHidIn = 0x83;
-
-std::vector<std::uint8_t> pseudo_random(std::size_t n, std::uint32_t seed) {
-  std::vector<std::uint8_t> b(n);
-  std::uint32_t x = seed;
-  for (auto& v : b) {
-    x = x * 1664525u + 1013904223u;
-    v = static_cast<std::uint8_t>(x >> 24);
-  }
-  return b;
-}
 
 int fail(const std::string& what) {
   std::fprintf(stderr, "usb_flash_bench: %s\n", what.c_str());
@@ -212,7 +203,7 @@ int main(int argc, char** argv) {
   if (!bus.ok()) return fail(bus.error() + " (run under umockdev-wrapper)");
   const fs::path dir = fs::temp_directory_path() / ("hadynet_usb_flash_bench_" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  const std::vector<std::uint8_t> image = pseudo_random(a.bytes, 1);
+  const std::vector<std::uint8_t> image = hadynet::usb::test_data::pseudo_random(a.bytes, 1);
   const fs::path image_path = dir / "image.bin";
   std::ofstream(image_path, std::ios::binary)
       .write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));

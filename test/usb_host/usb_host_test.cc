@@ -18,12 +18,12 @@
 #include <vector>
 
 #include "firmware/app/period_record.h"
-#include "firmware/link/crc32.h"
 #include "firmware/link/frame.h"
 #include "firmware/link/link_client.h"
 #include "firmware/link/messages.h"
 #include "firmware/link/stream_decoder.h"
 #include "firmware/usb/telemetry_decoder.h"
+#include "test/usb/test_bytes.h"
 #include "test/usb_host/hand_device.h"
 #include "test/usb_host/test_records.h"
 #include "test/usb_host/usb_testbed.h"
@@ -419,18 +419,9 @@ TEST_F(UsbHost, DfuModelImageDownloadAndUploadRoundTrip) {
   EXPECT_EQ(libusb_set_interface_alt_setting(handle_, kDfuModeInterface, 2), LIBUSB_ERROR_NOT_FOUND);
   ASSERT_EQ(libusb_set_interface_alt_setting(handle_, kDfuModeInterface, 0), 0);  // the inactive slot
 
-  // The envelope (docs/usb.md): "HDIM", version 1, reserved 0, length, CRC-32; then the payload.
-  std::vector<std::uint8_t> payload(3000);
-  std::uint32_t x = 7;
-  for (auto& v : payload) {
-    x = x * 1664525u + 1013904223u;
-    v = static_cast<std::uint8_t>(x >> 24);
-  }
-  const std::uint32_t crc = link::crc32(payload);
-  std::vector<std::uint8_t> image = {'H', 'D', 'I', 'M', 1, 0, 0, 0};
-  for (int k = 0; k < 4; ++k) image.push_back(static_cast<std::uint8_t>(payload.size() >> (8 * k)));
-  for (int k = 0; k < 4; ++k) image.push_back(static_cast<std::uint8_t>(crc >> (8 * k)));
-  image.insert(image.end(), payload.begin(), payload.end());
+  // The envelope (docs/usb.md), then a pseudo-random payload.
+  const std::vector<std::uint8_t> payload = test_data::pseudo_random(3000, 7);
+  std::vector<std::uint8_t> image = test_data::model_image_file(payload);  // libusb takes non-const data
 
   constexpr std::size_t kBlock = 256;  // the DFU functional descriptor's wTransferSize
   std::uint16_t block = 0;

@@ -49,12 +49,12 @@ std::string verdict_text(const Attribution& attribution) {
 }
 
 std::string pb_summary(const ResidualData& data, const std::string& pb_choice) {
-  std::map<std::string, int> logs_by_source;  // "state X" sources pooled as "trained"
+  std::map<std::string, int> logs_by_source;  // given PBs, by their text
   int trained = 0, adapted = 0;
   for (const auto& log : data.logs) {
-    if (log.pb_source.rfind("state ", 0) == 0) {
+    if (log.pb_origin == ResidualLog::PbOrigin::kTrained) {
       ++trained;
-    } else if (log.pb_source.rfind("adapted", 0) == 0) {
+    } else if (log.pb_origin == ResidualLog::PbOrigin::kAdapted) {
       ++adapted;
     } else {
       ++logs_by_source[log.pb_source];

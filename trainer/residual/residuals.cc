@@ -122,12 +122,14 @@ ResidualData compute_residuals(const HadynetModel& model, const std::vector<LogI
   for (const auto& [state, members] : by_state) {
     Eigen::VectorXf pb;
     std::string source;
+    ResidualLog::PbOrigin origin = ResidualLog::PbOrigin::kGiven;
     const int k = model.state_index(state);
     if (pb_choice == "adapt" || (pb_choice == "auto" && k < 0)) {
       std::vector<LogSequence> seqs;
       for (std::size_t i : members) seqs.push_back(data.logs[i].seq);
       pb = adapt_to(model, seqs);
       source = "adapted to the state's logs";
+      origin = ResidualLog::PbOrigin::kAdapted;
     } else if (pb_choice == "state" || pb_choice == "auto") {
       if (k < 0) {
         throw std::runtime_error(data.logs[members.front()].seq.file + ": state '" + state +
@@ -135,6 +137,7 @@ ResidualData compute_residuals(const HadynetModel& model, const std::vector<LogI
       }
       pb = model.params.pb.row(k).transpose();
       source = "state " + state;
+      origin = ResidualLog::PbOrigin::kTrained;
     } else {
       pb = explicit_pb(model, pb_choice);
       source = pb_choice;
@@ -142,6 +145,7 @@ ResidualData compute_residuals(const HadynetModel& model, const std::vector<LogI
     for (std::size_t i : members) {
       data.logs[i].pb = pb;
       data.logs[i].pb_source = source;
+      data.logs[i].pb_origin = origin;
     }
   }
 

@@ -24,7 +24,9 @@ struct ResidualLog {
   Eigen::MatrixXd aux;  // aux x T: the aux_* columns named in ResidualData::aux_names
   double dt_s = 0;      // control period (metadata dt_s)
   Eigen::VectorXf pb;   // the PB the predictions used
-  std::string pb_source;  // "state Cylinder/i1/w0", "adapted", ...
+  std::string pb_source;  // "state Cylinder/i1/w0", "adapted to the state's logs", "zero", ...
+  enum class PbOrigin { kTrained, kAdapted, kGiven };
+  PbOrigin pb_origin = PbOrigin::kGiven;  // the state's trained PB, one adapted here, or --pb's values
   Eigen::MatrixXd y_hat;  // y x n, n = T - 2: column j predicts row t = j + 2
   Eigen::MatrixXd r;      // y x n: y_t - y_hat_t
 
