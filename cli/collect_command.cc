@@ -23,7 +23,7 @@ int run_collect(int argc, char** argv) {
   opt.value("seed", "N", "dataset seed", "1");
   opt.value("jobs", "N", "worker threads", std::to_string(std::max(1u, std::thread::hardware_concurrency())));
   opt.value("steps", "N", "steps (rows) per log, 0.2 s each", "500");
-  opt.value("object", "NAME", "None, Hammer, Hammer-S, Cylinder, Gripper, Ball, Cylinder-L", "None");
+  opt.value("object", "NAME", plant::object_list(), "None");
   opt.value("motion", "NAME", "random1 | random2", "random1");
   opt.value("init", "N", "initialisation (encoder zeroing) id", "0");
   opt.value("wear", "W", "wear level, 0 (new) .. 1 (worn)", "0");

@@ -38,7 +38,7 @@ int act(tools::ByteStream& stream, const std::vector<std::string>& action) {
   if (what == "info" || what == "reset") {
     const link::InfoReply i = session.info();
     std::printf("%s: protocol %u, contract %u, %s, model hash %016llx (%s)\n", stream.name().c_str(),
-                i.protocol_version, i.contract_version, i.numeric == 0 ? "q15" : "f32",
+                i.protocol_version, i.contract_version, link::numeric_name(i.numeric),
                 static_cast<unsigned long long>(i.model_hash), i.generator_version);
     std::printf("dims: x %u, u %u, y %u, pb %u, hidden %u, states %u; N_detect %u, horizon %u; detection %s (C %g)\n",
                 i.x, i.u, i.y, i.pb, i.hidden, i.states, i.detect_steps, i.control_horizon,
@@ -117,7 +117,6 @@ int run_link(int argc, char** argv) {
   }
   const auto parsed_numeric = opt.get_numeric("numeric");
   if (!parsed_numeric) return 2;
-  const std::string numeric = firmware::numeric_name(*parsed_numeric);
   try {
     std::unique_ptr<tools::QemuProcess> qemu;
     std::unique_ptr<tools::FdStream> own;
@@ -141,7 +140,7 @@ int run_link(int argc, char** argv) {
           tools::FdStream::connect_tcp(host_port->first, host_port->second, 5000));
       stream = own.get();
     }
-    return numeric == "q15" ? act<model_q15::Model>(*stream, opt.positional())
+    return *parsed_numeric == firmware::Numeric::kQ15 ? act<model_q15::Model>(*stream, opt.positional())
                             : act<model_f32::Model>(*stream, opt.positional());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hadynet link: %s\n", error_text(e).c_str());

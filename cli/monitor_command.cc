@@ -199,9 +199,8 @@ int run_monitor(int argc, char** argv) {
   if (!duration) return 2;
   const auto parsed_numeric = opt.get_numeric("numeric");
   if (!parsed_numeric) return 2;
-  const std::string numeric = firmware::numeric_name(*parsed_numeric);
   try {
-    return numeric == "q15" ? monitor<model_q15::Model>(opt, *duration) : monitor<model_f32::Model>(opt, *duration);
+    return *parsed_numeric == firmware::Numeric::kQ15 ? monitor<model_q15::Model>(opt, *duration) : monitor<model_f32::Model>(opt, *duration);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hadynet monitor: %s\n", error_text(e).c_str());
     return 1;

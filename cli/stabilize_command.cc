@@ -128,7 +128,7 @@ int run_stabilize(int argc, char** argv) {
               "E = h_loss,1 (N^2: the force channels' squared deviation from the grasp, beta = 3) over\n"
               "time. Deterministic for a seed.",
               "[options]");
-  opt.value("object", "NAME", "grasped object: None, Hammer, Hammer-S, Cylinder, Gripper, Ball, Cylinder-L",
+  opt.value("object", "NAME", "grasped object: " + plant::object_list(),
             std::string(plant::object_name(defaults.object)));
   opt.value("init", "N", "initialisation (encoder zeroing) id of the grasp's dynamics state",
             std::to_string(defaults.init_id));
@@ -217,7 +217,9 @@ int run_stabilize(int argc, char** argv) {
     }
     pb_note = co.pb_state + " (--pb)";
   } else {
-    const std::string preferred = std::string(plant::object_name(co.object)) + "/i0/w0";
+    plant::ExperimentSpec first_state;  // the object's state at initialisation 0, no wear
+    first_state.object = co.object;
+    const std::string preferred = plant::state_id(first_state);
     if (has_state(preferred)) {
       co.pb_state = preferred;
       pb_note = preferred + " (default for " + std::string(plant::object_name(co.object)) + ")";

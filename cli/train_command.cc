@@ -144,12 +144,12 @@ int run_train(int argc, char** argv) {
     const std::vector<std::string> paths = trainer::expand_log_paths(opt.positional());
     const std::string delta_choice = opt.get("delta-groups");
     const datalog::LogTable first = datalog::read_log(paths.front());
-    const trainer::FeatureLayout layout =
-        trainer::feature_layout(first, paths.front(), trainer::delta_groups_for(delta_choice, first));
+    const datalog::RobotProfile profile = trainer::training_profile(delta_choice, first, paths.front());
+    const trainer::FeatureLayout layout = trainer::feature_layout(first, paths.front(), profile.delta_groups);
     std::vector<trainer::LogSequence> sequences = {trainer::log_sequence(first, paths.front(), layout)};
     for (std::size_t i = 1; i < paths.size(); ++i) {  // one table in memory at a time
       const datalog::LogTable table = datalog::read_log(paths[i]);
-      trainer::check_delta_groups_metadata(delta_choice, first, paths.front(), table, paths[i]);
+      trainer::check_profile_metadata(delta_choice, first, paths.front(), table, paths[i]);
       sequences.push_back(trainer::log_sequence(table, paths[i], layout));
     }
 
@@ -165,6 +165,7 @@ int run_train(int argc, char** argv) {
     trainer::HadynetModel model =
         trainer::new_model(layout, norm, states, static_cast<int>(*pb), static_cast<int>(*hidden),
                            static_cast<int>(*steps), options.seed);
+    model.profile = profile;
     model.provenance = trainer::training_provenance(paths, HADYNET_GIT_COMMIT, HADYNET_VERSION);
     model.hyper_parameters = trainer::training_hyper_parameters(
         options, {static_cast<int>(*steps), opt.get("lr"), opt.get("held-out"), split.train.size(), split.held_out.size()});

@@ -10,6 +10,7 @@
 #include "datalog/dataset_manifest.h"
 #include "datalog/log_error.h"
 #include "datalog/log_reader.h"
+#include "datalog/robot_profile.h"
 
 namespace hadynet::cli {
 namespace fs = std::filesystem;
@@ -47,10 +48,29 @@ bool list_folder(const fs::path& dir, std::vector<LogEntry>& out) {
   return true;
 }
 
+// Per object: the mean and the largest value of each contact sum of the
+// logs' robot profile (datalog/robot_profile.h), in the channels' unit.
 struct ObjectStats {
   long rows = 0;
-  double tip_sum_N = 0, palm_sum_N = 0, tip_max_N = 0;
+  std::map<std::string, double> sum, max;  // by contact-sum name
 };
+
+// The unit the log's `units` metadata gives the group of `channel` ("fc3"
+// -> "N" from "... fc=N ..."); empty when it says nothing.
+std::string unit_of(const datalog::LogTable& log, const std::string& channel) {
+  const auto units = log.metadata.get("units");
+  if (!units) return "";
+  std::size_t digits = channel.find_first_of("0123456789");
+  const std::string prefix = channel.substr(0, digits) + "=";
+  std::size_t pos = 0;
+  while (pos < units->size()) {
+    const std::size_t end = std::min(units->find(' ', pos), units->size());
+    const std::string item = units->substr(pos, end - pos);
+    if (item.rfind(prefix, 0) == 0) return item.substr(prefix.size());
+    pos = end + 1;
+  }
+  return "";
+}
 
 }  // namespace
 
@@ -84,6 +104,8 @@ int run_validate(int argc, char** argv) {
   std::map<std::string, long> windows_per_split;
   std::set<std::string> states;
   std::map<std::string, ObjectStats> per_object;
+  std::vector<datalog::ContactSum> contact_sums;  // the first log's; logs with others are not summed
+  std::string unit;                               // of the contact sums' channels, from `units`
   std::string layout_text;
   for (const auto& entry : entries) {
     try {
@@ -105,16 +127,31 @@ int run_validate(int argc, char** argv) {
       windows += w;
       windows_per_split[entry.split] += w;
       states.insert(log.metadata.get("state").value_or(entry.path.string()));
-      // Loadcell statistics when the log has the hand's fc group (5 tips + palm).
+      // Contact statistics from the profile's contact sums (the hand: tips, palm).
+      const datalog::RobotProfile profile = datalog::read_profile(log.metadata, entry.path.string());
+      if (contact_sums.empty()) {
+        contact_sums = profile.contact_sums;
+        if (!contact_sums.empty()) unit = unit_of(log, contact_sums.front().channels.front());
+      }
       auto& stats = per_object[log.metadata.get("object").value_or("?")];
-      for (const auto& g : layout.observed) {
-        if (g.prefix != "fc") continue;
+      if (!profile.contact_sums.empty() && profile.contact_sums == contact_sums) {
+        std::vector<std::vector<std::size_t>> columns;
+        for (const datalog::ContactSum& c : contact_sums) {
+          columns.emplace_back();
+          for (const std::string& name : c.channels) {
+            const auto col = log.column_index(name);
+            if (!col) throw datalog::LogError(entry.path.string(), 0, 0, name, "contact sum '" + c.name + "' names channel '" + name + "', which the log lacks");
+            columns.back().push_back(*col);
+          }
+        }
         for (std::size_t r = 0; r < log.rows(); ++r) {
-          double tips = 0, palm = 0;
-          for (std::size_t c = 0; c < g.columns.size(); ++c) (c < 5 ? tips : palm) += log.at(r, g.columns[c]);
-          stats.tip_sum_N += tips;
-          stats.palm_sum_N += palm;
-          stats.tip_max_N = std::max(stats.tip_max_N, tips);
+          for (std::size_t k = 0; k < contact_sums.size(); ++k) {
+            double v = 0;
+            for (std::size_t col : columns[k]) v += log.at(r, col);
+            stats.sum[contact_sums[k].name] += v;
+            auto [it, fresh] = stats.max.emplace(contact_sums[k].name, v);
+            if (!fresh) it->second = std::max(it->second, v);
+          }
         }
         stats.rows += static_cast<long>(log.rows());
       }
@@ -129,12 +166,21 @@ int run_validate(int argc, char** argv) {
   std::printf("training windows of %lld steps: %ld", *window, windows);
   for (const auto& [split, w] : windows_per_split) std::printf("  [%s: %ld]", split.c_str(), w);
   std::printf("\n");
-  if (!per_object.empty() && per_object.begin()->second.rows > 0) {
-    std::printf("%-12s %8s %16s %16s %14s\n", "object", "rows", "mean tips (N)", "mean palm (N)", "max tips (N)");
+  if (!contact_sums.empty()) {
+    std::printf("%-12s %8s", "object", "rows");
+    for (const char* what : {"mean", "max"}) {
+      for (const auto& c : contact_sums) {
+        const std::string head = std::string(what) + " " + c.name + (unit.empty() ? "" : " (" + unit + ")");
+        std::printf(" %16s", head.c_str());
+      }
+    }
+    std::printf("\n");
     for (const auto& [object, s] : per_object) {
       if (s.rows == 0) continue;
-      std::printf("%-12s %8ld %16.3f %16.3f %14.2f\n", object.c_str(), s.rows, s.tip_sum_N / static_cast<double>(s.rows),
-                  s.palm_sum_N / static_cast<double>(s.rows), s.tip_max_N);
+      std::printf("%-12s %8ld", object.c_str(), s.rows);
+      for (const auto& c : contact_sums) std::printf(" %16.3f", s.sum.at(c.name) / static_cast<double>(s.rows));
+      for (const auto& c : contact_sums) std::printf(" %16.2f", s.max.at(c.name));
+      std::printf("\n");
     }
   }
   if (errors > 0) {

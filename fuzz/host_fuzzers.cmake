@@ -12,10 +12,9 @@ set(host_fuzz_flags -std=c++20 -O2 -g -fno-omit-frame-pointer ${fuzz_sanitize}
     -I${PROJECT_SOURCE_DIR} -I${hadynet_fuzz_eigen_inc}
     -Wall -Wextra -Wno-unknown-pragmas)
 
-set(fuzz_datalog_sources "")
-foreach(f atomic_file dataset_manifest log_error log_reader log_rules log_table log_writer)
-  list(APPEND fuzz_datalog_sources "${PROJECT_SOURCE_DIR}/datalog/${f}.cc")
-endforeach()
+# The log library's sources, as the build defines them (so a new file there
+# needs no edit here).
+hadynet_fuzz_collect_sources(hadynet_datalog fuzz_datalog_sources)
 hadynet_fuzzer(log_fuzzer
   SOURCES "${CMAKE_CURRENT_SOURCE_DIR}/log_fuzzer.cc" ${fuzz_datalog_sources}
   FLAGS ${host_fuzz_flags}

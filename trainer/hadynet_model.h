@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "datalog/robot_profile.h"
 #include "trainer/hadynet_params.h"
 #include "trainer/log_dataset.h"
 #include "trainer/normalization.h"
@@ -84,6 +85,11 @@ struct HadynetModel {
   long bn_batches_tracked = 0;  // enc_bn.num_batches_tracked (PyTorch buffer)
   std::optional<DetectionCalibration> detection;
   std::optional<ValueRanges> ranges;  // measured value ranges (needed by codegen)
+  // The robot profile of the logs it was trained on (datalog/robot_profile.h):
+  // loss classes, stabiliser commands, board channels, contact sums. Its
+  // delta_groups are always layout.delta_groups (the model file stores them
+  // once, with the channels). Empty: a robot whose logs carry no profile.
+  datalog::RobotProfile profile;
   SensorModel sensor;  // measured channels from the network's (sensor_model.h); empty: the same
   std::map<std::string, std::string> hyper_parameters;  // e.g. "lr" -> "0.001"
   std::map<std::string, std::string> provenance;        // data_hash, git_commit, logs, ...

@@ -193,39 +193,35 @@ std::vector<std::string> expand_log_paths(const std::vector<std::string>& args) 
   return paths;
 }
 
-namespace {
-
-std::vector<std::string> split_list(const std::string& text) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t comma = std::min(text.find(',', start), text.size());
-    const std::string item = text.substr(start, comma - start);
-    if (!item.empty()) out.push_back(item);
-    start = comma + 1;
-  }
-  return out;
-}
-
-}  // namespace
-
 std::vector<std::string> delta_groups_for(const std::string& choice, const datalog::LogTable& first) {
-  if (choice == "none") return {};
-  if (choice != "auto") return split_list(choice);
-  const auto groups = first.metadata.get(kDeltaGroupsKey);
-  return groups ? split_list(*groups) : std::vector<std::string>{};
+  if (choice != "auto") return datalog::split_list(choice);
+  const auto groups = first.metadata.get(datalog::kDeltaGroupsKey);
+  return groups ? datalog::split_list(*groups) : std::vector<std::string>{};
 }
 
-void check_delta_groups_metadata(const std::string& choice, const datalog::LogTable& first,
-                                 const std::string& first_file, const datalog::LogTable& table,
-                                 const std::string& file) {
-  if (choice != "auto") return;
-  const auto expected = first.metadata.get(kDeltaGroupsKey);
-  const auto here = table.metadata.get(kDeltaGroupsKey);
-  if (here == expected) return;
-  throw std::runtime_error(file + ": metadata '" + kDeltaGroupsKey + "' is " + (here ? "'" + *here + "'" : "absent") +
-                           " but " + (expected ? "'" + *expected + "'" : "absent") + " in " + first_file +
-                           "; give --delta-groups");
+datalog::RobotProfile training_profile(const std::string& choice, const datalog::LogTable& first,
+                                       const std::string& file) {
+  datalog::RobotProfile profile = datalog::read_profile(first.metadata, file);
+  profile.delta_groups = delta_groups_for(choice, first);
+  return profile;
+}
+
+void check_profile_metadata(const std::string& choice, const datalog::LogTable& first,
+                            const std::string& first_file, const datalog::LogTable& table,
+                            const std::string& file) {
+  const char* keys[] = {datalog::kDeltaGroupsKey,     datalog::kForceGroupsKey, datalog::kAngleGroupsKey,
+                        datalog::kLengthGroupsKey,    datalog::kControlCommandsKey, datalog::kBoardGroupKey,
+                        datalog::kContactSumsKey};
+  for (const char* key : keys) {
+    if (choice != "auto" && std::string_view(key) == datalog::kDeltaGroupsKey) continue;
+    const auto expected = first.metadata.get(key);
+    const auto here = table.metadata.get(key);
+    if (here == expected) continue;
+    throw std::runtime_error(file + ": metadata '" + key + "' is " + (here ? "'" + *here + "'" : "absent") + " but " +
+                             (expected ? "'" + *expected + "'" : "absent") + " in " + first_file +
+                             (std::string_view(key) == datalog::kDeltaGroupsKey ? "; give --delta-groups"
+                                                                                 : "; the logs come from different robots"));
+  }
 }
 
 std::string content_hash(const std::vector<std::string>& paths) {

@@ -15,12 +15,9 @@
 #include <vector>
 
 #include "datalog/log_table.h"
+#include "datalog/robot_profile.h"
 
 namespace hadynet::trainer {
-
-// The log metadata key naming the delta groups of a log's producer, e.g.
-// "l,th" for the hand (docs/log-format.md); absent: none.
-inline constexpr const char* kDeltaGroupsKey = "delta_groups";
 
 // Channel names of x, u and y. Equal layouts mean interchangeable logs.
 struct FeatureLayout {
@@ -81,16 +78,24 @@ Eigen::VectorXd initial_state(const FeatureLayout& layout, const LogSequence& se
 std::vector<std::string> expand_log_paths(const std::vector<std::string>& args);
 
 // The delta groups for training, from the option's `choice` and the first log:
-//   "auto"  the log's `delta_groups` metadata (none when it has none); every
-//           other log must say the same (check_delta_groups_metadata);
+//   "auto"  the log's `delta_groups` metadata (none when it has none);
 //   "none"  no delta groups;
 //   else    a comma-separated list of observed groups.
+// Throws std::invalid_argument on an empty list item.
 std::vector<std::string> delta_groups_for(const std::string& choice, const datalog::LogTable& first);
-// With "auto": throws std::runtime_error naming `file` when its
-// `delta_groups` metadata differs from the first log's (`first_file`).
-void check_delta_groups_metadata(const std::string& choice, const datalog::LogTable& first,
-                                 const std::string& first_file, const datalog::LogTable& table,
-                                 const std::string& file);
+
+// The robot profile the logs carry (datalog/robot_profile.h), with the delta
+// groups `choice` gives (delta_groups_for). Throws datalog::LogError naming
+// `file` on malformed profile metadata.
+datalog::RobotProfile training_profile(const std::string& choice, const datalog::LogTable& first,
+                                       const std::string& file);
+
+// Every log of a training set must carry the first log's profile (with
+// "auto", the delta groups too): throws std::runtime_error naming `file`, the
+// first differing key and `first_file` when `table`'s differs.
+void check_profile_metadata(const std::string& choice, const datalog::LogTable& first,
+                            const std::string& first_file, const datalog::LogTable& table,
+                            const std::string& file);
 
 // Identifies a dataset: FNV-1a 64 over, per path in the given order, the
 // file name (not the folder) and the bytes. 16 hex digits. Throws

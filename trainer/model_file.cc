@@ -117,6 +117,38 @@ Eigen::MatrixXd read_matrix(const st::File& file, const std::string& name, std::
       v.data(), static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
 }
 
+// The robot profile as metadata "profile" (its delta groups are in
+// "channels"):
+//   {"force_groups": [..], "angle_groups": [..], "length_groups": [..],
+//    "control_commands": [..], "board_group": "fc",
+//    "contact_sums": [{"name": "tips", "channels": ["fc0", ..]}, ..]}
+json profile_json(const datalog::RobotProfile& p) {
+  json sums = json::array();
+  for (const datalog::ContactSum& c : p.contact_sums) sums.push_back({{"name", c.name}, {"channels", c.channels}});
+  return json{{"force_groups", p.force_groups},         {"angle_groups", p.angle_groups},
+              {"length_groups", p.length_groups},       {"control_commands", p.control_commands},
+              {"board_group", p.board_group},           {"contact_sums", sums}};
+}
+
+datalog::RobotProfile profile_from_json(const json& j, const std::vector<std::string>& delta_groups,
+                                        const std::string& origin) {
+  if (!j.is_object()) fail(origin, "metadata 'profile' must be an object");
+  datalog::RobotProfile p;
+  p.delta_groups = delta_groups;
+  p.force_groups = json_get<std::vector<std::string>>(j, "force_groups", "profile", origin);
+  p.angle_groups = json_get<std::vector<std::string>>(j, "angle_groups", "profile", origin);
+  p.length_groups = json_get<std::vector<std::string>>(j, "length_groups", "profile", origin);
+  p.control_commands = json_get<std::vector<std::string>>(j, "control_commands", "profile", origin);
+  p.board_group = json_get<std::string>(j, "board_group", "profile", origin);
+  const json sums = j.contains("contact_sums") ? j.at("contact_sums") : json();
+  if (!sums.is_array()) fail(origin, "metadata 'profile': 'contact_sums' must be a list");
+  for (const json& c : sums) {
+    p.contact_sums.push_back({json_get<std::string>(c, "name", "profile contact sum", origin),
+                              json_get<std::vector<std::string>>(c, "channels", "profile contact sum", origin)});
+  }
+  return p;
+}
+
 // The sensor model (sensor_model.h) as metadata "sensor":
 //   {"delays": [{"channel", "steps"}], "crosstalk": [{"target", "source", "gain"}],
 //    "drifts": [{"channel", "driver": "load"|"time", "rate"}], "period_s": s,
@@ -272,6 +304,7 @@ st::File model_to_safetensors(const HadynetModel& model) {
     file.metadata["ranges"] = r.dump();
   }
   if (!model.sensor.empty()) file.metadata["sensor"] = sensor_json(model.sensor).dump();
+  if (!model.profile.empty()) file.metadata["profile"] = profile_json(model.profile).dump();
   return file;
 }
 
@@ -319,6 +352,11 @@ HadynetModel model_from_safetensors(const st::File& file, const std::string& ori
     if (json_get<std::vector<std::string>>(channels, "x", "channels", origin) !=
         model.layout.x_names) {
       fail(origin, "metadata 'channels': x does not follow from y and delta_groups");
+    }
+
+    model.profile.delta_groups = model.layout.delta_groups;
+    if (file.metadata.count("profile") != 0) {
+      model.profile = profile_from_json(parse_metadata_json(file, "profile", origin), model.layout.delta_groups, origin);
     }
 
     const json states = parse_metadata_json(file, "states", origin);

@@ -23,6 +23,7 @@ HadynetModel new_model(const FeatureLayout& layout, const Normalization& norm,
                        std::uint64_t seed) {
   HadynetModel model;
   model.layout = layout;
+  model.profile.delta_groups = layout.delta_groups;
   model.norm = norm;
   HadynetDims dims;
   dims.x = static_cast<int>(layout.x_names.size());

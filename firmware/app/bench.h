@@ -45,7 +45,7 @@ class Bench {
   // too large for the stack).
   [[noreturn]] static void run(Runtime& runtime, firmware::HadynetNet<M>& net) noexcept {
     Text<160> line;
-    line << "bench board=" << board::description().name << " numeric=" << (firmware::kIsFixed<M> ? "q15" : "f32")
+    line << "bench board=" << board::description().name << " numeric=" << firmware::numeric_name(M::kNumeric)
          << " tick_hz=" << board::description().tick_hz << " model=";
     line.hex(M::kModelHash) << '\n';
     emit(line);

@@ -61,7 +61,17 @@ constexpr bool is_finite_f32(float v) noexcept {
 
 // ---- 0x81 info
 
+// firmware::Numeric on the wire (one byte; the values are the protocol's).
 enum class WireNumeric : std::uint8_t { kQ15 = 0, kF32 = 1 };
+constexpr WireNumeric to_wire(firmware::Numeric n) noexcept {
+  return n == firmware::Numeric::kQ15 ? WireNumeric::kQ15 : WireNumeric::kF32;
+}
+// "q15", "f32", or "?" for a byte that names neither.
+constexpr const char* numeric_name(std::uint8_t wire) noexcept {
+  return wire == static_cast<std::uint8_t>(WireNumeric::kQ15)   ? firmware::numeric_name(firmware::Numeric::kQ15)
+         : wire == static_cast<std::uint8_t>(WireNumeric::kF32) ? firmware::numeric_name(firmware::Numeric::kF32)
+                                                                 : "?";
+}
 
 struct InfoReply {
   std::uint64_t model_hash = 0;  // FNV-1a 64 of the model file
@@ -84,7 +94,7 @@ constexpr InfoReply info_of() noexcept {
   r.model_hash = M::kModelHash;
   r.contract_version = static_cast<std::uint16_t>(M::kContractVersion);
   r.protocol_version = kProtocolVersion;
-  r.numeric = static_cast<std::uint8_t>(M::kNumeric == firmware::Numeric::kQ15 ? WireNumeric::kQ15 : WireNumeric::kF32);
+  r.numeric = static_cast<std::uint8_t>(to_wire(M::kNumeric));
   r.x = static_cast<std::uint16_t>(M::kX);
   r.u = static_cast<std::uint16_t>(M::kU);
   r.y = static_cast<std::uint16_t>(M::kY);

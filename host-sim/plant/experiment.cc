@@ -97,9 +97,9 @@ ExperimentResult run_experiment(const ExperimentSpec& spec) {
   meta.set("wear", wear_text(spec.wear_level));
   meta.set("seed", std::to_string(spec.seed));
   meta.set("units", "t=s l=mm f=N fc=N th=rad u=mm");
-  // Muscle lengths and wrist angles integrate the commands: the model sees
-  // their step differences too (the paper's x; `hadynet train` reads this).
-  meta.set("delta_groups", "l,th");
+  // The hand's profile: delta groups (the paper's x; `hadynet train` reads
+  // them), loss classes, stabiliser commands, board channels, contact sums.
+  datalog::write_profile(hand_profile(), meta);
   meta.set("source", "hadynet collect: MuJoCo hand plant (host-sim/plant)");
   if (spec.declare_effects) meta.set("effects", hand.effects.describe());
 
@@ -131,6 +131,20 @@ std::vector<std::string> observed_channel_names() {
   for (int i = 0; i < kLoadcells; ++i) names.push_back("fc" + std::to_string(i));
   for (int j = 0; j < kWristJoints; ++j) names.push_back("th" + std::to_string(j));
   return names;
+}
+
+datalog::RobotProfile hand_profile() {
+  datalog::RobotProfile p;
+  p.delta_groups = {"l", "th"};
+  p.force_groups = {"f", "fc"};
+  p.angle_groups = {"th"};
+  p.length_groups = {"l"};
+  for (int m = kIndexMiddle; m < kMuscles; ++m) p.control_commands.push_back("u" + std::to_string(m));
+  p.board_group = "fc";
+  datalog::ContactSum tips{"tips", {}}, palm{"palm", {}};
+  for (int i = 0; i < kLoadcells; ++i) (i < kFingertips ? tips : palm).channels.push_back("fc" + std::to_string(i));
+  p.contact_sums = {tips, palm};
+  return p;
 }
 
 std::vector<std::string> command_channel_names() {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "datalog/log_table.h"
+#include "datalog/robot_profile.h"
 #include "host-sim/plant/hand_plant.h"
 #include "host-sim/plant/hand_spec.h"
 #include "host-sim/plant/motions.h"
@@ -46,6 +47,13 @@ ExperimentResult run_experiment(const ExperimentSpec& spec);
 // th0, th1 and u = u0..u7 (docs/log-format.md, docs/plant.md).
 std::vector<std::string> observed_channel_names();
 std::vector<std::string> command_channel_names();
+// The hand's robot profile (datalog/robot_profile.h), written into every
+// log: l and th integrate the commands; f, fc are forces, th angles, l
+// lengths; the grasp stabiliser moves the finger muscles #1..#5 (u3..u7) and
+// holds the wrist muscles (docs/firmware.md: the wrist muscles carry the
+// strikes, and letting the stabiliser move them drove grasps away); the
+// board scans the loadcells fc0..fc8; tips are fc0..fc4, palm fc5..fc8.
+datalog::RobotProfile hand_profile();
 // Appends one frame's y values in observed_channel_names() order.
 void append_observed(const SensorFrame& y, std::vector<double>& out);
 

@@ -34,6 +34,12 @@ std::string_view object_name(ObjectKind kind) {
   return "?";
 }
 
+std::string object_list() {
+  std::string out;
+  for (const auto& e : kObjectNames) out += (out.empty() ? "" : ", ") + std::string(e.name);
+  return out;
+}
+
 std::optional<ObjectKind> parse_object(std::string_view name) {
   for (const auto& e : kObjectNames) {
     if (e.name.size() != name.size()) continue;

@@ -31,6 +31,7 @@ enum Muscle : int {
 inline constexpr std::array<int, 4> kFingerMuscles = {kIndexMiddle, kRingLittle, kThumbFlex, kThumbOppose};
 
 // Loadcell order (fc0..fc8): five fingertips, then four palm quadrants.
+inline constexpr int kFingertips = 5;
 inline constexpr std::array<const char*, kLoadcells> kLoadcellNames = {
     "thumb_tip", "index_tip", "middle_tip", "ring_tip", "little_tip",
     "palm_prox_radial", "palm_prox_ulnar", "palm_dist_radial", "palm_dist_ulnar"};
@@ -40,6 +41,9 @@ enum class ObjectKind { kNone, kHammer, kHammerSoft, kCylinder, kGripper, kBall,
 // Canonical names used in logs and on the command line.
 std::string_view object_name(ObjectKind kind);
 std::optional<ObjectKind> parse_object(std::string_view name);
+// Every object's canonical name, comma-separated ("None, Hammer, ..."), for
+// help texts.
+std::string object_list();
 // The six training objects of the seed paper, in its order.
 inline constexpr std::array<ObjectKind, 6> kPaperObjects = {
     ObjectKind::kNone, ObjectKind::kHammer, ObjectKind::kHammerSoft,

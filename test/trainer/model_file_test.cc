@@ -40,6 +40,11 @@ HadynetModel sample_model(bool with_detection) {
   m.hyper_parameters = {{"lr", "0.01"}, {"batch", "25"}};
   m.provenance = {{"data_hash", "0123456789abcdef"}, {"logs", "a.csv\nb.csv"}};
   if (with_detection) {
+    // The robot profile goes with this variant; the other one has none.
+    m.profile.force_groups = {"q"};
+    m.profile.control_commands = {"u0"};
+    m.profile.board_group = "q";
+    m.profile.contact_sums = {{"all", {"q0", "q1"}}};
     std::mt19937_64 rng(17);
     DetectionCalibration c;
     c.steps = 3;
@@ -98,6 +103,7 @@ void expect_same_model(const HadynetModel& got, const HadynetModel& want) {
   EXPECT_EQ(got.bn_batches_tracked, want.bn_batches_tracked);
   EXPECT_EQ(got.hyper_parameters, want.hyper_parameters);
   EXPECT_EQ(got.provenance, want.provenance);
+  EXPECT_EQ(got.profile, want.profile);
   ASSERT_EQ(got.detection.has_value(), want.detection.has_value());
   if (want.detection) {
     const DetectionCalibration& g = *got.detection;
