@@ -44,7 +44,7 @@ for seed in "${seeds[@]}"; do
   rm -rf "$d" && mkdir -p "$d/logs"
   for o in "Cylinder random2 1" "Ball random2 2" "Gripper random2 0" "Cylinder random1 0"; do
     set -- $o
-    "$hadynet" collect --object "$1" --motion "$2" --init "$3" --steps 300 --seed "$seed" --out "$d/logs" --quiet >/dev/null
+    "$hadynet" collect --object "$1" --motion "$2" --init "$3" --rows 300 --seed "$seed" --out "$d/logs" --quiet >/dev/null
   done
   if ! "$hadynet" residual "$model" "$d/logs" --fix --json "$d/residual.json" >"$d/out.txt" 2>&1; then
     echo "seed $seed: hadynet residual failed: $(tail -1 "$d/out.txt")" | tee -a "$summary"

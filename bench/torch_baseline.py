@@ -59,7 +59,7 @@ Timing:
 Usage (with the Python that has python3-torch, i.e. Debian's /usr/bin/python3;
 a pyenv or venv python3 earlier on PATH may not see it):
   python3 bench/torch_baseline.py [--data data/paper] [--epochs 3] [--threads 2]
-      [--batch 100] [--steps 10] [--hidden 128] [--pb 8] [--seed 1] [--json OUT]
+      [--batch 100] [--window 10] [--hidden 128] [--pb-size 8] [--seed 1] [--json OUT]
 """
 
 import argparse
@@ -272,9 +272,9 @@ def main(argv=None):
     ap.add_argument("--epochs", type=int, default=3, help="training epochs (default 3)")
     ap.add_argument("--threads", type=int, default=2, help="torch.set_num_threads (default 2)")
     ap.add_argument("--batch", type=int, default=100, help="windows per batch (default 100)")
-    ap.add_argument("--steps", type=int, default=10, help="steps N per window (default 10)")
+    ap.add_argument("--window", type=int, default=10, help="steps N per training window (default 10)")
     ap.add_argument("--hidden", type=int, default=128, help="LSTM units (default 128)")
-    ap.add_argument("--pb", type=int, default=8, help="parametric-bias size (default 8)")
+    ap.add_argument("--pb-size", type=int, default=8, help="parametric-bias size (default 8)")
     ap.add_argument("--seed", type=int, default=1, help="seed of initialisation and shuffling (default 1)")
     ap.add_argument("--delta-groups", default="l,th",
                     help="comma-separated observed groups whose t minus t-1 difference is added to x (default l,th)")
@@ -294,7 +294,7 @@ def main(argv=None):
     # Data loading and standardisation (not timed).
     delta_groups = {g for g in args.delta_groups.split(",") if g}
     t0 = time.perf_counter()
-    x, u, y, s, states, n_logs = load_dataset(args.data, delta_groups, args.steps)
+    x, u, y, s, states, n_logs = load_dataset(args.data, delta_groups, args.window)
     X = torch.from_numpy(standardise(x))
     U = torch.from_numpy(standardise(u)).contiguous()
     Y = torch.from_numpy(standardise(y)).contiguous()
@@ -302,9 +302,9 @@ def main(argv=None):
     load_s = time.perf_counter() - t0
     windows = X.shape[0]
     print(f"data: {args.data}: {n_logs} train logs, {len(states)} states, {windows} windows; "
-          f"x {X.shape[1]}, u {U.shape[2]}, y {Y.shape[2]}, N {args.steps} (loaded in {load_s:.2f} s)")
+          f"x {X.shape[1]}, u {U.shape[2]}, y {Y.shape[2]}, N {args.window} (loaded in {load_s:.2f} s)")
 
-    model = Hadynet(X.shape[1], U.shape[2], Y.shape[2], len(states), args.pb, args.hidden)
+    model = Hadynet(X.shape[1], U.shape[2], Y.shape[2], len(states), args.pb_size, args.hidden)
     model.train()
     loss_fn = nn.MSELoss()
 
@@ -321,7 +321,7 @@ def main(argv=None):
     threads = torch.get_num_threads()
     blas = loaded_blas()
     load1 = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
-    print(f"torch {torch.__version__}, {threads} threads, batch {args.batch}, hidden {args.hidden}, pb {args.pb}")
+    print(f"torch {torch.__version__}, {threads} threads, batch {args.batch}, hidden {args.hidden}, pb {args.pb_size}")
     print(f"BLAS: {blas}; {os.cpu_count()} CPUs, load average {load1:.2f} before timing")
     if is_reference_blas(blas):
         print("warning: torch uses the reference (unoptimised) BLAS; install libopenblas0 for a fair baseline",

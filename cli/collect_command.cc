@@ -22,7 +22,7 @@ int run_collect(int argc, char** argv) {
   opt.value("preset", "NAME", "paper | smoke: record a whole dataset");
   opt.value("seed", "N", "dataset seed", "1");
   opt.value("jobs", "N", "worker threads", std::to_string(std::max(1u, std::thread::hardware_concurrency())));
-  opt.value("steps", "N", "steps (rows) per log, 0.2 s each", "500");
+  opt.value("rows", "N", "rows (control periods, 0.2 s each) per log", "500");
   opt.value("object", "NAME", plant::object_list(), "None");
   opt.value("motion", "NAME", "random1 | random2", "random1");
   opt.value("init", "N", "initialisation (encoder zeroing) id", "0");
@@ -46,7 +46,7 @@ int run_collect(int argc, char** argv) {
   }
   const auto seed = opt.get_int("seed", 0, (1ll << 62));
   const auto jobs = opt.get_int("jobs", 1, 256);
-  const auto steps = opt.get_int("steps", 11, 1000000);
+  const auto steps = opt.get_int("rows", 11, 1000000);
   const auto init = opt.get_int("init", 0, 1000000);
   const auto wear = opt.get_double("wear", 0.0, 1.0);
   if (!seed || !jobs || !steps || !init || !wear) return 2;

@@ -141,7 +141,7 @@ int run_stabilize(int argc, char** argv) {
                 kIndent + "drift_max=N, frame=world|radial (docs/plant.md); \"strike\" alone is the default\n" +
                 kIndent + "schedule " + plant::default_strike().describe(),
             "strike");
-  opt.value("steps", "N", "control periods (0.2 s each) after the grasp", std::to_string(defaults.steps));
+  opt.value("periods", "N", "control periods (0.2 s each) after the grasp", std::to_string(defaults.steps));
   opt.value("numeric", "q15|f32", "which generated build of the core", "q15");
   opt.value("pb", "STATE", "PB the stabiliser predicts with: a state name of the model's PB table\n" + kIndent +
                                "(default: <OBJECT>/i0/w0 if the table has it, else the model's default PB)");
@@ -171,7 +171,7 @@ int run_stabilize(int argc, char** argv) {
   const auto init = opt.get_int("init", 0, 1000);
   const auto wear = opt.get_double("wear", 0.0, 1.0);
   const auto seed = opt.get_int("seed", 0, (1LL << 62));
-  const auto steps = opt.get_int("steps", 1, 100000);
+  const auto steps = opt.get_int("periods", 1, 100000);
   if (!init || !wear || !seed || !steps) return 2;
   co.init_id = static_cast<int>(*init);
   co.wear_level = *wear;

@@ -71,7 +71,7 @@ void check_resumable(const trainer::Checkpoint& c, const trainer::HadynetModel& 
   for (std::size_t k = 0; k < fresh.states.size(); ++k)
     if (c.model.states[k].name != fresh.states[k].name) bad("the set of states");
   if (!(c.model.params.dims == fresh.params.dims)) bad("the network size");
-  if (c.model.train_steps != fresh.train_steps) bad("--steps");
+  if (c.model.train_steps != fresh.train_steps) bad("--window");
   if (c.options.batch != o.batch || c.options.lr != o.lr || c.options.seed != o.seed ||
       c.options.variable_pb != o.variable_pb) {
     bad("--batch, --lr, --seed or --constant-pb");
@@ -97,10 +97,10 @@ int run_train(int argc, char** argv) {
   opt.value("out", "MODEL", "model file to write (.safetensors)");
   opt.value("epochs", "N", "epochs", "200");
   opt.value("batch", "N", "windows per batch", "100");
-  opt.value("steps", "N", "steps per window (N_train)", "10");
+  opt.value("window", "N", "steps per training window (N_train)", "10");
   opt.value("lr", "X", "Adam learning rate", "0.001");
   opt.value("seed", "N", "seed of the initial weights and of the shuffling", "1");
-  opt.value("pb", "N", "PB size", "8");
+  opt.value("pb-size", "N", "PB size (entries of each state's PB vector)", "8");
   opt.value("hidden", "N", "LSTM units", "128");
   opt.value("delta-groups", "LIST",
             "channel groups whose step differences join x: a comma-separated list, none, or auto (the logs'\n"
@@ -119,10 +119,10 @@ int run_train(int argc, char** argv) {
   }
   const auto epochs = opt.get_int("epochs", 1, 1000000);
   const auto batch = opt.get_int("batch", 2, 1000000);
-  const auto steps = opt.get_int("steps", 1, 1000);
+  const auto steps = opt.get_int("window", 1, 1000);
   const auto lr = opt.get_double("lr", 1e-12, 10.0);
   const auto seed = opt.get_int("seed", 0, (1ll << 62));
-  const auto pb = opt.get_int("pb", 1, 1024);
+  const auto pb = opt.get_int("pb-size", 1, 1024);
   const auto hidden = opt.get_int("hidden", 1, 65536);
   const auto held_out = opt.get_double("held-out", 0.0, 0.9);
   const auto threads = opt.get_int("threads", 0, 1024);

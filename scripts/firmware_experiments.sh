@@ -67,7 +67,7 @@ fi
 end_section
 
 section "grasp stabiliser in closed loop with the plant: Cylinder init 3, default strikes, q15"
-record "$hadynet" stabilize --object Cylinder --init 3 --steps 100 --csv "$out/stabilize.csv" \
+record "$hadynet" stabilize --object Cylinder --init 3 --periods 100 --csv "$out/stabilize.csv" \
   --plot "$out/stabilize.png"
 end_section
 echo "summary: $summary"

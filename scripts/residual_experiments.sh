@@ -37,7 +37,7 @@ for entry in "${effects[@]}"; do
   echo "== [$i/$n] $name (${elapsed}s elapsed, ETA ${eta}s)"
   for o in "Cylinder random2 1" "Ball random2 2" "Gripper random2 0" "Cylinder random1 0"; do
     set -- $o
-    "$hadynet" collect --object "$1" --motion "$2" --init "$3" --steps 300 --seed 1 --out "$dir/logs" \
+    "$hadynet" collect --object "$1" --motion "$2" --init "$3" --rows 300 --seed 1 --out "$dir/logs" \
       ${effect:+--effect "$effect"} >/dev/null
   done
   printf '\n## %s (plant: %s)\n\n```\n' "$name" "${effect:-no effect}" >>"$summary"

@@ -11,7 +11,7 @@ packages=(
   # build
   cmake ninja-build g++ make pkg-config git
   # trainer, plant, tests, plots (libmujoco-dev's CMake config needs libqhull-dev's headers)
-  libeigen3-dev libmujoco-dev libqhull-dev libgtest-dev libgmock-dev nlohmann-json3-dev gnuplot-nox
+  libeigen3-dev libsodium-dev libmujoco-dev libqhull-dev libgtest-dev libgmock-dev nlohmann-json3-dev gnuplot-nox
   # firmware cross build and emulation (python3: the QEMU test runner, test/boards/qemu_run.py)
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm python3
   # host USB tools and their tests

@@ -1,3 +1,4 @@
+#include "trainer/data_hash.h"
 #include "trainer/deploy_prep.h"
 
 #include <algorithm>
@@ -105,7 +106,7 @@ ValueRanges measure_log_ranges(const HadynetModel& model, const std::vector<std:
   std::string args;
   for (const std::string& a : log_args) args += (args.empty() ? "" : " ") + a;
   r.source = args + ": " + std::to_string(paths.size()) + " logs (data_hash " +
-             content_hash(paths) + "), all windows of " + std::to_string(model.train_steps) +
+             data_hash(paths) + "), all windows of " + std::to_string(model.train_steps) +
              " steps";
   return r;
 }

@@ -7,7 +7,6 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "datalog/content_hash.h"
 #include "datalog/log_limits.h"
 #include "datalog/log_reader.h"
 #include "trainer/derived_inputs.h"
@@ -222,25 +221,6 @@ void check_profile_metadata(const std::string& choice, const datalog::LogTable& 
                              (std::string_view(key) == datalog::kDeltaGroupsKey ? "; give --delta-groups"
                                                                                  : "; the logs come from different robots"));
   }
-}
-
-std::string content_hash(const std::vector<std::string>& paths) {
-  datalog::Fnv1a64 h;
-  const auto mix = [&h](const char* data, std::size_t n) { h.update(std::string_view(data, n)); };
-  std::vector<char> buffer(1 << 16);
-  for (const std::string& path : paths) {
-    const std::string name = std::filesystem::path(path).filename().string();
-    mix(name.data(), name.size() + 1);  // with the terminating 0 as a separator
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error(path + ": cannot read");
-    while (in) {
-      in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-      mix(buffer.data(), static_cast<std::size_t>(in.gcount()));
-    }
-  }
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h.value()));
-  return hex;
 }
 
 }  // namespace hadynet::trainer

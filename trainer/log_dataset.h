@@ -97,9 +97,4 @@ void check_profile_metadata(const std::string& choice, const datalog::LogTable& 
                             const std::string& first_file, const datalog::LogTable& table,
                             const std::string& file);
 
-// Identifies a dataset: FNV-1a 64 over, per path in the given order, the
-// file name (not the folder) and the bytes. 16 hex digits. Throws
-// std::runtime_error naming an unreadable file.
-std::string content_hash(const std::vector<std::string>& paths);
-
 }  // namespace hadynet::trainer

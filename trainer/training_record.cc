@@ -1,3 +1,4 @@
+#include "trainer/data_hash.h"
 #include "trainer/training_record.h"
 
 #include <ctime>
@@ -26,7 +27,7 @@ PbStateTable pb_state_table(const std::vector<LogSequence>& sequences) {
 
 std::map<std::string, std::string> training_provenance(const std::vector<std::string>& log_paths,
                                                        const std::string& git_commit, const std::string& version) {
-  return {{"data_hash", content_hash(log_paths)},
+  return {{"data_hash", data_hash(log_paths)},
           {"git_commit", git_commit},
           {"hadynet_version", version},
           {"logs", std::to_string(log_paths.size())},

@@ -25,7 +25,7 @@ struct PbStateTable {
 // Throws std::runtime_error naming the log when one state has two objects.
 PbStateTable pb_state_table(const std::vector<LogSequence>& sequences);
 
-// Where the model came from. Keys: data_hash (content_hash of the logs),
+// Where the model came from. Keys: data_hash (data_hash.h: SHA-256 of the logs),
 // git_commit, hadynet_version, logs (how many), created_utc (ISO 8601).
 std::map<std::string, std::string> training_provenance(const std::vector<std::string>& log_paths,
                                                        const std::string& git_commit, const std::string& version);

@@ -24,7 +24,7 @@ function(run)
 endfunction()
 
 # A grasp of a state the model never trained on; control from row 20.
-run("${HADYNET}" collect --object Cylinder --motion random2 --init 3 --steps 60 --split test --out "${WORK}" --quiet)
+run("${HADYNET}" collect --object Cylinder --motion random2 --init 3 --rows 60 --split test --out "${WORK}" --quiet)
 set(log "${WORK}/test/Cylinder_random2_i3_w0.csv")
 run("${HADYNET}" replay "${log}" --out "${WORK}/host.csv" --control-from 20)
 run("${HADYNET}" replay "${log}" --out "${WORK}/qemu.csv" --control-from 20 --target qemu --image "${IMAGE}"

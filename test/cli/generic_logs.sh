@@ -32,7 +32,7 @@ mkdir -p plain tagged mixed
 cp a.csv b.csv plain/
 cp c.csv tagged/
 cp a.csv c.csv mixed/
-small=(--epochs 1 --batch 10 --steps 3 --hidden 8 --pb 2 --quiet)
+small=(--epochs 1 --batch 10 --window 3 --hidden 8 --pb-size 2 --quiet)
 
 # Defaults on logs without an `l` group: trains (exit 0), no delta group.
 out=$("$hadynet" train plain --out plain.safetensors "${small[@]}" 2>&1) || fail "train with defaults: $out"

@@ -9,7 +9,7 @@ work="$2"
 rm -rf "$work"
 mkdir -p "$work"
 "$hadynet" collect --preset smoke --quiet --out "$work/data"
-args=(--epochs 80 --hidden 32 --pb 2 --batch 20 --seed 5 --threads 1 --quiet)
+args=(--epochs 80 --hidden 32 --pb-size 2 --batch 20 --seed 5 --threads 1 --quiet)
 
 "$hadynet" train "$work/data/train" --out "$work/straight.safetensors" "${args[@]}" >/dev/null
 

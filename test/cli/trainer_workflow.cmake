@@ -20,7 +20,7 @@ endfunction()
 run("${HADYNET}" collect --preset smoke --quiet --out "${WORK}/data")
 must_succeed("collect")
 set(model "${WORK}/m.safetensors")
-set(tiny --hidden 16 --pb 2 --batch 20 --seed 3 --threads 1)  # 1 thread: ctest may run tests in parallel
+set(tiny --hidden 16 --pb-size 2 --batch 20 --seed 3 --threads 1)  # 1 thread: ctest may run tests in parallel
 
 run("${HADYNET}" train "${WORK}/data/train" --out "${model}" --epochs 2 ${tiny})
 must_succeed("train")

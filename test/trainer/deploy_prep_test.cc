@@ -5,6 +5,7 @@
 
 #include "synthetic_logs.h"
 #include "test_batches.h"
+#include "trainer/data_hash.h"
 #include "trainer/deploy_prep.h"
 
 namespace hadynet::trainer::testing {
@@ -110,7 +111,7 @@ TEST(MeasureLogRanges, EveryWindowOfTheLogsWithTheirStatesPb) {
   ValueRanges want = measure_ranges(m, data, all_ids(data));
   EXPECT_EQ(r.windows, data.size());
   EXPECT_EQ(r.windows, (40 - 1 - kSpringTrainSteps) + (30 - 1 - kSpringTrainSteps));
-  EXPECT_TRUE(contains(r.source, "2 logs (data_hash " + content_hash({soft, stiff}) + ")")) << r.source;
+  EXPECT_TRUE(contains(r.source, "2 logs (data_hash " + data_hash({soft, stiff}) + ")")) << r.source;
   want.source = r.source;
   EXPECT_EQ(r, want);  // same windows, same order of computation: exact
 

@@ -2,6 +2,7 @@
 // their errors, x_t from y, file expansion and the dataset hash.
 // Every comparison is exact: extraction copies doubles and x_t's differences
 // are the same single double subtraction as in the reference.
+#include "trainer/data_hash.h"
 #include "trainer/log_dataset.h"
 
 #include <gtest/gtest.h>
@@ -209,16 +210,16 @@ TEST(ExpandLogPaths, MissingPathEmptyFolderAndNoArgumentsAreErrors) {
   EXPECT_THROW(expand_log_paths({}), std::runtime_error);
 }
 
-TEST(ContentHash, StableAndSensitiveToEveryByteAndName) {
+TEST(DataHash, StableAndSensitiveToEveryByteAndName) {
   TempDir dir;
   const std::string a = dir.write_log("one/a.csv", spring_log(1.0, 20, 1, "a"));
   const std::string b = dir.write_log("one/b.csv", spring_log(2.0, 20, 2, "b"));
-  const std::string h = content_hash({a, b});
-  ASSERT_EQ(h.size(), 16u);
+  const std::string h = data_hash({a, b});
+  ASSERT_EQ(h.size(), 64u);  // SHA-256
   EXPECT_EQ(h.find_first_not_of("0123456789abcdef"), std::string::npos) << h;
-  EXPECT_EQ(content_hash({a, b}), h);  // stable
-  EXPECT_NE(content_hash({b, a}), h);  // the given order counts
-  EXPECT_NE(content_hash({a}), h);
+  EXPECT_EQ(data_hash({a, b}), h);  // stable
+  EXPECT_NE(data_hash({b, a}), h);  // the given order counts
+  EXPECT_NE(data_hash({a}), h);
 
   // Same names and bytes in another folder: same hash (folders do not count).
   fs::create_directories(dir.path() / "two");
@@ -226,12 +227,12 @@ TEST(ContentHash, StableAndSensitiveToEveryByteAndName) {
   const std::string b2 = (dir.path() / "two" / "b.csv").string();
   fs::copy_file(a, a2);
   fs::copy_file(b, b2);
-  EXPECT_EQ(content_hash({a2, b2}), h);
+  EXPECT_EQ(data_hash({a2, b2}), h);
 
   // A renamed file changes it.
   const std::string renamed = (dir.path() / "two" / "c.csv").string();
   fs::copy_file(b, renamed);
-  EXPECT_NE(content_hash({a2, renamed}), h);
+  EXPECT_NE(data_hash({a2, renamed}), h);
 
   // One changed byte anywhere (first, middle, last) changes it; restoring restores it.
   const std::string original = read_bytes(b2);
@@ -239,13 +240,22 @@ TEST(ContentHash, StableAndSensitiveToEveryByteAndName) {
     std::string changed = original;
     changed[pos] = static_cast<char>(changed[pos] ^ 0x01);
     write_bytes(b2, changed);
-    EXPECT_NE(content_hash({a2, b2}), h) << "byte " << pos;
+    EXPECT_NE(data_hash({a2, b2}), h) << "byte " << pos;
   }
   write_bytes(b2, original);
-  EXPECT_EQ(content_hash({a2, b2}), h);
+  EXPECT_EQ(data_hash({a2, b2}), h);
 
   const std::string missing = (dir.path() / "gone.csv").string();
-  expect_runtime_error([&] { content_hash({a, missing}); }, {missing});
+  expect_runtime_error([&] { data_hash({a, missing}); }, {missing});
+}
+
+// A known answer, independent of this code: SHA-256 of "x", a 0 byte and
+// "abc" (Python's hashlib.sha256(b"x\x00abc")).
+TEST(DataHash, IsSha256OfNameZeroAndBytes) {
+  TempDir dir;
+  const std::string x = (dir.path() / "x").string();
+  write_bytes(x, "abc");
+  EXPECT_EQ(data_hash({x}), "7899406e7ba30b3904cd2a37bc0d8d8c77aa96525d34ecf614c69f418e37982b");
 }
 
 }  // namespace
