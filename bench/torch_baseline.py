@@ -280,7 +280,7 @@ def main(argv=None):
                     help="comma-separated observed groups whose t minus t-1 difference is added to x (default l,th)")
     ap.add_argument("--json", metavar="OUT", help="write the results as JSON to OUT")
     args = ap.parse_args(argv)
-    for name in ("epochs", "threads", "batch", "steps", "hidden", "pb"):
+    for name in ("epochs", "threads", "batch", "window", "hidden", "pb_size"):
         if getattr(args, name) < 1:
             ap.error(f"--{name} must be >= 1")
     if args.batch < 2:
