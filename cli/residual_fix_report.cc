@@ -38,13 +38,16 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
             {"seed", o.seed},
             {"before", held_out_json(f.before)}};
   if (f.augmentation) {
-    j["augmentation"] = {{"effect", f.augmentation->effect}, {"description", f.augmentation->description},
-                         {"channels", f.augmentation->channels}, {"delay_steps", f.augmentation->delay}};
-    if (f.augmentation->kind == rs::EffectKind::kCrosstalk) {
-      j["augmentation"]["source"] = f.augmentation->source;
-      j["augmentation"]["gain"] = f.augmentation->gain;
+    const rs::Augmentation& a = *f.augmentation;
+    const auto* alignment = std::get_if<rs::TimeAlignment>(&a.change);
+    j["augmentation"] = {{"effect", a.effect}, {"description", a.description}, {"channels", a.channels},
+                         {"delay_steps", alignment != nullptr ? alignment->delay : 0}};
+    if (const auto* removal = std::get_if<rs::CrosstalkRemoval>(&a.change)) {
+      j["augmentation"]["source"] = removal->pair.source;
+      j["augmentation"]["gain"] = removal->pair.gain;
     }
-    if (!f.augmentation->inputs.empty()) j["augmentation"]["derived_inputs"] = f.augmentation->inputs;
+    const auto* hysteresis = std::get_if<rs::HysteresisInputs>(&a.change);
+    if (hysteresis != nullptr && !hysteresis->inputs.empty()) j["augmentation"]["derived_inputs"] = hysteresis->inputs;
     if (!f.fitted_rates.empty()) j["augmentation"]["fitted_rates"] = f.fitted_rates;
   }
   if (f.changed) j["sensor_model"] = f.model.sensor.describe();

@@ -38,26 +38,13 @@ json hypothesis_json(const rs::ResidualData& data, const rs::HypothesisResult& r
             {"ar_order", r.ar_order},
             {"n_train", r.n_train},
             {"n_held_out", r.n_held_out}};
-  switch (h.kind) {
-    case rs::EffectKind::kSensorDelay:
-    case rs::EffectKind::kInputDelay:
-      j["delay_steps"] = h.delay;
-      break;
-    case rs::EffectKind::kFriction:
-      j["source"] = data.u_names[static_cast<std::size_t>(h.source)];
-      break;
-    case rs::EffectKind::kCrosstalk:
-      j["source"] = data.y_names[static_cast<std::size_t>(h.source)];
-      break;
-    case rs::EffectKind::kAuxChannel:
-      j["source"] = data.aux_names[static_cast<std::size_t>(h.source)];
-      break;
-    case rs::EffectKind::kSaturation:
-      j["rail"] = h.rail;
-      j["side"] = h.side > 0 ? "upper" : "lower";
-      break;
-    default:
-      break;
+  // The hypothesis' own parameters, whatever its effect: a delay, a source
+  // channel (its effect's SourceKind), a rail (effects.h: 0 / none otherwise).
+  if (h.delay > 0) j["delay_steps"] = h.delay;
+  if (const std::string source = rs::source_name(h, data); !source.empty()) j["source"] = source;
+  if (h.side != 0) {
+    j["rail"] = h.rail;
+    j["side"] = h.side > 0 ? "upper" : "lower";
   }
   return j;
 }

@@ -99,7 +99,7 @@ int run_simulate(int argc, char** argv) {
     const trainer::HadynetModel model = trainer::load_model(opt.positional().front());
     const std::string log_path = opt.get("log");
     const datalog::LogTable table = datalog::read_log(log_path);
-    const trainer::LogSequence seq = model_sequence(model, table, log_path);
+    const trainer::LogSequence seq = trainer::in_model_frame(model.sensor, model.layout, table, log_path).sequence;
     const int t0 = static_cast<int>(*from);
     const int n = *steps == 0 ? seq.steps() - 1 - t0 : static_cast<int>(*steps);
     if (t0 >= seq.steps() - 1 || n < 1 || t0 + n > seq.steps() - 1) {

@@ -16,19 +16,13 @@ std::vector<trainer::LogSequence> read_sequences(const std::vector<std::string>&
   return out;
 }
 
-trainer::LogSequence model_sequence(const trainer::HadynetModel& model, const datalog::LogTable& table,
-                                    const std::string& path) {
-  if (model.sensor.frame_is_measured()) return trainer::log_sequence(table, path, model.layout);
-  return trainer::log_sequence(trainer::to_model_frame(model.sensor, table, path), path, model.layout);
-}
-
 std::vector<trainer::LogSequence> read_sequences(const std::vector<std::string>& args,
                                                  const trainer::HadynetModel& model) {
   std::vector<trainer::LogSequence> out;
   for (const std::string& path : trainer::expand_log_paths(args)) {
     const datalog::LogTable table = datalog::read_log(path);
     datalog::channel_layout(table, path);  // header rules
-    out.push_back(model_sequence(model, table, path));
+    out.push_back(trainer::in_model_frame(model.sensor, model.layout, table, path).sequence);
   }
   return out;
 }

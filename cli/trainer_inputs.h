@@ -9,6 +9,7 @@
 
 #include "trainer/hadynet_model.h"
 #include "trainer/log_dataset.h"
+#include "trainer/model_frame.h"
 
 namespace hadynet::cli {
 
@@ -18,13 +19,11 @@ namespace hadynet::cli {
 std::vector<trainer::LogSequence> read_sequences(const std::vector<std::string>& args,
                                                  const trainer::FeatureLayout& layout);
 
-// The same for a trained model: each log moved into the model's frame (its
-// sensor model, trainer/sensor_model.h; a model fixed by `hadynet residual
-// --fix` may predict e.g. the channels without cross-talk).
+// The same for a trained model: each log read in the model's own frame
+// (trainer::in_model_frame; a model fixed by `hadynet residual --fix` may
+// predict e.g. the channels without cross-talk).
 std::vector<trainer::LogSequence> read_sequences(const std::vector<std::string>& args,
                                                  const trainer::HadynetModel& model);
-trainer::LogSequence model_sequence(const trainer::HadynetModel& model, const datalog::LogTable& table,
-                                    const std::string& path);
 
 // Sequences grouped by state id, groups in first-appearance order.
 struct StateGroup {

@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
     friction.kind = residual::EffectKind::kFriction;
     friction.effect = "friction";
     friction.description = "test: hysteresis inputs of u0";
-    friction.inputs = {"sign_u0", "hyst_u0"};
+    friction.change.emplace<residual::HysteresisInputs>().inputs = {"sign_u0", "hyst_u0"};
     std::vector<LogSequence> seqs;
     const FeatureLayout layout = residual::augmented_layout(base.layout, friction);
     for (const auto& l : logs) seqs.push_back(log_sequence(l.table, l.file, layout));

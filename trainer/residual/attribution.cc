@@ -187,10 +187,8 @@ std::vector<HypothesisResult> Attribution::family_of(const HypothesisResult& lea
   std::map<int, bool> seen;
   for (const auto& r : ranked) {
     if (!r.significant) break;
-    if (r.hypothesis.kind != w->hypothesis.kind) continue;
-    if ((r.hypothesis.kind == EffectKind::kSensorDelay || r.hypothesis.kind == EffectKind::kInputDelay) &&
-        r.hypothesis.delay != w->hypothesis.delay)
-      continue;
+    // The same effect with the same delay (0 for the effects without one).
+    if (r.hypothesis.kind != w->hypothesis.kind || r.hypothesis.delay != w->hypothesis.delay) continue;
     if (seen[r.hypothesis.target]) continue;
     seen[r.hypothesis.target] = true;
     out.push_back(r);

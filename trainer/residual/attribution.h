@@ -75,8 +75,9 @@ struct Attribution {
   std::vector<HypothesisResult> ranked;  // significant by explained (desc), then the rest by p
   // The winner (ranked[0]) when it is significant; otherwise none.
   std::optional<HypothesisResult> winner() const;
-  // Significant hypotheses of the winner's effect (and delay, for delays), one per target channel
-  // (the best), by explained variance: where else the same effect shows.
+  // Significant hypotheses of the winner's effect and delay (Hypothesis::delay: 0 for the effects
+  // without one), one per target channel (the best), by explained variance: where else the same
+  // effect shows.
   std::vector<HypothesisResult> winner_family() const;
   // The same for any significant hypothesis `lead` (its effect and delay).
   std::vector<HypothesisResult> family_of(const HypothesisResult& lead) const;

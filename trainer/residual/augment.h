@@ -2,38 +2,14 @@
 // attribution's winning effect to the model, fine-tune it, and measure the
 // error before and after on held-out data.
 //
-// Implemented augmentations (docs/residual.md says for each why this one).
-// Sensor effects become part of the model's sensor model (sensor_model.h:
-// the measured channels from the network's; each model is fed logs moved
-// into its own frame), so the network keeps its structure:
-//   sensor-delay  time alignment of the winner's family (the channels with
-//                 the winner's delay d): the model is fine-tuned on logs with
-//                 y'_c(s) = y_c(s + d) and predicts the true-time signal.
-//   crosstalk     removal: the winner's target c picks up k times source s
-//                 (the fitted gain); the model is fine-tuned on y'_c = y_c -
-//                 k y_s (in y and x); the measured y_c is y'_c + k y'_s.
-//   drift-load,   a bias state b_c(t) = rate * D_c(t) per family channel (D:
-//   drift-time    accumulated load sum |y_c| dt, or time), removed from the
-//                 data (in y and x) and added to the prediction; the rate is
-//                 re-estimated before fine-tuning (the attribution's fit is
-//                 low: the model carries part of a bias over from x_t).
-//   saturation    clipping: each family channel's prediction passes through
-//                 min(., R) (max for a lower rail) at its measured rail R,
-//                 applied by every prediction, and the model is fine-tuned on
-//                 the clipped output (a clipped element has zero gradient).
-// Effects of the dynamics change the network's inputs:
-//   aux-channel   the aux_* column becomes an observed channel: appended to y
-//                 (and so to x, an encoder input) with a zero encoder column
-//                 and a zero decoder row (the new output starts at the
-//                 channel's mean). dims.x and dims.y grow by one.
-//   friction      a hysteresis state as an input: for every muscle m of the
-//                 winner's family, the derived command channels sign_<m>
-//                 (direction of motion) and hyst_<m> (sign of the last
-//                 non-zero command; trainer/derived_inputs.h) are appended to
-//                 u with zero LSTM input weights. dims.u grows by two per
-//                 muscle; logs need no new column (they are computed from
-//                 the commands).
-// Then the model is fine-tuned (batch norm frozen).
+// What --fix adds for an effect is planned by the effect's row of the table
+// in effects.cc and held as one alternative of Augmentation::change below
+// (each says what it adds; docs/residual.md says why). Sensor effects become
+// part of the model's sensor model (sensor_model.h: the measured channels
+// from the network's; each model is fed logs moved into its own frame,
+// model_frame.h), so the network keeps its structure; effects of the
+// dynamics change the network's inputs. Then the model is fine-tuned (batch
+// norm frozen).
 //
 // Held out by time: the first `train_fraction` of each log's rows are the only
 // data fine-tuning sees; every number is reported on the remaining rows.
@@ -43,8 +19,10 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "trainer/hadynet_model.h"
@@ -66,54 +44,147 @@ struct FixOptions {
   bool control = true;          // also fine-tune without the augmentation (same data, epochs, seed)
 };
 
-// What --fix adds, from the winner and its family.
+struct Augmentation;
+
+// fix()'s probe for refine(): the unchanged network's 1-step RMSE of
+// `channel` (physical units) on the training rows, in the measured frame,
+// with sensor model `sensor`.
+using TrainingRmse = std::function<double(const SensorModel& sensor, const std::string& channel)>;
+
+// What an alternative of Augmentation::change does to a model. std::visit
+// calls these on the alternative held; the base's no-ops are what an
+// alternative leaves as it is, and an alternative declares (hides) the ones
+// it changes, defined in its effect's section of effects.cc.
+struct ModelChange {
+  // sensor_after(): adds the change to the sensor model.
+  void add_to_sensor(SensorModel&, const Augmentation&) const {}
+  // augmented_layout(): appends channels to the layout's y and u names.
+  void add_to_channels(std::vector<std::string>&, std::vector<std::string>&) const {}
+  // augmented_model(): changes `m`, a copy of `before` with the new sensor
+  // model, for new channels: layout, standardisation (fitted on
+  // `train_seqs`, in the augmented layout) and weights.
+  void add_to_network(const Augmentation&, const HadynetModel&, HadynetModel&,
+                      const std::vector<LogSequence>&) const {}
+  // fix(), before fine-tuning: re-estimates the change's parameters on the
+  // training rows; appends what the attribution had fitted to `fitted`.
+  void refine(Augmentation&, const SensorModel&, const TrainingRmse&, std::vector<double>&) {}
+};
+
+// input-delay: nothing (named and reported only: dead time in the commands
+// would change what the stabiliser controls; fix() says "not supported").
+struct NoChange : ModelChange {
+  void add_to_network(const Augmentation& a, const HadynetModel& before, HadynetModel& m,
+                      const std::vector<LogSequence>& train_seqs) const;  // throws std::invalid_argument
+};
+
+// sensor-delay: time alignment of Augmentation::channels (the winner's family
+// with the same delay, extended to its group): the model is fine-tuned on logs
+// with y'_c(s) = y_c(s + delay) and predicts the true-time signal. The delay
+// goes into the sensor model (added to a channel's earlier delay).
+struct TimeAlignment : ModelChange {
+  int delay = 0;  // steps
+  void add_to_sensor(SensorModel& s, const Augmentation& a) const;
+};
+
+// crosstalk: removal of the winner's pair: the target picks up `gain` times
+// the source (the fitted gain); the model is fine-tuned on y'_c = y_c - k y_s
+// (in y and x); the measured y_c is y'_c + k y'_s.
+struct CrosstalkRemoval : ModelChange {
+  SensorCrosstalk pair;  // target, source, gain (target units per source unit)
+  void add_to_sensor(SensorModel& s, const Augmentation& a) const;
+};
+
+// drift-load, drift-time: a bias state b_c(t) = rate * D_c(t) per family
+// channel (D: accumulated load sum |y_c| dt, or time), removed from the data
+// (in y and x) and added to the prediction; the rates are re-estimated before
+// fine-tuning (refine: the attribution's fit is low, because the model
+// carries part of a bias over from x_t).
+struct BiasState : ModelChange {
+  std::vector<SensorDrift> drifts;  // one per channel
+  double period_s = 0;              // the logs' control period (s)
+  void add_to_sensor(SensorModel& s, const Augmentation& a) const;
+  void refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
+              std::vector<double>& fitted);
+};
+
+// saturation: clipping: each family channel's prediction passes through
+// min(., R) (max for a lower rail) at its measured rail R, applied by every
+// prediction, and the model is fine-tuned on the clipped output (a clipped
+// element has zero gradient).
+struct OutputClips : ModelChange {
+  std::vector<OutputClip> clips;  // one per channel
+  void add_to_sensor(SensorModel& s, const Augmentation& a) const;
+};
+
+// friction: a hysteresis state as an input: for every muscle m of the
+// winner's family, the derived command channels sign_<m> (direction of
+// motion) and hyst_<m> (sign of the last non-zero command;
+// trainer/derived_inputs.h) are appended to u with zero LSTM input weights.
+// dims.u grows by two per muscle; logs need no new column (they are computed
+// from the commands).
+struct HysteresisInputs : ModelChange {
+  std::vector<std::string> inputs;  // the derived u channels (sign_u0, hyst_u0, ...)
+  void add_to_channels(std::vector<std::string>& y, std::vector<std::string>& u) const;
+  void add_to_network(const Augmentation& a, const HadynetModel& before, HadynetModel& m,
+                      const std::vector<LogSequence>& train_seqs) const;
+};
+
+// aux-channel: the aux_* column becomes an observed channel: appended to y
+// (and so to x, an encoder input) with a zero encoder column and a zero
+// decoder row (the new output starts at the channel's mean). dims.x and
+// dims.y grow by one.
+struct ObservedAuxChannel : ModelChange {
+  std::string channel;  // the aux_* column
+  void add_to_channels(std::vector<std::string>& y, std::vector<std::string>& u) const;
+  void add_to_network(const Augmentation& a, const HadynetModel& before, HadynetModel& m,
+                      const std::vector<LogSequence>& train_seqs) const;
+};
+
+// What --fix adds, from the winner and its family (the effect's plan).
 struct Augmentation {
   EffectKind kind = EffectKind::kSensorDelay;
-  std::string effect;              // library name
-  std::string description;         // e.g. "time-align fc1, fc2, fc6 by 2 steps"
-  // The affected y channels: delayed (delay), the aux channel (aux), the
-  // target (crosstalk), the friction targets, the clipped (saturation) or
-  // drifting (drift) channels.
+  std::string effect;       // library name
+  std::string description;  // e.g. "time-align fc1, fc2, fc6 by 2 steps"
+  // The affected channels: delayed (delay), the aux channel (aux), the target
+  // (crosstalk), the friction targets, the clipped (saturation) or drifting
+  // (drift) channels.
   std::vector<std::string> channels;
-  int delay = 0;                   // steps (sensor-delay); 0 otherwise
-  std::string source;              // crosstalk: the winner's source y channel; empty otherwise
-  double gain = 0;                 // crosstalk: the winner's fitted gain k (target units per source unit)
-  std::vector<SensorCrosstalk> crosstalk;  // crosstalk: the pairs removed (the winner's)
-  std::vector<std::string> inputs;  // friction: derived u channels added (sign_u0, hyst_u0, ...)
-  std::vector<OutputClip> clips;    // saturation: one per channel
-  std::vector<SensorDrift> drifts;   // drift: one per channel (rates refined by fix())
-  double period_s = 0;               // drift: the logs' control period (s)
+  // The model's y channels the effect was found on: the decision compares
+  // the models there (fix()). The channels above, or for an aux channel the
+  // targets it explains.
+  std::vector<std::string> found_on;
+  std::variant<NoChange, TimeAlignment, CrosstalkRemoval, BiasState, OutputClips, HysteresisInputs,
+               ObservedAuxChannel>
+      change;
 };
-// True for the effects --fix implements (all but input-delay).
+// True for the effects --fix implements (those with a plan: all but input-delay).
 bool fix_supported(EffectKind kind);
 
-// The augmentation of the attribution's winner, with its family (see each
-// effect above). When the winner's effect has no augmentation (input-delay),
-// the best significant hypothesis that has one, and the description says so;
-// when none has, the winner's (fix() then reports "not supported"). None
-// without a winner.
+// The augmentation of the attribution's winner, with its family (the
+// effect's plan, effects.cc). When the winner's effect has no augmentation
+// (input-delay), the best significant hypothesis that has one, and the
+// description says so; when none has, the winner's (fix() then reports "not
+// supported"). None without a winner.
 std::optional<Augmentation> plan_augmentation(const ResidualData& data, const Attribution& attribution);
 
-// The sensor model after adding the augmentation's part (delay,
-// cross-talk, drift, clips; the others leave it as it is). A delay found in
-// the model's frame adds to a channel's existing delay.
+// The sensor model after adding the augmentation's part (add_to_sensor:
+// delay, cross-talk, drift, clips; the others leave it as it is). A delay
+// found in the model's frame adds to a channel's existing delay.
 SensorModel sensor_after(const SensorModel& before, const Augmentation& a);
 
-// The channel layout after the augmentation: the aux channel appended to y
-// (aux-channel), the derived inputs to u (friction); the same otherwise.
+// The channel layout after the augmentation (add_to_channels): the aux
+// channel appended to y (aux-channel), the derived inputs to u (friction);
+// the same otherwise.
 FeatureLayout augmented_layout(const FeatureLayout& layout, const Augmentation& a);
 
-// Logs moved into the frame of a model with sensor model `sensor`
-// (to_model_frame); the same logs if its frame is the measured one.
-std::vector<LogInput> model_frame_logs(const SensorModel& sensor, const std::vector<LogInput>& logs);
-
-// The model with the augmentation's structural change (aux: one more y and x
-// channel; friction: the derived u channels; standardisation of a new channel
-// fitted on `train_seqs`, which must hold it), its sensor model
-// (sensor_after) and the provenance key "residual_fix" (what was added, after
-// what an earlier fix added). Weights otherwise unchanged (new inputs get
-// zero weights); detection statistics are dropped (they belong to the old
-// weights) and ranges must be re-measured.
+// The model with the augmentation's structural change (add_to_network; aux:
+// one more y and x channel; friction: the derived u channels;
+// standardisation of a new channel fitted on `train_seqs`, which must hold
+// it), its sensor model (sensor_after) and the provenance key
+// "residual_fix" (what was added, after what an earlier fix added). Weights
+// otherwise unchanged (new inputs get zero weights); detection statistics
+// are dropped (they belong to the old weights) and ranges must be
+// re-measured.
 HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
                              const std::vector<LogSequence>& train_seqs);
 
@@ -138,7 +209,7 @@ struct FixResult {
   DieboldMariano confirmation;                     // reference's loss minus after's (valid if tried)
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
-  std::vector<double> fitted_rates;     // drift: the attribution's rate per channel, before refinement
+  std::vector<double> fitted_rates;     // drift: the attribution's rate per channel, before refine()
   long train_windows = 0;
 };
 

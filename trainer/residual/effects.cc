@@ -1,3 +1,7 @@
+// The effect library (effects.h): one section per effect with everything
+// about it (hypotheses, feature test, parameter, description, the plan of
+// its augmentation and how that augmentation changes a model), then the
+// table of effects, then the lookups everyone else calls.
 #include "trainer/residual/effects.h"
 
 #include <algorithm>
@@ -6,57 +10,11 @@
 #include <limits>
 #include <stdexcept>
 
+#include "trainer/derived_inputs.h"
+#include "trainer/residual/attribution.h"
+#include "trainer/residual/augment.h"
+
 namespace hadynet::trainer::residual {
-
-const std::vector<EffectInfo>& effect_library() {
-  static const std::vector<EffectInfo> library = {
-      {EffectKind::kSensorDelay, "sensor-delay",
-       "y_hat_c(t-d) - y_hat_c(t): the residual a sensor reporting d steps late leaves against the model's "
-       "prediction (d = 1..max_delay)",
-       "delay d (steps) and the gain of the aligned prediction (1: the whole residual is the delay)",
-       "time alignment: train on y_c shifted d steps earlier (the network predicts the true-time signal), "
-       "with the winner's group where the same delay tests significant; the delay goes into the sensor model"},
-      {EffectKind::kInputDelay, "input-delay",
-       "u(t-1-d) - u(t-1), every command channel: commands that act d steps later than the model assumes",
-       "delay d (steps)",
-       "none (named and reported only): dead time in the commands would change what the stabiliser controls"},
-      {EffectKind::kFriction, "friction",
-       "sign(u_m(t-1)) and the hysteresis state h_m(t) (sign of the last non-zero command of muscle m): dry "
-       "friction acting against the motion of muscle m",
-       "the residual offset while muscle m moves in the + direction (target units; minus that in the other)",
-       "a hysteresis state as an input: the derived commands sign_u_m and hyst_u_m appended to u"},
-      {EffectKind::kDriftLoad, "drift-load",
-       "the accumulated load sum_{s<=t} |y_c(s)| dt from the log's start: a bias that grows with the load "
-       "the sensor has carried",
-       "rate: bias per accumulated load (target units per (target unit s))",
-       "a drift/bias state in the sensor model: a per-channel bias integrating |y_c| dt at a re-estimated "
-       "rate, subtracted from the measured y_c before the network sees it and added to its prediction"},
-      {EffectKind::kDriftTime, "drift-time", "time since the log's start: a bias growing with time",
-       "rate: bias per second (target units per s)",
-       "a drift/bias state in the sensor model, growing with time at a re-estimated rate"},
-      {EffectKind::kSaturation, "saturation",
-       "min(y_hat_c, R) - y_hat_c (upper rail R = the largest measured value over the logs; lower: max(y_hat_c, "
-       "R) - y_hat_c with the smallest): the part of the prediction a clipped sensor cannot show",
-       "the rail R (target units) and the gain (1: fully clipped)",
-       "clipping in the sensor model: the prediction of y_c passes min(., R) (max for a lower rail); "
-       "fine-tuned on the clipped output"},
-      {EffectKind::kCrosstalk, "crosstalk",
-       "y_s(t): another channel's measured value (by default of the target's group) leaking into the target",
-       "gain: the fraction of y_s the target picks up",
-       "removal: train on y_c - k y_s (in y and x); the sensor model adds k times the predicted y_s back"},
-      {EffectKind::kAuxChannel, "aux-channel",
-       "an aux_* column's value at t: a logged channel the model does not use",
-       "gain (target units per aux unit)",
-       "use it: the aux channel becomes an observed channel (an input in x, predicted in y)"},
-  };
-  return library;
-}
-
-const EffectInfo& effect_info(EffectKind kind) {
-  for (const auto& e : effect_library())
-    if (e.kind == kind) return e;
-  throw std::logic_error("effect kind without library entry");
-}
 
 namespace {
 
@@ -68,131 +26,636 @@ std::string fmt(const char* format, double v) {
   return buf;
 }
 
-}  // namespace
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + v[i];
+  return s;
+}
 
+const std::string& y_name(const ResidualData& data, int c) { return data.y_names[static_cast<std::size_t>(c)]; }
+
+std::string steps(int d) { return std::to_string(d) + (d == 1 ? " step" : " steps"); }
+
+// The defaults of a row: the main parameter is the first coefficient, and any
+// finite value is in the effect's domain.
+double first_coefficient(const Eigen::VectorXd& coef) { return coef(0); }
+bool finite(double parameter) { return std::isfinite(parameter); }
+// A delay or a rail explains the residual with a positive gain.
+bool positive(double parameter) { return parameter > 0; }
+
+// One regressor per row: column 0 of an n x 1 matrix.
+Features one_column(int n, const auto& value_of_column) {
+  Features f;
+  f.z = Eigen::MatrixXd::Zero(n, 1);
+  for (int j = 0; j < n; ++j) f.z(j, 0) = value_of_column(j);
+  return f;
+}
+
+// Mean and population std of row `row` over the training sequences' `part` (y or u).
+std::pair<double, double> row_moments(const std::vector<LogSequence>& seqs, Eigen::MatrixXd LogSequence::*part,
+                                      Eigen::Index row, const std::string& name) {
+  double sum = 0, sum_sq = 0;
+  long n = 0;
+  for (const auto& s : seqs) {
+    if ((s.*part).rows() <= row) throw std::invalid_argument("--fix: training logs lack " + name);
+    sum += (s.*part).row(row).sum();
+    sum_sq += (s.*part).row(row).squaredNorm();
+    n += s.steps();
+  }
+  if (n == 0) throw std::invalid_argument("--fix: no training rows");
+  const double mean = sum / static_cast<double>(n);
+  const double sd = std::sqrt(std::max(0.0, sum_sq / static_cast<double>(n) - mean * mean));
+  return {mean, sd > 0 ? sd : 1.0};
+}
+
+void append(Eigen::VectorXd& v, double value) {
+  v.conservativeResize(v.size() + 1);
+  v(v.size() - 1) = value;
+}
+
+// ---- sensor-delay: the target is reported `delay` steps late ----
+namespace sensor_delay {
+
+void enumerate(const ResidualData&, const LibraryOptions& options, int c, std::vector<Hypothesis>& out) {
+  for (int d = 1; d <= options.max_delay; ++d) out.push_back({EffectKind::kSensorDelay, c, -1, d, 0, 0});
+}
+
+// y_hat_c(t - d) - y_hat_c(t): what a sensor reporting d steps late leaves against the prediction.
 Features features(const Hypothesis& h, const ResidualLog& log) {
   const int n = log.size();
   const auto c = static_cast<Eigen::Index>(h.target);
   Features f;
-  switch (h.kind) {
-    case EffectKind::kSensorDelay: {
-      f.z = Eigen::MatrixXd::Zero(n, 1);
-      f.first_valid = std::min(h.delay, n);
-      for (int j = f.first_valid; j < n; ++j) f.z(j, 0) = log.y_hat(c, j - h.delay) - log.y_hat(c, j);
-      break;
-    }
-    case EffectKind::kInputDelay: {
-      const auto nu = log.seq.u.rows();
-      f.z = Eigen::MatrixXd::Zero(n, nu);
-      f.first_valid = std::clamp(h.delay - 1, 0, n);
-      for (int j = f.first_valid; j < n; ++j) {
-        const int t = ResidualLog::row(j);
-        f.z.row(j) = (log.seq.u.col(t - 1 - h.delay) - log.seq.u.col(t - 1)).transpose();
-      }
-      break;
-    }
-    case EffectKind::kFriction: {
-      f.z = Eigen::MatrixXd::Zero(n, 2);
-      const auto m = static_cast<Eigen::Index>(h.source);
-      double state = 0;
-      int next_row = 0;  // rows of u folded into `state` so far
-      for (int j = 0; j < n; ++j) {
-        const int t = ResidualLog::row(j);
-        for (; next_row <= t - 1; ++next_row)
-          if (log.seq.u(m, next_row) != 0) state = sign(log.seq.u(m, next_row));
-        f.z(j, 0) = sign(log.seq.u(m, t - 1));
-        f.z(j, 1) = state;
-      }
-      break;
-    }
-    case EffectKind::kDriftLoad: {
-      f.z = Eigen::MatrixXd::Zero(n, 1);
-      double load = 0;
-      int next_row = 0;
-      for (int j = 0; j < n; ++j) {
-        const int t = ResidualLog::row(j);
-        for (; next_row <= t; ++next_row) load += std::abs(log.seq.y(c, next_row)) * log.dt_s;
-        f.z(j, 0) = load;
-      }
-      break;
-    }
-    case EffectKind::kDriftTime: {
-      f.z = Eigen::MatrixXd::Zero(n, 1);
-      for (int j = 0; j < n; ++j) f.z(j, 0) = ResidualLog::row(j) * log.dt_s;
-      break;
-    }
-    case EffectKind::kSaturation: {
-      f.z = Eigen::MatrixXd::Zero(n, 1);
-      for (int j = 0; j < n; ++j) {
-        const double p = log.y_hat(c, j);
-        f.z(j, 0) = (h.side > 0 ? std::min(p, h.rail) : std::max(p, h.rail)) - p;
-      }
-      break;
-    }
-    case EffectKind::kCrosstalk: {
-      f.z = Eigen::MatrixXd::Zero(n, 1);
-      for (int j = 0; j < n; ++j) f.z(j, 0) = log.seq.y(h.source, ResidualLog::row(j));
-      break;
-    }
-    case EffectKind::kAuxChannel: {
-      f.z = Eigen::MatrixXd::Zero(n, 1);
-      for (int j = 0; j < n; ++j) f.z(j, 0) = log.aux(h.source, ResidualLog::row(j));
-      break;
-    }
+  f.z = Eigen::MatrixXd::Zero(n, 1);
+  f.first_valid = std::min(h.delay, n);
+  for (int j = f.first_valid; j < n; ++j) f.z(j, 0) = log.y_hat(c, j - h.delay) - log.y_hat(c, j);
+  return f;
+}
+
+std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
+  return "delay = " + steps(h.delay) + " on " + y_name(data, h.target) + " (gain" + fmt(" %.2f)", p);
+}
+
+void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
+  const auto& h = w.hypothesis;
+  auto& change = a.change.emplace<TimeAlignment>();
+  change.delay = h.delay;
+  for (const auto& r : attribution.family_of(w))
+    if (r.hypothesis.delay == h.delay) a.channels.push_back(y_name(data, r.hypothesis.target));
+  // A delay belongs to the acquisition chain, so it extends to the other
+  // channels of the winner's group where the same delay passes the test
+  // (Holm-adjusted p < alpha, positive gain) without the practical
+  // floors: the floors guard against naming the model's own misfit as a
+  // new effect; here the effect is established and the test only says
+  // where else it is. A loadcell that barely moves leaves a small
+  // residual, but aligning it is still right (docs/residual.md).
+  const std::string group = channel_group(y_name(data, h.target));
+  std::vector<std::string> extended;
+  for (const auto& r : attribution.ranked) {
+    const auto& hr = r.hypothesis;
+    const std::string& name = y_name(data, hr.target);
+    if (hr.kind != EffectKind::kSensorDelay || hr.delay != h.delay || channel_group(name) != group) continue;
+    if (!r.testable || r.p_adjusted >= attribution.options.alpha || !(r.parameter > 0)) continue;
+    if (std::find(a.channels.begin(), a.channels.end(), name) != a.channels.end()) continue;
+    a.channels.push_back(name);
+    extended.push_back(name);
+  }
+  a.description = "time-align " + join(a.channels) + " by " + std::to_string(change.delay) + " steps" +
+                  (extended.empty() ? "" : " (" + join(extended) + ": the same delay in the same group)") +
+                  "; the model predicts the true-time signal";
+  a.found_on = a.channels;
+}
+
+}  // namespace sensor_delay
+}  // namespace
+
+// Found in the model's frame: a channel already aligned is late by its old
+// delay plus this one.
+void TimeAlignment::add_to_sensor(SensorModel& s, const Augmentation& a) const {
+  for (const auto& c : a.channels) {
+    const auto it =
+        std::find_if(s.delays.begin(), s.delays.end(), [&](const SensorDelay& x) { return x.channel == c; });
+    if (it != s.delays.end()) it->steps += delay;
+    else s.delays.push_back({c, delay});
+  }
+}
+
+namespace {
+
+// ---- input-delay: the commands act `delay` steps later than the model assumes ----
+namespace input_delay {
+
+void enumerate(const ResidualData&, const LibraryOptions& options, int c, std::vector<Hypothesis>& out) {
+  for (int d = 1; d <= options.max_delay; ++d) out.push_back({EffectKind::kInputDelay, c, -1, d, 0, 0});
+}
+
+// u(t - 1 - d) - u(t - 1), every command channel.
+Features features(const Hypothesis& h, const ResidualLog& log) {
+  const int n = log.size();
+  const auto nu = log.seq.u.rows();
+  Features f;
+  f.z = Eigen::MatrixXd::Zero(n, nu);
+  f.first_valid = std::clamp(h.delay - 1, 0, n);
+  for (int j = f.first_valid; j < n; ++j) {
+    const int t = ResidualLog::row(j);
+    f.z.row(j) = (log.seq.u.col(t - 1 - h.delay) - log.seq.u.col(t - 1)).transpose();
   }
   return f;
 }
 
+double norm(const Eigen::VectorXd& coef) { return coef.norm(); }
+
+std::string describe(const Hypothesis& h, const ResidualData& data, double) {
+  return "input delay = " + steps(h.delay) + " seen on " + y_name(data, h.target);
+}
+
+// No plan: a correct augmentation is dead time in the commands, which changes
+// what the stabiliser controls (docs/residual.md, "Open").
+
+}  // namespace input_delay
+}  // namespace
+
+void NoChange::add_to_network(const Augmentation& a, const HadynetModel&, HadynetModel&,
+                              const std::vector<LogSequence>&) const {
+  throw std::invalid_argument("--fix: " + a.effect + " is not implemented");
+}
+
+namespace {
+
+// ---- friction: dry friction / hysteresis driven by the motion of muscle `source` ----
+namespace friction {
+
+void enumerate(const ResidualData& data, const LibraryOptions&, int c, std::vector<Hypothesis>& out) {
+  const int nu = static_cast<int>(data.u_names.size());
+  for (int m = 0; m < nu; ++m) out.push_back({EffectKind::kFriction, c, m, 0, 0, 0});
+}
+
+// sign(u_m(t - 1)) and the hysteresis state h_m(t) (sign of the last non-zero command).
+Features features(const Hypothesis& h, const ResidualLog& log) {
+  const int n = log.size();
+  Features f;
+  f.z = Eigen::MatrixXd::Zero(n, 2);
+  const auto m = static_cast<Eigen::Index>(h.source);
+  double state = 0;
+  int next_row = 0;  // rows of u folded into `state` so far
+  for (int j = 0; j < n; ++j) {
+    const int t = ResidualLog::row(j);
+    for (; next_row <= t - 1; ++next_row)
+      if (log.seq.u(m, next_row) != 0) state = sign(log.seq.u(m, next_row));
+    f.z(j, 0) = sign(log.seq.u(m, t - 1));
+    f.z(j, 1) = state;
+  }
+  return f;
+}
+
+// The offset while muscle m moves in the + direction: both regressors are +1.
+double offset(const Eigen::VectorXd& coef) { return coef.size() >= 2 ? coef(0) + coef(1) : coef(0); }
+
+std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
+  return "friction on " + y_name(data, h.target) + " with the motion of " + source_name(h, data) + ": " +
+         fmt("%+.3g", p) + " while it moves +";
+}
+
+void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
+  auto& change = a.change.emplace<HysteresisInputs>();
+  std::vector<std::string> muscles;
+  for (const auto& r : attribution.family_of(w)) {
+    a.channels.push_back(y_name(data, r.hypothesis.target));
+    const std::string m = source_name(r.hypothesis, data);
+    if (std::find(muscles.begin(), muscles.end(), m) == muscles.end()) muscles.push_back(m);
+  }
+  for (const auto& m : muscles)
+    for (const DerivedKind k : {DerivedKind::kSign, DerivedKind::kHysteresis})
+      change.inputs.push_back(derived_input_name({k, m}));
+  a.description = "add the hysteresis state of " + join(muscles) + " as inputs (" + join(change.inputs) +
+                  "; friction on " + join(a.channels) + ")";
+  a.found_on = a.channels;
+}
+
+}  // namespace friction
+}  // namespace
+
+void HysteresisInputs::add_to_channels(std::vector<std::string>&, std::vector<std::string>& u) const {
+  for (const auto& name : inputs) u.push_back(name);
+}
+
+// The derived command channels appended to u: standardisation from the
+// training rows (whose u holds them, last), zero LSTM input weights (inputs
+// are [u ; p]).
+void HysteresisInputs::add_to_network(const Augmentation& a, const HadynetModel& before, HadynetModel& m,
+                                      const std::vector<LogSequence>& train_seqs) const {
+  m.layout = augmented_layout(before.layout, a);
+  const auto u_old = static_cast<Eigen::Index>(before.layout.u_names.size());
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const auto [mean, sd] = row_moments(train_seqs, &LogSequence::u, u_old + static_cast<Eigen::Index>(i), inputs[i]);
+    append(m.norm.u.mean, mean);
+    append(m.norm.u.std, sd);
+  }
+  auto& p = m.params;
+  const auto k = static_cast<Eigen::Index>(inputs.size());
+  const Eigen::Index pb = p.dims.pb;
+  RowMatrix<float> ih(p.lstm_weight_ih.rows(), u_old + k + pb);
+  ih.setZero();
+  ih.leftCols(u_old) = p.lstm_weight_ih.leftCols(u_old);
+  ih.rightCols(pb) = p.lstm_weight_ih.rightCols(pb);
+  p.lstm_weight_ih = ih;
+  p.dims.u += static_cast<int>(k);
+  p.check_shapes();
+}
+
+namespace {
+
+// ---- drift-load, drift-time: a sensor bias growing with the load carried, or with time ----
+namespace drift {
+
+void enumerate_load(const ResidualData&, const LibraryOptions&, int c, std::vector<Hypothesis>& out) {
+  out.push_back({EffectKind::kDriftLoad, c, -1, 0, 0, 0});
+}
+void enumerate_time(const ResidualData&, const LibraryOptions&, int c, std::vector<Hypothesis>& out) {
+  out.push_back({EffectKind::kDriftTime, c, -1, 0, 0, 0});
+}
+
+// sum_{s<=t} |y_c(s)| dt, the load accumulated since the log's start.
+Features load_features(const Hypothesis& h, const ResidualLog& log) {
+  const auto c = static_cast<Eigen::Index>(h.target);
+  double load = 0;
+  int next_row = 0;
+  return one_column(log.size(), [&](int j) {
+    const int t = ResidualLog::row(j);
+    for (; next_row <= t; ++next_row) load += std::abs(log.seq.y(c, next_row)) * log.dt_s;
+    return load;
+  });
+}
+
+// t - t0 (s).
+Features time_features(const Hypothesis&, const ResidualLog& log) {
+  return one_column(log.size(), [&](int j) { return ResidualLog::row(j) * log.dt_s; });
+}
+
+std::string describe_load(const Hypothesis& h, const ResidualData& data, double p) {
+  return "drift on " + y_name(data, h.target) + " with accumulated load: rate " + fmt("%.3g", p) + " per (unit s)";
+}
+std::string describe_time(const Hypothesis& h, const ResidualData& data, double p) {
+  return "drift on " + y_name(data, h.target) + " with time: rate " + fmt("%.3g", p) + " per s";
+}
+
+// Both drifts: one bias state per family channel at its fitted rate (refined by refine()).
+void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
+  const auto& h = w.hypothesis;
+  auto& change = a.change.emplace<BiasState>();
+  change.period_s = data.logs.front().dt_s;
+  for (const auto& log : data.logs)
+    if (log.dt_s != change.period_s)
+      throw std::runtime_error(log.seq.file + ": dt_s differs from the other logs' (a drift needs one period)");
+  for (const auto& r : attribution.family_of(w)) {
+    a.channels.push_back(y_name(data, r.hypothesis.target));
+    change.drifts.push_back({a.channels.back(), h.kind == EffectKind::kDriftLoad, r.parameter});
+  }
+  a.description = std::string("a bias state growing with ") +
+                  (h.kind == EffectKind::kDriftLoad ? "the accumulated load" : "time") + " on " + join(a.channels) +
+                  ", removed from the data and added to the prediction";
+  a.found_on = a.channels;
+}
+
+}  // namespace drift
+}  // namespace
+
+void BiasState::add_to_sensor(SensorModel& s, const Augmentation&) const {
+  for (const SensorDrift& d : drifts) s.drifts.push_back(d);
+  s.period_s = period_s;
+}
+
+// The attribution's fit is low (the model carries part of a bias over from
+// x_t). Each channel's rate is re-estimated as the one, on a grid of 0..5x
+// the fitted rate in steps of 0.1x, that minimises the unchanged network's
+// 1-step RMSE of that channel in the measured frame on the training rows
+// (the bias removed from the inputs, added to the prediction). Channels in
+// family order, each with the others' rates so far.
+void BiasState::refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
+                       std::vector<double>& fitted) {
+  if (drifts.empty()) return;
+  for (SensorDrift& drift : drifts) {
+    fitted.push_back(drift.rate);
+    const double fitted_rate = drift.rate;
+    double best_rate = fitted_rate, best_rmse = std::numeric_limits<double>::infinity();
+    for (int step = 0; step <= 50; ++step) {
+      drift.rate = fitted_rate * 0.1 * step;
+      const double rmse = training_rmse(sensor_after(before, a), drift.channel);
+      if (rmse < best_rmse) best_rmse = rmse, best_rate = drift.rate;
+    }
+    drift.rate = best_rate;
+  }
+  char text[64];
+  std::string rates;
+  for (const SensorDrift& drift : drifts) {
+    std::snprintf(text, sizeof text, "%s%s %.4g", rates.empty() ? "" : ", ", drift.channel.c_str(), drift.rate);
+    rates += text;
+  }
+  a.description += "; rates re-estimated: " + rates;
+}
+
+namespace {
+
+// ---- saturation: the measured target is clipped at a rail ----
+namespace saturation {
+
+// A rail per side where the channel sits (LibraryOptions: min_rail_share
+// within rail_band), at the measured extreme over all logs.
+void enumerate(const ResidualData& data, const LibraryOptions& options, int c, std::vector<Hypothesis>& out) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const auto& log : data.logs) {
+    lo = std::min(lo, log.seq.y.row(c).minCoeff());
+    hi = std::max(hi, log.seq.y.row(c).maxCoeff());
+  }
+  if (!(hi > lo)) return;
+  long rows = 0, at_hi = 0, at_lo = 0;
+  for (const auto& log : data.logs) {
+    const auto y = log.seq.y.row(c).array();
+    rows += y.size();
+    // "At": within rail_band of the channel's range (a saturated sensor still
+    // shows its ADC noise around the rail).
+    const double band = options.rail_band * (hi - lo);
+    at_hi += (y >= hi - band).count();
+    at_lo += (y <= lo + band).count();
+  }
+  const double need = std::max(5.0, options.min_rail_share * static_cast<double>(rows));
+  if (static_cast<double>(at_hi) >= need) out.push_back({EffectKind::kSaturation, c, -1, 0, +1, hi});
+  if (static_cast<double>(at_lo) >= need) out.push_back({EffectKind::kSaturation, c, -1, 0, -1, lo});
+}
+
+// min(y_hat_c, R) - y_hat_c (lower rail: max): the part of the prediction a clipped sensor cannot show.
+Features features(const Hypothesis& h, const ResidualLog& log) {
+  const auto c = static_cast<Eigen::Index>(h.target);
+  return one_column(log.size(), [&](int j) {
+    const double p = log.y_hat(c, j);
+    return (h.side > 0 ? std::min(p, h.rail) : std::max(p, h.rail)) - p;
+  });
+}
+
+std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
+  return std::string(h.side > 0 ? "upper" : "lower") + " rail of " + y_name(data, h.target) + " at" +
+         fmt(" %.4g", h.rail) + " (gain" + fmt(" %.2f)", p);
+}
+
+void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
+  auto& change = a.change.emplace<OutputClips>();
+  std::vector<std::string> rails;
+  for (const auto& r : attribution.family_of(w)) {
+    const auto& hr = r.hypothesis;
+    a.channels.push_back(y_name(data, hr.target));
+    change.clips.push_back({a.channels.back(), hr.side, hr.rail});
+    char text[96];
+    std::snprintf(text, sizeof text, "%s %s %.4g", a.channels.back().c_str(), hr.side > 0 ? "<=" : ">=", hr.rail);
+    rails.push_back(text);
+  }
+  a.description = "clip the prediction at the measured rail: " + join(rails) + " (trained on the clipped output)";
+  a.found_on = a.channels;
+}
+
+}  // namespace saturation
+}  // namespace
+
+// A clip of a channel and side already clipped replaces it.
+void OutputClips::add_to_sensor(SensorModel& s, const Augmentation&) const {
+  for (const OutputClip& c : clips) {
+    const auto it = std::find_if(s.clips.begin(), s.clips.end(),
+                                 [&](const OutputClip& o) { return o.channel == c.channel && o.side == c.side; });
+    if (it != s.clips.end()) *it = c;
+    else s.clips.push_back(c);
+  }
+}
+
+namespace {
+
+// ---- crosstalk: the target picks up a fraction of another channel ----
+namespace crosstalk {
+
+void enumerate(const ResidualData& data, const LibraryOptions& options, int c, std::vector<Hypothesis>& out) {
+  const int ny = static_cast<int>(data.y_names.size());
+  const std::string group = channel_group(y_name(data, c));
+  for (int s = 0; s < ny; ++s) {
+    if (s == c) continue;
+    if (options.crosstalk_same_group && channel_group(y_name(data, s)) != group) continue;
+    out.push_back({EffectKind::kCrosstalk, c, s, 0, 0, 0});
+  }
+}
+
+// y_s(t), the source's measured value.
+Features features(const Hypothesis& h, const ResidualLog& log) {
+  return one_column(log.size(), [&](int j) { return log.seq.y(h.source, ResidualLog::row(j)); });
+}
+
+// A cross-talk picks up a fraction of its source. (A negative pick-up
+// between neighbouring fingertips is the model's own error: docs/residual.md.)
+bool fraction(double gain) { return gain > 0 && gain < 1; }
+
+std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
+  return "crosstalk " + source_name(h, data) + " -> " + y_name(data, h.target) + ": gain" + fmt(" %.3g", p);
+}
+
+// The winner's pair only. Removing every pair of the family was measured
+// worse: between correlated sources the family holds pairs the plant does
+// not have (fc6 -> fc5 with gain -0.27 on the default plant logs), and fc1
+// got worse than before (docs/residual.md).
+void plan(const ResidualData& data, const Attribution&, const HypothesisResult& w, Augmentation& a) {
+  auto& change = a.change.emplace<CrosstalkRemoval>();
+  a.channels = {y_name(data, w.hypothesis.target)};
+  change.pair = {a.channels[0], source_name(w.hypothesis, data), w.parameter};
+  char gain[32];
+  std::snprintf(gain, sizeof gain, "%.4g", change.pair.gain);
+  a.description = "remove the crosstalk " + change.pair.source + " -> " + a.channels[0] + " (train on " +
+                  a.channels[0] + " - " + gain + " " + change.pair.source + "; the sensor model adds it back)";
+  a.found_on = a.channels;
+}
+
+}  // namespace crosstalk
+}  // namespace
+
+void CrosstalkRemoval::add_to_sensor(SensorModel& s, const Augmentation&) const { s.crosstalk.push_back(pair); }
+
+namespace {
+
+// ---- aux-channel: an unused logged channel explains the target ----
+namespace aux_channel {
+
+void enumerate(const ResidualData& data, const LibraryOptions&, int c, std::vector<Hypothesis>& out) {
+  const int na = static_cast<int>(data.aux_names.size());
+  for (int a = 0; a < na; ++a) out.push_back({EffectKind::kAuxChannel, c, a, 0, 0, 0});
+}
+
+// aux_a(t).
+Features features(const Hypothesis& h, const ResidualLog& log) {
+  return one_column(log.size(), [&](int j) { return log.aux(h.source, ResidualLog::row(j)); });
+}
+
+std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
+  return source_name(h, data) + " explains " + y_name(data, h.target) + ": gain" + fmt(" %.3g", p);
+}
+
+// Found on: every target a significant hypothesis of the same aux channel explains.
+void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
+  auto& change = a.change.emplace<ObservedAuxChannel>();
+  change.channel = source_name(w.hypothesis, data);
+  a.channels = {change.channel};
+  a.description = "use " + change.channel + " as an observed channel (input of x, predicted in y)";
+  for (const auto& r : attribution.ranked)
+    if (r.significant && r.hypothesis.kind == EffectKind::kAuxChannel && r.hypothesis.source == w.hypothesis.source)
+      a.found_on.push_back(y_name(data, r.hypothesis.target));
+}
+
+}  // namespace aux_channel
+}  // namespace
+
+void ObservedAuxChannel::add_to_channels(std::vector<std::string>& y, std::vector<std::string>&) const {
+  y.push_back(channel);
+}
+
+// Standardisation of the new channel over the training rows (population
+// std); a zero encoder column for the new x input (inputs are [x ; p]) and a
+// zero decoder row (the new output starts at the channel's mean).
+void ObservedAuxChannel::add_to_network(const Augmentation& a, const HadynetModel& before, HadynetModel& m,
+                                        const std::vector<LogSequence>& train_seqs) const {
+  m.layout = augmented_layout(before.layout, a);
+  const std::vector<std::string>& y = m.layout.y_names;
+  // The aux group is last in y and not a delta group, so it is the last x channel.
+  if (m.layout.x_names.back() != channel || m.layout.x_names.size() != before.layout.x_names.size() + 1)
+    throw std::logic_error("--fix: unexpected x layout for " + channel);
+  const auto row = static_cast<Eigen::Index>(y.size() - 1);
+  const auto [mean, sd] = row_moments(train_seqs, &LogSequence::y, row, channel);
+  append(m.norm.y.mean, mean);
+  append(m.norm.y.std, sd);
+  append(m.norm.x.mean, mean);
+  append(m.norm.x.std, sd);
+
+  auto& p = m.params;
+  const int x_old = p.dims.x, pb = p.dims.pb;
+  RowMatrix<float> enc(p.enc_weight.rows(), x_old + 1 + pb);
+  enc.setZero();
+  enc.leftCols(x_old) = p.enc_weight.leftCols(x_old);
+  enc.rightCols(pb) = p.enc_weight.rightCols(pb);
+  p.enc_weight = enc;
+  p.dec_weight.conservativeResize(p.dec_weight.rows() + 1, Eigen::NoChange);
+  p.dec_weight.bottomRows(1).setZero();
+  p.dec_bias.conservativeResize(p.dec_bias.size() + 1);
+  p.dec_bias(p.dec_bias.size() - 1) = 0.0f;
+  p.dims.x += 1;
+  p.dims.y += 1;
+  p.check_shapes();
+}
+
+// ---- The table of effects ----
+//
+// One row per effect, in EffectKind order (effect_info() checks it). For each
+// target channel the hypotheses are enumerated in this order, which breaks
+// ties in the ranking: reordering rows changes reports.
+//
+// To add an effect:
+//   1. effects.h: its EffectKind, in the place of its row.
+//   2. Here: a section like those above with its functions (enumerate,
+//      features, describe; main_parameter and plausible where the defaults
+//      first_coefficient and finite do not fit; plan if --fix can add it),
+//      and its row below.
+//   3. Only if --fix adds something none of Augmentation::change's
+//      alternatives expresses (augment.h): declare an alternative there with
+//      its data and the ModelChange operations it changes, and define those
+//      in the effect's section here.
+// Everything else takes the effect from its row and alternative: the
+// attribution and families, --fix (plan, sensor model, layout, network,
+// refinement, the decision's channels), the report's effect library and the
+// hypotheses' JSON. Not derived from here: the JSON of a new alternative's
+// data (cli/residual_fix_report.cc), `hadynet residual --help`'s list of
+// fixes, and docs/residual.md's effect table.
+const std::vector<EffectInfo>& effect_library() {
+  static const std::vector<EffectInfo> library = {
+      {EffectKind::kSensorDelay, "sensor-delay",
+       "y_hat_c(t-d) - y_hat_c(t): the residual a sensor reporting d steps late leaves against the model's "
+       "prediction (d = 1..max_delay)",
+       "delay d (steps) and the gain of the aligned prediction (1: the whole residual is the delay)",
+       "time alignment: train on y_c shifted d steps earlier (the network predicts the true-time signal), "
+       "with the winner's group where the same delay tests significant; the delay goes into the sensor model",
+       SourceKind::kNone, sensor_delay::enumerate, sensor_delay::features, first_coefficient, positive,
+       sensor_delay::describe, sensor_delay::plan},
+      {EffectKind::kInputDelay, "input-delay",
+       "u(t-1-d) - u(t-1), every command channel: commands that act d steps later than the model assumes",
+       "delay d (steps)",
+       "none (named and reported only): dead time in the commands would change what the stabiliser controls",
+       SourceKind::kNone, input_delay::enumerate, input_delay::features, input_delay::norm, finite,
+       input_delay::describe, nullptr},
+      {EffectKind::kFriction, "friction",
+       "sign(u_m(t-1)) and the hysteresis state h_m(t) (sign of the last non-zero command of muscle m): dry "
+       "friction acting against the motion of muscle m",
+       "the residual offset while muscle m moves in the + direction (target units; minus that in the other)",
+       "a hysteresis state as an input: the derived commands sign_u_m and hyst_u_m appended to u",
+       SourceKind::kCommand, friction::enumerate, friction::features, friction::offset, finite, friction::describe,
+       friction::plan},
+      {EffectKind::kDriftLoad, "drift-load",
+       "the accumulated load sum_{s<=t} |y_c(s)| dt from the log's start: a bias that grows with the load "
+       "the sensor has carried",
+       "rate: bias per accumulated load (target units per (target unit s))",
+       "a drift/bias state in the sensor model: a per-channel bias integrating |y_c| dt at a re-estimated "
+       "rate, subtracted from the measured y_c before the network sees it and added to its prediction",
+       SourceKind::kNone, drift::enumerate_load, drift::load_features, first_coefficient, finite,
+       drift::describe_load, drift::plan},
+      {EffectKind::kDriftTime, "drift-time", "time since the log's start: a bias growing with time",
+       "rate: bias per second (target units per s)",
+       "a drift/bias state in the sensor model, growing with time at a re-estimated rate", SourceKind::kNone,
+       drift::enumerate_time, drift::time_features, first_coefficient, finite, drift::describe_time, drift::plan},
+      {EffectKind::kSaturation, "saturation",
+       "min(y_hat_c, R) - y_hat_c (upper rail R = the largest measured value over the logs; lower: max(y_hat_c, "
+       "R) - y_hat_c with the smallest): the part of the prediction a clipped sensor cannot show",
+       "the rail R (target units) and the gain (1: fully clipped)",
+       "clipping in the sensor model: the prediction of y_c passes min(., R) (max for a lower rail); "
+       "fine-tuned on the clipped output",
+       SourceKind::kNone, saturation::enumerate, saturation::features, first_coefficient, positive,
+       saturation::describe, saturation::plan},
+      {EffectKind::kCrosstalk, "crosstalk",
+       "y_s(t): another channel's measured value (by default of the target's group) leaking into the target",
+       "gain: the fraction of y_s the target picks up",
+       "removal: train on y_c - k y_s (in y and x); the sensor model adds k times the predicted y_s back",
+       SourceKind::kObserved, crosstalk::enumerate, crosstalk::features, first_coefficient, crosstalk::fraction,
+       crosstalk::describe, crosstalk::plan},
+      {EffectKind::kAuxChannel, "aux-channel", "an aux_* column's value at t: a logged channel the model does not use",
+       "gain (target units per aux unit)",
+       "use it: the aux channel becomes an observed channel (an input in x, predicted in y)", SourceKind::kAux,
+       aux_channel::enumerate, aux_channel::features, first_coefficient, finite, aux_channel::describe,
+       aux_channel::plan},
+  };
+  return library;
+}
+
+// ---- Lookups ----
+
+const EffectInfo& effect_info(EffectKind kind) {
+  const auto& library = effect_library();
+  const auto i = static_cast<std::size_t>(kind);
+  if (i >= library.size() || library[i].kind != kind)
+    throw std::logic_error("effect kind without its row in the effect table (effects.cc)");
+  return library[i];
+}
+
+Features features(const Hypothesis& h, const ResidualLog& log) { return effect_info(h.kind).features(h, log); }
+
 double main_parameter(const Hypothesis& h, const Eigen::VectorXd& coef) {
   if (coef.size() == 0) return std::numeric_limits<double>::quiet_NaN();
-  switch (h.kind) {
-    case EffectKind::kFriction:
-      return coef.size() >= 2 ? coef(0) + coef(1) : coef(0);
-    case EffectKind::kInputDelay:
-      return coef.norm();
-    default:
-      return coef(0);
-  }
+  return effect_info(h.kind).main_parameter(coef);
 }
 
-bool plausible(const Hypothesis& h, double parameter) {
-  switch (h.kind) {
-    case EffectKind::kCrosstalk:
-      return parameter > 0 && parameter < 1;
-    case EffectKind::kSensorDelay:
-    case EffectKind::kSaturation:
-      return parameter > 0;
-    default:
-      return std::isfinite(parameter);
-  }
-}
+bool plausible(const Hypothesis& h, double parameter) { return effect_info(h.kind).plausible(parameter); }
 
 std::string describe(const Hypothesis& h, const ResidualData& data, const Eigen::VectorXd& coef) {
-  const std::string& target = data.y_names[static_cast<std::size_t>(h.target)];
-  const double p = main_parameter(h, coef);
-  switch (h.kind) {
-    case EffectKind::kSensorDelay:
-      return "delay = " + std::to_string(h.delay) + (h.delay == 1 ? " step" : " steps") + " on " + target +
-             " (gain" + fmt(" %.2f)", p);
-    case EffectKind::kInputDelay:
-      return "input delay = " + std::to_string(h.delay) + (h.delay == 1 ? " step" : " steps") + " seen on " +
-             target;
-    case EffectKind::kFriction:
-      return "friction on " + target + " with the motion of " + data.u_names[static_cast<std::size_t>(h.source)] +
-             ": " + fmt("%+.3g", p) + " while it moves +";
-    case EffectKind::kDriftLoad:
-      return "drift on " + target + " with accumulated load: rate " + fmt("%.3g", p) + " per (unit s)";
-    case EffectKind::kDriftTime:
-      return "drift on " + target + " with time: rate " + fmt("%.3g", p) + " per s";
-    case EffectKind::kSaturation:
-      return std::string(h.side > 0 ? "upper" : "lower") + " rail of " + target + " at" + fmt(" %.4g", h.rail) +
-             " (gain" + fmt(" %.2f)", p);
-    case EffectKind::kCrosstalk:
-      return "crosstalk " + data.y_names[static_cast<std::size_t>(h.source)] + " -> " + target + ": gain" +
-             fmt(" %.3g", p);
-    case EffectKind::kAuxChannel:
-      return data.aux_names[static_cast<std::size_t>(h.source)] + " explains " + target + ": gain" +
-             fmt(" %.3g", p);
+  return effect_info(h.kind).describe(h, data, main_parameter(h, coef));
+}
+
+std::string source_name(const Hypothesis& h, const ResidualData& data) {
+  const auto s = static_cast<std::size_t>(h.source);
+  switch (effect_info(h.kind).source) {
+    case SourceKind::kCommand:
+      return data.u_names[s];
+    case SourceKind::kObserved:
+      return data.y_names[s];
+    case SourceKind::kAux:
+      return data.aux_names[s];
+    case SourceKind::kNone:
+      break;
   }
   return "";
 }
@@ -200,42 +663,8 @@ std::string describe(const Hypothesis& h, const ResidualData& data, const Eigen:
 std::vector<Hypothesis> enumerate_hypotheses(const ResidualData& data, const LibraryOptions& options) {
   std::vector<Hypothesis> out;
   const int ny = static_cast<int>(data.y_names.size());
-  const int nu = static_cast<int>(data.u_names.size());
-  const int na = static_cast<int>(data.aux_names.size());
-  for (int c = 0; c < ny; ++c) {
-    for (int d = 1; d <= options.max_delay; ++d) out.push_back({EffectKind::kSensorDelay, c, -1, d, 0, 0});
-    for (int d = 1; d <= options.max_delay; ++d) out.push_back({EffectKind::kInputDelay, c, -1, d, 0, 0});
-    for (int m = 0; m < nu; ++m) out.push_back({EffectKind::kFriction, c, m, 0, 0, 0});
-    out.push_back({EffectKind::kDriftLoad, c, -1, 0, 0, 0});
-    out.push_back({EffectKind::kDriftTime, c, -1, 0, 0, 0});
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const auto& log : data.logs) {
-      lo = std::min(lo, log.seq.y.row(c).minCoeff());
-      hi = std::max(hi, log.seq.y.row(c).maxCoeff());
-    }
-    if (hi > lo) {
-      long rows = 0, at_hi = 0, at_lo = 0;
-      for (const auto& log : data.logs) {
-        const auto y = log.seq.y.row(c).array();
-        rows += y.size();
-        // "At": within rail_band of the channel's range (a saturated sensor still
-        // shows its ADC noise around the rail).
-        const double band = options.rail_band * (hi - lo);
-        at_hi += (y >= hi - band).count();
-        at_lo += (y <= lo + band).count();
-      }
-      const double need = std::max(5.0, options.min_rail_share * static_cast<double>(rows));
-      if (static_cast<double>(at_hi) >= need) out.push_back({EffectKind::kSaturation, c, -1, 0, +1, hi});
-      if (static_cast<double>(at_lo) >= need) out.push_back({EffectKind::kSaturation, c, -1, 0, -1, lo});
-    }
-    const std::string group = channel_group(data.y_names[static_cast<std::size_t>(c)]);
-    for (int s = 0; s < ny; ++s) {
-      if (s == c) continue;
-      if (options.crosstalk_same_group && channel_group(data.y_names[static_cast<std::size_t>(s)]) != group) continue;
-      out.push_back({EffectKind::kCrosstalk, c, s, 0, 0, 0});
-    }
-    for (int a = 0; a < na; ++a) out.push_back({EffectKind::kAuxChannel, c, a, 0, 0, 0});
-  }
+  for (int c = 0; c < ny; ++c)
+    for (const EffectInfo& e : effect_library()) e.enumerate(data, options, c, out);
   return out;
 }
 

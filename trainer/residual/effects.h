@@ -3,11 +3,17 @@
 //   (a) a feature test: regressors built from the logs, the model's 1-step
 //       predictions and the auxiliary channels, which should explain the
 //       1-step residual of one target channel if the effect is present, and
-//   (b) a model augmentation (added by `hadynet residual --fix`, augment.h;
-//       `augmentation` describes it).
+//   (b) a model augmentation (added by `hadynet residual --fix`, augment.h).
 // A hypothesis is one effect with its parameters (target channel, source,
 // delay, rail). Nothing here knows the hand: channels come by index into the
 // ResidualData's names.
+//
+// Everything about one effect is one row of the table in effects.cc
+// (EffectInfo below): its texts, which hypotheses it enumerates, its feature
+// test, its parameter and physical domain, its description, and the plan of
+// its augmentation; how the augmentation changes a model is its alternative
+// of Augmentation::change (augment.h), defined in the same section of
+// effects.cc. effects.cc says at the table how to add an effect.
 #pragma once
 
 #include <Eigen/Core>
@@ -18,6 +24,7 @@
 
 namespace hadynet::trainer::residual {
 
+// One per row of the effect table (effects.cc), in its order.
 enum class EffectKind {
   kSensorDelay,  // the target is reported `delay` steps late
   kInputDelay,   // the commands act `delay` steps later than the model assumes
@@ -29,22 +36,12 @@ enum class EffectKind {
   kAuxChannel,   // an unused logged channel (aux `source`) explains the target
 };
 
-struct EffectInfo {
-  EffectKind kind;
-  const char* name;          // used in the CLI, the JSON and the report
-  const char* feature;       // the regressors of the feature test
-  const char* parameter;     // what the fitted parameter means
-  const char* augmentation;  // the model augmentation of --fix (augment.h)
-};
-const std::vector<EffectInfo>& effect_library();
-const EffectInfo& effect_info(EffectKind kind);
-
 struct Hypothesis {
   EffectKind kind = EffectKind::kSensorDelay;
   int target = 0;      // y channel whose residual is explained
   int source = -1;     // u channel (friction), y channel (crosstalk), aux channel (aux); else -1
-  int delay = 0;       // steps (delays)
-  int side = 0;        // saturation: +1 upper rail, -1 lower rail
+  int delay = 0;       // steps (delays); 0 for the other effects (a family shares it: attribution.h)
+  int side = 0;        // saturation: +1 upper rail, -1 lower rail; 0 for the other effects
   double rail = 0;     // saturation: the rail, target units
 };
 
@@ -54,21 +51,6 @@ struct Features {
   Eigen::MatrixXd z;  // n x k
   int first_valid = 0;
 };
-Features features(const Hypothesis& h, const ResidualLog& log);
-
-// Human-readable parameters, e.g. "delay = 2 steps on fc3", from the fitted
-// coefficients (`coef`: one per regressor, in target units per regressor unit).
-std::string describe(const Hypothesis& h, const ResidualData& data, const Eigen::VectorXd& coef);
-// The main fitted parameter (e.g. gain, friction in target units, drift rate).
-double main_parameter(const Hypothesis& h, const Eigen::VectorXd& coef);
-
-// Whether the main parameter is in the effect's physical domain: a
-// cross-talk picks up a fraction of its source (0 < gain < 1), and a delay
-// or a rail explains the residual with a positive gain. The other effects
-// take either sign (friction's sign follows the command convention; a drift
-// may lower a reading). An implausible hypothesis is tested but never
-// significant (attribution.h).
-bool plausible(const Hypothesis& h, double parameter);
 
 struct LibraryOptions {
   int max_delay = 5;                // delays 1..max_delay steps
@@ -86,11 +68,73 @@ struct LibraryOptions {
   double rail_band = 0.05;
 };
 
-// Every hypothesis of the library for these logs: delays per target and
-// delay, friction per target and muscle, drift per target, saturation per
-// target and side (rails: the measured extremes over all logs, where the
-// signal sits: min_rail_share), cross-talk
-// per target and source, aux per target and aux channel.
+// What Hypothesis::source indexes for an effect.
+enum class SourceKind {
+  kNone,      // no source (source = -1)
+  kCommand,   // a u channel (ResidualData::u_names)
+  kObserved,  // another y channel (y_names)
+  kAux,       // an aux_* channel (aux_names)
+};
+
+struct Attribution;       // attribution.h
+struct HypothesisResult;  // attribution.h
+struct Augmentation;      // augment.h
+
+// One effect of the library: everything about it (one row of the table in
+// effects.cc). The functions are given hypotheses of this effect only.
+struct EffectInfo {
+  EffectKind kind;
+  const char* name;          // used in the CLI, the JSON and the report
+  const char* feature;       // the regressors of the feature test
+  const char* parameter;     // what the fitted parameter means
+  const char* augmentation;  // the model augmentation of --fix (augment.h)
+  SourceKind source;         // what Hypothesis::source indexes
+  // Appends the effect's hypotheses about y channel `target`.
+  void (*enumerate)(const ResidualData& data, const LibraryOptions& options, int target,
+                    std::vector<Hypothesis>& out);
+  // The feature test's regressors for one log.
+  Features (*features)(const Hypothesis& h, const ResidualLog& log);
+  // The main fitted parameter from the coefficients (never empty).
+  double (*main_parameter)(const Eigen::VectorXd& coef);
+  // Whether the main parameter is in the effect's physical domain.
+  bool (*plausible)(double parameter);
+  // Human-readable parameters, e.g. "delay = 2 steps on fc3 (gain 0.75)".
+  std::string (*describe)(const Hypothesis& h, const ResidualData& data, double parameter);
+  // --fix: the augmentation for the significant hypothesis `lead` of this
+  // effect (the winner, or the best that has an augmentation): fills a's
+  // channels, found_on, description and change. nullptr: the effect is named
+  // and reported but has no augmentation.
+  void (*plan)(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead,
+               Augmentation& a);
+};
+// The table, in EffectKind order (the order hypotheses are enumerated in).
+const std::vector<EffectInfo>& effect_library();
+const EffectInfo& effect_info(EffectKind kind);
+
+// The row's functions for any hypothesis:
+// The regressors of a hypothesis for one log.
+Features features(const Hypothesis& h, const ResidualLog& log);
+// Human-readable parameters, e.g. "delay = 2 steps on fc3", from the fitted
+// coefficients (`coef`: one per regressor, in target units per regressor unit).
+std::string describe(const Hypothesis& h, const ResidualData& data, const Eigen::VectorXd& coef);
+// The main fitted parameter (e.g. gain, friction in target units, drift
+// rate); NaN without coefficients.
+double main_parameter(const Hypothesis& h, const Eigen::VectorXd& coef);
+// Whether the main parameter is in the effect's physical domain: a
+// cross-talk picks up a fraction of its source (0 < gain < 1), and a delay
+// or a rail explains the residual with a positive gain. The other effects
+// take either sign (friction's sign follows the command convention; a drift
+// may lower a reading). An implausible hypothesis is tested but never
+// significant (attribution.h).
+bool plausible(const Hypothesis& h, double parameter);
+// The name of the hypothesis' source channel (u, y or aux, by the effect's
+// SourceKind); "" for an effect without one.
+std::string source_name(const Hypothesis& h, const ResidualData& data);
+
+// Every hypothesis of the library for these logs: per target channel, each
+// effect's in table order (delays per delay, friction per muscle, drift,
+// saturation per side where the signal sits at a rail: min_rail_share,
+// cross-talk per source, aux per aux channel).
 std::vector<Hypothesis> enumerate_hypotheses(const ResidualData& data, const LibraryOptions& options);
 
 }  // namespace hadynet::trainer::residual

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "trainer/hadynet_network.h"
+#include "trainer/model_frame.h"
 #include "trainer/output_clip.h"
 #include "trainer/pb_adaptation.h"
 #include "trainer/window_dataset.h"
@@ -97,15 +98,15 @@ ResidualData compute_residuals(const HadynetModel& model, const std::vector<LogI
   data.y_scale = model.norm.y.std;
 
   for (const auto& raw : logs) {
-    // The model sees (and predicts) its own frame (sensor_model.h).
-    const LogInput in{to_model_frame(model.sensor, raw.table, raw.file), raw.file};
+    // The model sees (and predicts) its own frame; the aux columns are read from the same rows.
+    ModelFrameLog in = in_model_frame(model.sensor, model.layout, raw.table, raw.file);
     ResidualLog log;
-    log.seq = log_sequence(in.table, in.file, model.layout);
+    log.seq = std::move(in.sequence);
     if (log.seq.steps() < ResidualLog::kFirstRow + 1 + model.train_steps) {
-      throw std::runtime_error(in.file + ": " + std::to_string(log.seq.steps()) + " rows; at least " +
+      throw std::runtime_error(raw.file + ": " + std::to_string(log.seq.steps()) + " rows; at least " +
                                std::to_string(ResidualLog::kFirstRow + 1 + model.train_steps) + " needed");
     }
-    log.dt_s = log_dt(in.table, in.file);
+    log.dt_s = log_dt(in.table, raw.file);
     const auto T = static_cast<Eigen::Index>(in.table.rows());
     log.aux.resize(static_cast<Eigen::Index>(data.aux_names.size()), T);
     for (std::size_t a = 0; a < data.aux_names.size(); ++a) {

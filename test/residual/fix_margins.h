@@ -1,0 +1,225 @@
+// The margins of the `hadynet residual --fix` tests: their one source.
+// fix_test.cc and generic_layout_test.cc take every bound from here, and
+// FixMargins.DocsTableIsThisTable (fix_margins_test.cc) checks that the
+// "Test margins" table of docs/residual.md is margins_table() below, so the
+// docs cannot drift from the tests.
+//
+// Each bound is stated with the value measured when it was set (release
+// build, 2 threads, the tests' seeds: 20 epochs from the build's model, seed
+// 1, the first 60 % of each log's rows) and, in `why`, why it is where it is.
+// What every ratio bound shares: "after / before" and "after / fine-tune
+// only" are held-out 1-step RMSE ratios of one channel; each bound sits
+// between the measured value and 1 (no gain), with room for thread-count
+// rounding (the CLI reproduces the numbers to about 1 %), and tight enough
+// that losing the effect's mechanism fails it. They are not derived from a
+// noise model.
+#pragma once
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace hadynet::test::fix_margins {
+
+// value < limit
+struct Below {
+  double limit;
+  double measured;
+};
+// value > limit
+struct Above {
+  double limit;
+  double measured;
+};
+// lo < value < hi
+struct Between {
+  double lo, hi;
+  double measured;
+};
+
+// Plant: every loadcell reported 2 steps late (latency=2).
+struct Latency {
+  Below winner_vs_before;   // the winner (fc1): after / before
+  Below winner_vs_control;  // the winner: after / fine-tune only
+  Below aligned_vs_before;  // every aligned channel: after / before (measured: the worst, fc5)
+  Below aligned_median;     // the median of after / before over the aligned channels
+  int delay_steps;          // the plant's delay, found on
+  int aligned_channels;     // every loadcell
+  const char* why;
+};
+inline constexpr Latency kLatency{
+    .winner_vs_before = {0.6, 0.36},
+    .winner_vs_control = {0.6, 0.45},
+    .aligned_vs_before = {0.97, 0.93},
+    .aligned_median = {0.75, 0.61},
+    .delay_steps = 2,
+    .aligned_channels = 9,
+    .why = "the cut must be the alignment's, so the bound against fine-tuning alone is as tight as against "
+           "before; every aligned channel must gain (fc5 barely moves in these grasps: 0.93), which catches "
+           "aligning only the channels past the floors (five delayed loadcells got worse, up to 1.4×)"};
+
+// Plant: 4 N of dry friction on every tendon (friction).
+struct Friction {
+  Below winner_vs_before;   // the winner (f0)
+  Below winner_vs_control;
+  Below family_vs_before;   // every friction channel of the family (measured: the worst, f1)
+  const char* why;
+};
+inline constexpr Friction kFriction{
+    .winner_vs_before = {0.75, 0.61},
+    .winner_vs_control = {0.95, 0.87},
+    .family_vs_before = {0.9, 0.76},
+    .why = "fine-tuning alone already cuts f0 to 0.70×, so the hysteresis inputs are asked for a further 5 %; "
+           "the family channels measured 0.58-0.76×"};
+
+// Plant: fingertip loadcell i adds 0.35 x its neighbour's force (crosstalk).
+struct Crosstalk {
+  Below winner_vs_before;   // the target (fc2)
+  Below winner_vs_control;
+  Between gain;             // the fitted gain removed
+  Above target_ljung_box_p;  // the target's held-out residual after the fix
+  const char* why;
+};
+inline constexpr Crosstalk kCrosstalk{
+    .winner_vs_before = {0.6, 0.47},
+    .winner_vs_control = {0.95, 0.91},
+    .gain = {0.1, 0.5, 0.252},
+    .target_ljung_box_p = {1e-3, 0.085},
+    .why = "the source fc3 is an input, so fine-tuning alone learns most of the pick-up (0.51× before) and the "
+           "bound against it is loose; the fitted gain is below the plant's 0.35 (persistence, docs above); "
+           "the removal leaves the target nearly white (p 1e-78 before)"};
+
+// Plant: loadcell bias growing 0.02 N per N s of load (drift=0.02, 5× the default).
+struct Drift {
+  Below winner_vs_before;   // the winner (fc3)
+  Below winner_vs_control;
+  Between rate_vs_plant;    // the winner's re-estimated rate / the plant's 0.02
+  Below family_vs_before;   // every drift channel of the family (measured: the worst, fc6)
+  const char* why;
+};
+inline constexpr Drift kDrift{
+    .winner_vs_before = {0.5, 0.35},
+    .winner_vs_control = {0.75, 0.57},
+    .rate_vs_plant = {0.7, 1.3, 1.006},
+    .family_vs_before = {0.8, 0.60},
+    .why = "the attribution's own fit of the rate is 0.42× the plant's, so the rate bound fails when the "
+           "re-estimation does not run; the bias state must cut well beyond fine-tuning alone"};
+
+// Plant default drift (0.004 N per N s plus a 0.01 N/sqrt(step) walk) on 1 000-step logs.
+struct DefaultDriftLongLogs {
+  Below winner_vs_before;   // the winner (fc2); no bound against the control
+  Between rate_vs_plant;    // the winner's re-estimated rate / the plant's 0.004
+  Below decision_p;         // the Diebold-Mariano p against fine-tuning alone
+  const char* why;
+};
+inline constexpr DefaultDriftLongLogs kDefaultDriftLongLogs{
+    .winner_vs_before = {0.75, 0.62},
+    .rate_vs_plant = {0.5, 2.0, 1.14},
+    .decision_p = {0.05, 0.0065},
+    .why = "at this strength most of the cut is the fine-tuning's (0.68× alone) and the decision is "
+           "borderline (p 0.0065 with 2 threads, 0.0095 with 1; alpha 0.01), so the test asks for the "
+           "candidate and its evaluation, not the verdict; the walk adds its own slow bias to the rate"};
+
+// Plant: every loadcell clipped at 2 N (saturation=2).
+struct Saturation {
+  Below winner_vs_before;   // the winner (fc6)
+  Below winner_vs_control;
+  Below rail_error_N;       // |rail - 2 N| of every clip (measured: the largest, fc3)
+  const char* why;
+};
+inline constexpr Saturation kSaturation{
+    .winner_vs_before = {0.85, 0.74},
+    .winner_vs_control = {0.97, 0.93},
+    .rail_error_N = {0.1, 0.051},
+    .why = "a rail is the measured maximum: sensor noise (20 mN) and quantisation on top of 2 N; training on "
+           "the clipped output gains little on the winner beyond fine-tuning alone (the clip's gain is on "
+           "fc3: 0.55× before)"};
+
+// A slow synthetic aux_temp column adding 0.5 N per unit to fc3 on clean plant logs.
+struct Aux {
+  Below winner_vs_before;   // fc3
+  Below winner_vs_control;
+  const char* why;
+};
+inline constexpr Aux kAux{
+    .winner_vs_before = {0.8, 0.72},
+    .winner_vs_control = {0.95, 0.91},
+    .why = "fine-tuning alone absorbs much of the slow aux term through the PB and the recurrent state (0.80× "
+           "before), so the input is asked for a further 5 %"};
+
+// Not the hand: two mass-springs, v1 reported 2 steps late (generic_layout_test.cc).
+struct SpringDelay {
+  Below winner_vs_before;   // v1
+  Below winner_vs_control;
+  const char* why;
+};
+inline constexpr SpringDelay kSpringDelay{
+    .winner_vs_before = {0.6, 0.46},
+    .winner_vs_control = {0.8, 0.64},
+    .why = "an input delay on v1 ranks first and has no augmentation, so --fix must take the sensor delay; "
+           "the small model's alignment gain is smaller than the hand's"};
+
+// ---- The docs table (docs/residual.md, "Test margins") ----
+
+inline std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+inline std::string text(const Below& b) { return "< " + number(b.limit) + " (" + number(b.measured) + ")"; }
+inline std::string text(const Above& b) { return "> " + number(b.limit) + " (" + number(b.measured) + ")"; }
+inline std::string text(const Between& b) {
+  return "within " + number(b.lo) + "–" + number(b.hi) + " (" + number(b.measured) + ")";
+}
+inline std::string worst(const Below& b) {
+  return "< " + number(b.limit) + " (worst " + number(b.measured) + ")";
+}
+
+// The table's lines, header first: effect | winner after / before | vs
+// control | other checks | why (bounds with the measured value in brackets).
+inline std::vector<std::string> margins_table() {
+  const std::string none = "—";
+  struct Row {
+    std::string effect, vs_before, vs_control, other, why;
+  };
+  const std::vector<Row> rows = {
+      {"clean", none, none, "status `no significant effect`, weights bit-identical, nothing fine-tuned",
+       "exact: with nothing significant nothing may change"},
+      {"latency", text(kLatency.winner_vs_before), text(kLatency.winner_vs_control),
+       std::to_string(kLatency.delay_steps) + " steps on all " + std::to_string(kLatency.aligned_channels) +
+           " loadcells; every aligned channel " + worst(kLatency.aligned_vs_before) + "; their median " +
+           text(kLatency.aligned_median),
+       kLatency.why},
+      {"friction", text(kFriction.winner_vs_before), text(kFriction.winner_vs_control),
+       "two derived inputs per family muscle; every family channel " + worst(kFriction.family_vs_before),
+       kFriction.why},
+      {"crosstalk", text(kCrosstalk.winner_vs_before), text(kCrosstalk.winner_vs_control),
+       "fitted gain " + text(kCrosstalk.gain) + "; target's held-out Ljung-Box p " +
+           text(kCrosstalk.target_ljung_box_p),
+       kCrosstalk.why},
+      {"drift", text(kDrift.winner_vs_before), text(kDrift.winner_vs_control),
+       "re-estimated rate / the plant's " + text(kDrift.rate_vs_plant) + "; every family channel " +
+           worst(kDrift.family_vs_before),
+       kDrift.why},
+      {"default drift, 1 000 steps", text(kDefaultDriftLongLogs.winner_vs_before), none,
+       "re-estimated rate / the plant's " + text(kDefaultDriftLongLogs.rate_vs_plant) +
+           "; decision p against fine-tuning alone " + text(kDefaultDriftLongLogs.decision_p),
+       kDefaultDriftLongLogs.why},
+      {"saturation", text(kSaturation.winner_vs_before), text(kSaturation.winner_vs_control),
+       "every rail within " + number(kSaturation.rail_error_N.limit) + " N of 2 N (" +
+           number(kSaturation.rail_error_N.measured) + "); no prediction of a clipped channel above its rail",
+       kSaturation.why},
+      {"aux", text(kAux.winner_vs_before), text(kAux.winner_vs_control), "dims.x and dims.y + 1", kAux.why},
+      {"spring delay (not the hand)", text(kSpringDelay.winner_vs_before), text(kSpringDelay.winner_vs_control),
+       "v1 aligned by 2 steps; clean spring logs give `no significant effect`", kSpringDelay.why},
+  };
+  std::vector<std::string> lines = {
+      "| effect | winner after / before (measured) | vs control (measured) | other checks | why |",
+      "|---|---|---|---|---|"};
+  for (const Row& r : rows)
+    lines.push_back("| " + r.effect + " | " + r.vs_before + " | " + r.vs_control + " | " + r.other + " | " + r.why +
+                    " |");
+  return lines;
+}
+
+}  // namespace hadynet::test::fix_margins
