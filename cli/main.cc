@@ -1,5 +1,4 @@
 // hadynet: one program, one subcommand per job (kCommands below).
-#include <Eigen/Core>
 #include <cstdio>
 #include <cstring>
 
@@ -59,10 +58,6 @@ void print_help() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Matrix products run on one thread unless a command asks for more (train
-  // --threads): OpenMP's spinning threads slow down badly when the cores are
-  // shared with other work, and the small products of adapt/detect gain nothing.
-  Eigen::setNbThreads(1);
   if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0 ||
       std::strcmp(argv[1], "help") == 0) {
     print_help();

@@ -9,7 +9,6 @@
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
-#include <thread>
 
 #include "cli/commands.h"
 #include "cli/error_text.h"
@@ -23,6 +22,7 @@
 #include "trainer/model_file.h"
 #include "trainer/training.h"
 #include "trainer/training_record.h"
+#include "trainer/work_pool.h"
 
 namespace hadynet::cli {
 namespace fs = std::filesystem;
@@ -107,7 +107,7 @@ int run_train(int argc, char** argv) {
             "'delta_groups' metadata, e.g. l,th in the hand's logs; none when the logs do not name any)",
             "auto");
   opt.value("held-out", "F", "fraction of each log's windows held out for the held-out loss", "0.1");
-  opt.value("threads", "N", "threads for matrix products (0: all cores; 1 is faster when the cores are busy)", "0");
+  opt.value("threads", "N", "training threads (0: every core); results do not depend on it", "0");
   opt.flag("constant-pb", "keep every PB at 0 (the paper's 'constant PB' comparison)");
   opt.flag("resume", "continue from OUT.ckpt (same data and options; --epochs may be raised)");
   opt.flag("quiet", "no per-epoch progress");
@@ -127,8 +127,7 @@ int run_train(int argc, char** argv) {
   const auto held_out = opt.get_double("held-out", 0.0, 0.9);
   const auto threads = opt.get_int("threads", 0, 1024);
   if (!epochs || !batch || !steps || !lr || !seed || !pb || !hidden || !held_out || !threads) return 2;
-  Eigen::setNbThreads(*threads > 0 ? static_cast<int>(*threads)
-                                    : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  trainer::set_training_threads(static_cast<int>(*threads));
 
   const std::string out = opt.get("out");
   const std::string ckpt = out + ".ckpt";
@@ -189,7 +188,7 @@ int run_train(int argc, char** argv) {
                  paths.size(), states.size(), split.train.size(), split.held_out.size(),
                  static_cast<int>(*steps), model.params.dims.x, model.params.dims.u,
                  model.params.dims.y, model.params.dims.pb, model.params.dims.hidden,
-                 options.variable_pb ? "variable" : "constant", options.epochs, Eigen::nbThreads());
+                 options.variable_pb ? "variable" : "constant", options.epochs, trainer::training_pool().threads());
 
     const auto started = std::chrono::steady_clock::now();
     const int first_epoch = state.epochs_done + 1;

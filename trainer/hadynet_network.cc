@@ -1,5 +1,7 @@
 #include "trainer/hadynet_network.h"
 
+#include "trainer/work_pool.h"
+
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -16,11 +18,35 @@ std::string shape_str(Eigen::Index rows, Eigen::Index cols) {
   return std::to_string(rows) + "x" + std::to_string(cols);
 }
 
-// Parts the windows are split into for the recurrence: one per Eigen thread,
-// at most one per 16 windows (smaller parts lose more in matrix-product
-// efficiency than a thread gains).
-int recurrence_parts(int windows) {
-  return std::max(1, std::min(Eigen::nbThreads(), windows / 16));
+// How the work of a forward or backward pass is split over training_pool():
+// `count` items (windows, columns or gate rows) in chunks of at least
+// `min_items` (smaller chunks lose more in matrix-product efficiency than a
+// thread gains), one chunk per thread. (Two per thread, so that a thread on
+// a shared core could take fewer, measured slower both on an idle machine,
+// +5 %, and with one core busy, +4 %: bench/train_shared_core.sh.)
+//
+// Results do not depend on the split, hence not on the thread count: Eigen
+// blocks a product's depth by the depth alone and computes each element in
+// the same order wherever its row and column fall, PROVIDED the chunk
+// boundaries fall on its register blocks: rows in panels of up to 3 SIMD
+// registers (48 floats with AVX-512; 24 with AVX; 12 with SSE) and columns
+// in groups of up to 8. Rows that fall in a panel's tail take another code
+// path with another summation order. So chunk boundaries are multiples of
+// kRowAlign rows or kColumnAlign columns (work_pool_test.cc checks the bits
+// for 1, 2 and 3 threads at the paper's sizes).
+constexpr int kRowAlign = 48;
+constexpr int kColumnAlign = 8;
+
+int chunks_for(int count, int min_items) {
+  const int threads = training_pool().threads();
+  if (threads == 1) return 1;
+  return std::clamp(count / min_items, 1, threads);
+}
+// First item of chunk c of `chunks`, rounded down to a multiple of `align`
+// (the last chunk ends at `count`; a chunk may be empty).
+int chunk_begin(int c, int count, int chunks, int align) {
+  if (c >= chunks) return count;
+  return static_cast<int>(static_cast<long>(c) * count / chunks) / align * align;
 }
 
 }  // namespace
@@ -120,15 +146,23 @@ const Matrix<S>& HadynetNetwork<S>::forward(const HadynetParams<S>& params,
   gates_pb_.colwise() += params.lstm_bias_ih + params.lstm_bias_hh;
   tanh_c_.resize(H, static_cast<Eigen::Index>(N) * B);
   // Windows are independent through the recurrence: split them over threads.
-  const int parts = recurrence_parts(B);
-#pragma omp parallel for schedule(static) num_threads(parts) if (parts > 1)
-  for (int part = 0; part < parts; ++part) {
-    forward_recurrence(params, part * B / parts, (part + 1) * B / parts - part * B / parts);
-  }
+  const int parts = chunks_for(B, 16);
+  training_pool().run(parts, [&](int part) {
+    const int b0 = chunk_begin(part, B, parts, kColumnAlign);
+    const int nb = chunk_begin(part + 1, B, parts, kColumnAlign) - b0;
+    if (nb > 0) forward_recurrence(params, b0, nb);
+  });
 
-  // ---- decoder, all steps in one product ----
-  y_hat_.noalias() = params.dec_weight * h_.rightCols(static_cast<Eigen::Index>(N) * B);
-  y_hat_.colwise() += params.dec_bias;
+  // ---- decoder, one step per chunk ----
+  y_hat_.resize(d.y, static_cast<Eigen::Index>(N) * B);
+  const int NB = N * B;
+  const int column_chunks = chunks_for(NB, 64);
+  training_pool().run(column_chunks, [&](int c) {
+    const int c0 = chunk_begin(c, NB, column_chunks, kColumnAlign);
+    auto y_c = y_hat_.middleCols(c0, chunk_begin(c + 1, NB, column_chunks, kColumnAlign) - c0);
+    y_c.noalias() = params.dec_weight * h_.middleCols(B + c0, y_c.cols());
+    y_c.colwise() += params.dec_bias;
+  });
   return y_hat_;
 }
 
@@ -186,7 +220,14 @@ void HadynetNetwork<S>::backward(const HadynetParams<S>& params, const Matrix<S>
   const auto h_next = h_.rightCols(NB);
   g.dec_weight.noalias() = d_y_hat * h_next.transpose();
   g.dec_bias = d_y_hat.rowwise().sum();
-  d_h_out_.noalias() = params.dec_weight.transpose() * d_y_hat;
+  d_h_out_.resize(d.hidden, NB);
+  const int columns = static_cast<int>(NB);
+  const int column_chunks = chunks_for(columns, 64);
+  training_pool().run(column_chunks, [&](int c) {
+    const int c0 = chunk_begin(c, columns, column_chunks, kColumnAlign);
+    const int n = chunk_begin(c + 1, columns, column_chunks, kColumnAlign) - c0;
+    d_h_out_.middleCols(c0, n).noalias() = params.dec_weight.transpose() * d_y_hat.middleCols(c0, n);
+  });
 
   backward_recurrence(params, truncation);
 
@@ -194,12 +235,26 @@ void HadynetNetwork<S>::backward(const HadynetParams<S>& params, const Matrix<S>
   const auto w_ih_u = params.lstm_weight_ih.leftCols(d.u);
   const auto w_ih_p = params.lstm_weight_ih.rightCols(d.pb);
   const auto pb_in = enc_in_.bottomRows(d.pb);
-  g.lstm_weight_hh.noalias() = d_gates_ * h_.leftCols(NB).transpose();
-  g.lstm_weight_ih.leftCols(d.u).noalias() = d_gates_ * u_.transpose();
+  // dL/dW_hh (the largest product of a step) and dL/dW_ih of u, in fixed
+  // chunks of gate rows over the pool.
+  const int gate_rows = static_cast<int>(d_gates_.rows());
+  const int row_chunks = chunks_for(gate_rows, 32);
+  training_pool().run(row_chunks, [&](int c) {
+    const int r0 = chunk_begin(c, gate_rows, row_chunks, kRowAlign);
+    const int rows = chunk_begin(c + 1, gate_rows, row_chunks, kRowAlign) - r0;
+    const auto d_gates_rows = d_gates_.middleRows(r0, rows);
+    g.lstm_weight_hh.middleRows(r0, rows).noalias() = d_gates_rows * h_.leftCols(NB).transpose();
+    g.lstm_weight_ih.leftCols(d.u).middleRows(r0, rows).noalias() = d_gates_rows * u_.transpose();
+  });
   g.lstm_weight_ih.rightCols(d.pb).noalias() = d_gates_pb_sum_ * pb_in.transpose();
   g.lstm_bias_ih = d_gates_pb_sum_.rowwise().sum();
   g.lstm_bias_hh = g.lstm_bias_ih;
-  grads.u.noalias() = w_ih_u.transpose() * d_gates_;
+  grads.u.resize(d.u, NB);
+  training_pool().run(column_chunks, [&](int c) {
+    const int c0 = chunk_begin(c, columns, column_chunks, kColumnAlign);
+    const int n = chunk_begin(c + 1, columns, column_chunks, kColumnAlign) - c0;
+    grads.u.middleCols(c0, n).noalias() = w_ih_u.transpose() * d_gates_.middleCols(c0, n);
+  });
   grads.pb_window.noalias() = w_ih_p.transpose() * d_gates_pb_sum_;
 
   backward_encoder(params, grads);
@@ -230,12 +285,12 @@ void HadynetNetwork<S>::backward_recurrence(const HadynetParams<S>& params, int 
   d_gates_.resize(4 * H, static_cast<Eigen::Index>(N) * B);
   d_h0_.resize(H, B);
   // Windows are independent through the recurrence: split them over threads.
-  const int parts = recurrence_parts(B);
-#pragma omp parallel for schedule(static) num_threads(parts) if (parts > 1)
-  for (int part = 0; part < parts; ++part) {
-    backward_recurrence_columns(params, truncation, part * B / parts,
-                                (part + 1) * B / parts - part * B / parts);
-  }
+  const int parts = chunks_for(B, 16);
+  training_pool().run(parts, [&](int part) {
+    const int b0 = chunk_begin(part, B, parts, kColumnAlign);
+    const int nb = chunk_begin(part + 1, B, parts, kColumnAlign) - b0;
+    if (nb > 0) backward_recurrence_columns(params, truncation, b0, nb);
+  });
   d_gates_pb_sum_ = d_gates_.leftCols(B);
   for (int k = 1; k < N; ++k) d_gates_pb_sum_ += d_gates_.middleCols(k * B, B);
 }

@@ -62,10 +62,11 @@ S mse_loss(const Matrix<S>& y_hat, const Matrix<S>& y,
 
 // Holds the activations of the last forward pass that backward needs, and
 // scratch buffers reused between calls (no allocation once shapes settle).
-// Threads: with Eigen::nbThreads() > 1 (OpenMP) the recurrence of forward and
-// backward runs on one thread per part of the windows (windows are
-// independent there) and the large products use Eigen's own threads. Results
-// are deterministic for a given thread count.
+// Threads: the recurrence of forward and backward runs in parts of the
+// windows (windows are independent there), the decoder and the input
+// gradients in steps, and the largest weight gradients in chunks of gate
+// rows, all on training_pool() (work_pool.h). Results are bit-identical for
+// any thread count (hadynet_network.cc, chunks_for()).
 template <class S>
 class HadynetNetwork {
  public:
