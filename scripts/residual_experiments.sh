@@ -20,7 +20,7 @@ printf '# The residual loop on %s (measured by scripts/residual_experiments.sh)\
 
 # name|plant effect ("" = clean); drift and saturation at the stronger
 # settings docs/residual.md explains (300-step logs do not show the defaults).
-effects=("clean|" "latency|latency" "friction|friction" "crosstalk|crosstalk" "drift|drift=0.02"
+effects=("clean|" "sensor-delay|sensor-delay" "friction|friction" "crosstalk|crosstalk" "drift|drift=0.02"
          "saturation|saturation=2")
 n=${#effects[@]}
 i=0

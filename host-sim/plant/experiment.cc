@@ -153,7 +153,7 @@ std::vector<std::string> command_channel_names() {
   return names;
 }
 
-void append_observed(const SensorFrame& y, std::vector<double>& out) {
+void append_observed(const Measurement& y, std::vector<double>& out) {
   out.insert(out.end(), y.muscle_length_mm.begin(), y.muscle_length_mm.end());
   out.insert(out.end(), y.tension_N.begin(), y.tension_N.end());
   out.insert(out.end(), y.loadcell_N.begin(), y.loadcell_N.end());

@@ -12,7 +12,7 @@
 #include "host-sim/plant/hand_plant.h"
 #include "host-sim/plant/hand_spec.h"
 #include "host-sim/plant/motions.h"
-#include "host-sim/plant/sensor_model.h"
+#include "host-sim/plant/sensor_simulation.h"
 
 namespace hadynet::plant {
 
@@ -55,7 +55,7 @@ std::vector<std::string> command_channel_names();
 // board scans the loadcells fc0..fc8; tips are fc0..fc4, palm fc5..fc8.
 datalog::RobotProfile hand_profile();
 // Appends one frame's y values in observed_channel_names() order.
-void append_observed(const SensorFrame& y, std::vector<double>& out);
+void append_observed(const Measurement& y, std::vector<double>& out);
 
 // Command resolution (mm) of the target muscle lengths.
 inline constexpr double kCommandResolution_mm = 0.001;
@@ -76,7 +76,7 @@ class ExperimentLoop {
   explicit ExperimentLoop(const ExperimentSpec& spec);
 
   // The measured y after the last step (log units), i.e. this row's y.
-  const SensorFrame& measured() const { return measured_; }
+  const Measurement& measured() const { return measured_; }
   const std::array<double, kMuscles>& target_mm() const { return target_mm_; }
   // The command that moves the target to `wanted_mm`, at command resolution.
   std::array<double, kMuscles> command_to(const std::array<double, kMuscles>& wanted_mm) const;
@@ -90,9 +90,9 @@ class ExperimentLoop {
 
  private:
   HandPlant plant_;
-  SensorModel sensors_;
+  SensorSimulation sensors_;
   std::array<double, kMuscles> target_mm_{};
-  SensorFrame measured_;
+  Measurement measured_;
 };
 
 }  // namespace hadynet::plant

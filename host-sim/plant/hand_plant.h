@@ -1,7 +1,7 @@
 // The flexible hand as a MuJoCo plant: one dynamics state (HandSpec), driven
 // at the 0.2 s control step by target muscle lengths in encoder millimetres,
 // returning the true (noise-free) sensor values. Sensor noise and the
-// switchable sensor effects are applied afterwards by SensorModel.
+// switchable sensor effects are applied afterwards by SensorSimulation.
 #pragma once
 
 #include <array>
@@ -17,7 +17,7 @@ struct mjData_;
 namespace hadynet::plant {
 
 // One sample of every signal the robot measures (y of DESIGN.md).
-struct SensorFrame {
+struct Measurement {
   std::array<double, kMuscles> muscle_length_mm{};  // l: encoder, incl. offsets
   std::array<double, kMuscles> tension_N{};         // f
   std::array<double, kLoadcells> loadcell_N{};      // f_contact
@@ -43,7 +43,7 @@ class HandPlant {
 
   // True sensor values at the end of the last step (loadcells averaged over
   // the step's last 20 ms).
-  const SensorFrame& state() const { return state_; }
+  const Measurement& state() const { return state_; }
   const std::array<double, kMuscles>& target_mm() const { return target_mm_; }
 
   // External wrench on the grasped object's body (MuJoCo mjData::xfrc_applied):
@@ -97,7 +97,7 @@ class HandPlant {
   std::array<double, kMuscles> target_mm_{};
   std::array<double, kLoadcells> loadcell_sum_{};
   int loadcell_samples_ = 0;
-  SensorFrame state_;
+  Measurement state_;
   long physics_steps_ = 0;
 };
 

@@ -62,7 +62,7 @@ Wear wear_from_level(double level) {
 }
 
 bool Effects::any() const {
-  return tendon_friction_N > 0 || loadcell_latency_steps > 0 || loadcell_drift_per_Ns > 0 ||
+  return tendon_friction_N > 0 || loadcell_delay_steps > 0 || loadcell_drift_per_Ns > 0 ||
          loadcell_drift_walk_N > 0 || loadcell_rail_N > 0 || loadcell_crosstalk > 0;
 }
 
@@ -74,7 +74,7 @@ std::string Effects::describe() const {
     out += text;
   };
   if (tendon_friction_N > 0) { std::snprintf(buf, sizeof buf, "friction=%g", tendon_friction_N); add(buf); }
-  if (loadcell_latency_steps > 0) { std::snprintf(buf, sizeof buf, "latency=%d", loadcell_latency_steps); add(buf); }
+  if (loadcell_delay_steps > 0) { std::snprintf(buf, sizeof buf, "sensor-delay=%d", loadcell_delay_steps); add(buf); }
   if (loadcell_drift_per_Ns > 0 || loadcell_drift_walk_N > 0) {
     std::snprintf(buf, sizeof buf, "drift=%g/%g", loadcell_drift_per_Ns, loadcell_drift_walk_N);
     add(buf);
@@ -94,10 +94,10 @@ std::string apply_effect_arg(std::string_view arg, Effects& e) {
   if (has_value && value < 0) return "effect '" + std::string(arg) + "': value must be >= 0";
   if (name == "friction") {
     e.tendon_friction_N = has_value ? value : 4.0;
-  } else if (name == "latency") {
-    e.loadcell_latency_steps = has_value ? static_cast<int>(value) : 2;
+  } else if (name == "sensor-delay") {
+    e.loadcell_delay_steps = has_value ? static_cast<int>(value) : 2;
     if (has_value && (value != static_cast<int>(value) || value > 20))
-      return "effect 'latency': expected a whole number of steps in 0..20";
+      return "effect 'sensor-delay': expected a whole number of steps in 0..20";
   } else if (name == "drift") {
     e.loadcell_drift_per_Ns = has_value ? value : 0.004;
     e.loadcell_drift_walk_N = 0.01;
@@ -108,7 +108,7 @@ std::string apply_effect_arg(std::string_view arg, Effects& e) {
     if (e.loadcell_crosstalk > 1) return "effect 'crosstalk': expected a fraction in 0..1";
   } else {
     return "unknown effect '" + std::string(name) +
-           "' (expected friction, latency, drift, saturation or crosstalk)";
+           "' (expected friction, sensor-delay, drift, saturation or crosstalk)";
   }
   return "";
 }

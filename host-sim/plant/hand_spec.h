@@ -63,8 +63,8 @@ Wear wear_from_level(double level);
 struct Effects {
   // Dry friction on every tendon (N): hysteresis between length and tension.
   double tendon_friction_N = 0.0;
-  // Loadcell latency: fc channels are reported this many 0.2 s steps late.
-  int loadcell_latency_steps = 0;
+  // Sensor delay: fc channels are reported this many 0.2 s steps late.
+  int loadcell_delay_steps = 0;
   // Loadcell drift: bias (N) growing with accumulated load (N*s) plus a slow
   // random walk (N per sqrt(step)), per channel.
   double loadcell_drift_per_Ns = 0.0;
@@ -76,11 +76,11 @@ struct Effects {
   double loadcell_crosstalk = 0.0;
 
   bool any() const;
-  // "friction=4,latency=2" style summary, for declared logs and reports.
+  // "friction=4,sensor-delay=2" style summary, for declared logs and reports.
   std::string describe() const;
 };
 // Parses one `--effect` argument: NAME or NAME=VALUE, NAME in
-// friction|latency|drift|saturation|crosstalk. Returns an error text or "".
+// friction|sensor-delay|drift|saturation|crosstalk. Returns an error text or "".
 std::string apply_effect_arg(std::string_view arg, Effects& effects);
 
 // One dynamics state plus its simulation settings.

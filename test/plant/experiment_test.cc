@@ -88,7 +88,7 @@ EffectPair run_pair(const std::string& effect_arg, ObjectKind object = ObjectKin
 }
 
 TEST(Effects, AreNeverDeclaredUnlessAsked) {
-  for (const char* effect : {"friction", "latency", "drift", "saturation", "crosstalk"}) {
+  for (const char* effect : {"friction", "sensor-delay", "drift", "saturation", "crosstalk"}) {
     auto spec = short_spec(ObjectKind::kCylinder, Motion::kRandom1, 20);
     ASSERT_EQ(apply_effect_arg(effect, spec.effects), "");
     const std::string text = datalog::format_log(run_experiment(spec).log);
@@ -100,13 +100,13 @@ TEST(Effects, AreNeverDeclaredUnlessAsked) {
 }
 
 TEST(Effects, LatencyDelaysLoadcellsByExactlyThatManySteps) {
-  const auto [clean, late] = run_pair("latency=2");
+  const auto [clean, late] = run_pair("sensor-delay=2");
   for (std::size_t r = 2; r < clean.rows(); ++r)
     for (int i = 0; i < 9; ++i) {
       const auto c = col(clean, "fc" + std::to_string(i));
       EXPECT_EQ(late.at(r, c), clean.at(r - 2, c));
     }
-  // Everything else is untouched (latency is in the sensor path only).
+  // Everything else is untouched (the delay is in the sensor path only).
   EXPECT_EQ(late.at(40, col(late, "f3")), clean.at(40, col(clean, "f3")));
 }
 

@@ -37,8 +37,8 @@ struct Between {
   double measured;
 };
 
-// Plant: every loadcell reported 2 steps late (latency=2).
-struct Latency {
+// Plant: every loadcell reported 2 steps late (sensor-delay=2).
+struct SensorDelay {
   Below winner_vs_before;   // the winner (fc1): after / before
   Below winner_vs_control;  // the winner: after / fine-tune only
   Below aligned_vs_before;  // every aligned channel: after / before (measured: the worst, fc5)
@@ -47,7 +47,7 @@ struct Latency {
   int aligned_channels;     // every loadcell
   const char* why;
 };
-inline constexpr Latency kLatency{
+inline constexpr SensorDelay kSensorDelay{
     .winner_vs_before = {0.6, 0.36},
     .winner_vs_control = {0.6, 0.45},
     .aligned_vs_before = {0.97, 0.93},
@@ -185,11 +185,11 @@ inline std::vector<std::string> margins_table() {
   const std::vector<Row> rows = {
       {"clean", none, none, "status `no significant effect`, weights bit-identical, nothing fine-tuned",
        "exact: with nothing significant nothing may change"},
-      {"latency", text(kLatency.winner_vs_before), text(kLatency.winner_vs_control),
-       std::to_string(kLatency.delay_steps) + " steps on all " + std::to_string(kLatency.aligned_channels) +
-           " loadcells; every aligned channel " + worst(kLatency.aligned_vs_before) + "; their median " +
-           text(kLatency.aligned_median),
-       kLatency.why},
+      {"sensor-delay", text(kSensorDelay.winner_vs_before), text(kSensorDelay.winner_vs_control),
+       std::to_string(kSensorDelay.delay_steps) + " steps on all " + std::to_string(kSensorDelay.aligned_channels) +
+           " loadcells; every aligned channel " + worst(kSensorDelay.aligned_vs_before) + "; their median " +
+           text(kSensorDelay.aligned_median),
+       kSensorDelay.why},
       {"friction", text(kFriction.winner_vs_before), text(kFriction.winner_vs_control),
        "two derived inputs per family muscle; every family channel " + worst(kFriction.family_vs_before),
        kFriction.why},

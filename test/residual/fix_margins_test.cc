@@ -44,8 +44,8 @@ TEST(FixMargins, DocsTableIsThisTable) {
 // passes its own bound (a bound moved past its measurement is a typo).
 TEST(FixMargins, EveryMeasuredValuePassesItsBound) {
   using namespace fix_margins;
-  for (const Below& b : {kLatency.winner_vs_before, kLatency.winner_vs_control, kLatency.aligned_vs_before,
-                         kLatency.aligned_median, kFriction.winner_vs_before, kFriction.winner_vs_control,
+  for (const Below& b : {kSensorDelay.winner_vs_before, kSensorDelay.winner_vs_control, kSensorDelay.aligned_vs_before,
+                         kSensorDelay.aligned_median, kFriction.winner_vs_before, kFriction.winner_vs_control,
                          kFriction.family_vs_before, kCrosstalk.winner_vs_before, kCrosstalk.winner_vs_control,
                          kDrift.winner_vs_before, kDrift.winner_vs_control, kDrift.family_vs_before,
                          kDefaultDriftLongLogs.winner_vs_before, kDefaultDriftLongLogs.decision_p,

@@ -135,30 +135,30 @@ TEST(ResidualFix, FreshCleanLogsScreenACandidateThatIsNotConfirmed) {
   EXPECT_TRUE(r.fix.model.params.enc_weight == build_model().params.enc_weight);
 }
 
-TEST(ResidualFix, LatencyIsTimeAlignedAndCutsTheDelayedChannelsError) {
-  // Plant: every loadcell reported 2 steps late (latency=2).
-  const FixRun r = run_fix(plant_logs("latency"), "latency");
+TEST(ResidualFix, SensorDelayIsTimeAlignedAndCutsTheDelayedChannelsError) {
+  // Plant: every loadcell reported 2 steps late (sensor-delay=2).
+  const FixRun r = run_fix(plant_logs("sensor-delay"), "sensor-delay");
   ASSERT_TRUE(fixed_as(r, EffectKind::kSensorDelay));
   const Augmentation& a = *r.fix.augmentation;
-  EXPECT_EQ(std::get<TimeAlignment>(a.change).delay, fm::kLatency.delay_steps);
+  EXPECT_EQ(std::get<TimeAlignment>(a.change).delay, fm::kSensorDelay.delay_steps);
   // Same network: dims and layout unchanged, the delay in the sensor model.
   EXPECT_TRUE(r.fix.model.params.dims.x == build_model().params.dims.x);
   EXPECT_TRUE(r.fix.model.layout == build_model().layout);
   ASSERT_EQ(r.fix.model.sensor.delays.size(), a.channels.size());
-  for (const auto& delay : r.fix.model.sensor.delays) EXPECT_EQ(delay.steps, fm::kLatency.delay_steps) << delay.channel;
+  for (const auto& delay : r.fix.model.sensor.delays) EXPECT_EQ(delay.steps, fm::kSensorDelay.delay_steps) << delay.channel;
   // The plant delays every loadcell: the fix aligns all nine (three pass the
   // floors; the rest join as the same delay in the same group).
-  EXPECT_EQ(a.channels.size(), static_cast<std::size_t>(fm::kLatency.aligned_channels));
+  EXPECT_EQ(a.channels.size(), static_cast<std::size_t>(fm::kSensorDelay.aligned_channels));
   for (const auto& ch : a.channels) EXPECT_EQ(ch.rfind("fc", 0), 0u) << ch;
   const std::string& c = a.channels.front();
-  expect_cut(r.fix, c, fm::kLatency.winner_vs_before, fm::kLatency.winner_vs_control);
+  expect_cut(r.fix, c, fm::kSensorDelay.winner_vs_before, fm::kSensorDelay.winner_vs_control);
   std::vector<double> ratios;
   for (const auto& ch : a.channels) {
-    expect_cut(r.fix, ch, fm::kLatency.aligned_vs_before);
+    expect_cut(r.fix, ch, fm::kSensorDelay.aligned_vs_before);
     ratios.push_back(rmse_of(r.fix.after, ch) / rmse_of(r.fix.before, ch));
   }
   std::nth_element(ratios.begin(), ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2), ratios.end());
-  EXPECT_LT(ratios[ratios.size() / 2], fm::kLatency.aligned_median.limit);
+  EXPECT_LT(ratios[ratios.size() / 2], fm::kSensorDelay.aligned_median.limit);
   expect_deployable(r.fix.model);
 }
 

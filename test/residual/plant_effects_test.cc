@@ -53,8 +53,8 @@ TEST(PlantEffects, CleanLogsReportNothingSignificant) {
 }
 
 TEST(PlantEffects, LatencyIsNamedWithItsDelay) {
-  // Plant: every loadcell reported 2 steps late (latency=2, the default).
-  const Outcome o = analyse("latency");
+  // Plant: every loadcell reported 2 steps late (sensor-delay=2, the default).
+  const Outcome o = analyse("sensor-delay");
   ASSERT_TRUE(o.attribution.winner().has_value());
   const auto w = *o.attribution.winner();
   EXPECT_EQ(w.hypothesis.kind, EffectKind::kSensorDelay) << w.label;
@@ -83,7 +83,7 @@ TEST(PlantEffects, CrosstalkIsNamedWithAPlantPairAndGain) {
   ASSERT_TRUE(o.attribution.winner().has_value());
   const auto w = *o.attribution.winner();
   EXPECT_EQ(w.hypothesis.kind, EffectKind::kCrosstalk) << w.label;
-  // host-sim/plant/sensor_model.cc: thumb<-index, index<-middle, middle<-ring, ring<-little, little<-ring.
+  // host-sim/plant/sensor_simulation.cc: thumb<-index, index<-middle, middle<-ring, ring<-little, little<-ring.
   const std::set<std::pair<std::string, std::string>> plant_pairs = {
       {"fc1", "fc0"}, {"fc2", "fc1"}, {"fc3", "fc2"}, {"fc4", "fc3"}, {"fc3", "fc4"}};
   EXPECT_TRUE(plant_pairs.count({name_of(o, w.hypothesis.source), name_of(o, w.hypothesis.target)})) << w.label;

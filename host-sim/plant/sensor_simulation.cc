@@ -1,4 +1,4 @@
-#include "host-sim/plant/sensor_model.h"
+#include "host-sim/plant/sensor_simulation.h"
 
 #include <algorithm>
 #include <cmath>
@@ -20,11 +20,11 @@ double quantise(double value, double lsb) {
 constexpr int kCrosstalkSource[5] = {1, 2, 3, 4, 3};
 }  // namespace
 
-SensorModel::SensorModel(const Effects& effects, bool realism, std::uint64_t seed)
+SensorSimulation::SensorSimulation(const Effects& effects, bool realism, std::uint64_t seed)
     : effects_(effects), realism_(realism), rng_(seed) {}
 
-SensorFrame SensorModel::measure(const SensorFrame& truth) {
-  SensorFrame out = truth;
+Measurement SensorSimulation::measure(const Measurement& truth) {
+  Measurement out = truth;
   auto& fc = out.loadcell_N;
   if (effects_.loadcell_crosstalk > 0)
     for (int i = 0; i < 5; ++i) fc[i] += effects_.loadcell_crosstalk * truth.loadcell_N[kCrosstalkSource[i]];
@@ -49,11 +49,11 @@ SensorFrame SensorModel::measure(const SensorFrame& truth) {
     for (auto& v : out.wrist_rad) v = quantise(v + noise_.wrist_rad * rng_.normal(), noise_.wrist_lsb_rad);
   }
 
-  if (effects_.loadcell_latency_steps > 0) {
+  if (effects_.loadcell_delay_steps > 0) {
     // Reported values are those measured this many steps ago; until the
     // pipeline has filled, the first measurement is repeated.
     loadcell_history_.push_back(fc);
-    while (static_cast<int>(loadcell_history_.size()) > effects_.loadcell_latency_steps + 1)
+    while (static_cast<int>(loadcell_history_.size()) > effects_.loadcell_delay_steps + 1)
       loadcell_history_.pop_front();
     fc = loadcell_history_.front();
   }

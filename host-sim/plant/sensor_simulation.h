@@ -1,5 +1,5 @@
 // What the robot's sensors make of the true signals: the switchable effects
-// (cross-talk, drift, saturation, latency) and sensor realism (noise, rated
+// (cross-talk, drift, saturation, sensor delay) and sensor realism (noise, rated
 // ranges, ADC/encoder quantisation). Deterministic for a seed.
 #pragma once
 
@@ -20,11 +20,11 @@ struct SensorNoise {
   double wrist_lsb_rad = 6.283185307179586 / 16384;  // 14-bit joint module
 };
 
-class SensorModel {
+class SensorSimulation {
  public:
-  SensorModel(const Effects& effects, bool realism, std::uint64_t seed);
+  SensorSimulation(const Effects& effects, bool realism, std::uint64_t seed);
   // Maps one true frame to the measured frame. Call once per 0.2 s step.
-  SensorFrame measure(const SensorFrame& truth);
+  Measurement measure(const Measurement& truth);
 
  private:
   Effects effects_;
