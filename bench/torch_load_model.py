@@ -8,7 +8,7 @@ same rollout as `hadynet simulate` and prints the largest difference.
 
 Usage: /usr/bin/python3 bench/torch_load_model.py MODEL LOG SIMULATED_CSV --pb STATE --from T
   SIMULATED_CSV is the output of
-  `hadynet simulate MODEL --log LOG --pb STATE --from T --steps N --out SIMULATED_CSV`.
+  `hadynet simulate MODEL --log LOG --pb STATE --from T --horizon N --out SIMULATED_CSV`.
 Needs python3-torch and python3-numpy (scripts/setup.sh --bench).
 """
 import argparse

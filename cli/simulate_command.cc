@@ -81,7 +81,7 @@ int run_simulate(int argc, char** argv) {
   opt.value("log", "LOG", "log giving the start state and the commands (and the measurement to compare)");
   opt.value("out", "CSV", "predicted log to write");
   opt.value("from", "T", "start step t (x_t needs t >= 1)", "1");
-  opt.value("steps", "N", "steps to predict (0: to the end of the log)", "0");
+  opt.value("horizon", "N", "steps to predict (0: to the end of the log)", "0");
   opt.value("pb", "PB", "zero, a state of the model, comma-separated values, or adapt (fit to --log)",
             "adapt");
   opt.value("plot", "PNG", "draw measured and predicted channels");
@@ -92,7 +92,7 @@ int run_simulate(int argc, char** argv) {
     return 2;
   }
   const auto from = opt.get_int("from", 1, 1 << 30);
-  const auto steps = opt.get_int("steps", 0, 1 << 30);
+  const auto steps = opt.get_int("horizon", 0, 1 << 30);
   const auto adapt = adapt_options(opt);
   if (!from || !steps || !adapt) return 2;
   try {

@@ -77,7 +77,7 @@ record "$hadynet" detect "$out/hadynet_detect.safetensors" "$data/test" --pb Non
 end_section
 
 section "contact simulation: a test grasp predicted 50 steps ahead with its adapted PB"
-record "$hadynet" simulate "$model" --log "$data/test/Ball_random2_i3_w0.csv" --from 1 --steps 50 \
+record "$hadynet" simulate "$model" --log "$data/test/Ball_random2_i3_w0.csv" --from 1 --horizon 50 \
   --out "$out/simulated_ball.csv" --plot "$out/simulated_ball.png"
 end_section
 echo "summary: $summary"

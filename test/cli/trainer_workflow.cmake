@@ -145,7 +145,7 @@ if(rc EQUAL 0 OR NOT err MATCHES "control horizon 30" OR EXISTS "${WORK}/gen_bad
 endif()
 
 run("${HADYNET}" simulate "${WORK}/md.safetensors" --log "${WORK}/data/train/Cylinder_random1_i0_w0.csv"
-    --pb Cylinder/i0/w0 --from 5 --steps 20 --out "${WORK}/sim.csv" --plot "${WORK}/sim.png")
+    --pb Cylinder/i0/w0 --from 5 --horizon 20 --out "${WORK}/sim.csv" --plot "${WORK}/sim.png")
 must_succeed("simulate")
 run("${HADYNET}" validate "${WORK}/sim.csv")
 must_succeed("validate of the simulated log")
