@@ -230,7 +230,20 @@ void check_namespace(const std::string& ns) {
   }
 }
 
-// Loss class of each y channel, from the option's channel groups.
+// The options with every choice the caller left open taken from the model's
+// robot profile (the stabiliser's commands and loss classes).
+CodegenOptions with_profile(CodegenOptions o, const HadynetModel& model) {
+  ControlOptions& c = o.control;
+  const datalog::RobotProfile& p = model.profile;
+  if (!c.commands) c.commands = p.control_commands;
+  if (!c.force_groups) c.force_groups = p.force_groups;
+  if (!c.angle_groups) c.angle_groups = p.angle_groups;
+  if (!c.length_groups) c.length_groups = p.length_groups;
+  return o;
+}
+
+// Loss class of each y channel, from the option's channel groups (options
+// after with_profile()).
 std::vector<firmware::LossClass> loss_classes(const HadynetModel& model, const ControlOptions& c) {
   const std::vector<std::string>& y = model.layout.y_names;
   std::vector<firmware::LossClass> classes(y.size(), firmware::LossClass::kNone);
@@ -253,9 +266,9 @@ std::vector<firmware::LossClass> loss_classes(const HadynetModel& model, const C
       if (!any) reject(std::string(name) + " loss group '" + g + "' names no y channel of the model");
     }
   };
-  assign(c.force_groups, firmware::LossClass::kForce, "force");
-  assign(c.angle_groups, firmware::LossClass::kAngle, "angle");
-  assign(c.length_groups, firmware::LossClass::kLength, "length");
+  assign(c.force_groups.value(), firmware::LossClass::kForce, "force");
+  assign(c.angle_groups.value(), firmware::LossClass::kAngle, "angle");
+  assign(c.length_groups.value(), firmware::LossClass::kLength, "length");
   return classes;
 }
 
@@ -265,9 +278,10 @@ std::vector<bool> active_commands(const HadynetModel& model, const ControlOption
   // A derived input (sign_u0, hyst_u0: trainer/derived_inputs.h) is computed
   // from a command, so it is never one the stabiliser sets.
   std::vector<bool> active(u.size(), false);
-  if (c.commands.empty())
+  const std::vector<std::string>& commands = c.commands.value();
+  if (commands.empty())
     for (std::size_t i = 0; i < u.size(); ++i) active[i] = !trainer::parse_derived_input(u[i]).has_value();
-  for (const std::string& name : c.commands) {
+  for (const std::string& name : commands) {
     const auto it = std::find(u.begin(), u.end(), name);
     if (it == u.end()) reject("control command '" + name + "' is not a u channel of the model");
     if (trainer::parse_derived_input(name))
@@ -350,7 +364,8 @@ SensorArrays sensor_arrays(const HadynetModel& model, bool q15, int frac_y) {
   return a;
 }
 
-void check_options(const HadynetModel& model, const CodegenOptions& o) {
+void check_options(const HadynetModel& model, const CodegenOptions& given) {
+  const CodegenOptions o = with_profile(given, model);
   check_namespace(namespace_of(o));
   if (!std::isfinite(o.headroom) || o.headroom < 1.0 || o.headroom > 1e6) {
     reject("headroom " + num(o.headroom) + " must be a number >= 1");
@@ -550,8 +565,8 @@ std::vector<std::string> option_words(const CodegenOptions& o) {
   for (std::size_t i = 0; i < o.control.alphas.size(); ++i)
     alphas += (i ? "," : "") + exact_num(o.control.alphas[i]);
   std::string commands;
-  for (std::size_t i = 0; i < o.control.commands.size(); ++i)
-    commands += (i ? "," : "") + o.control.commands[i];
+  const std::vector<std::string>& names = o.control.commands.value();
+  for (std::size_t i = 0; i < names.size(); ++i) commands += (i ? "," : "") + names[i];
   return {"--numeric " + std::string(numeric_name(o.numeric)),
           "--namespace " + namespace_of(o),
           "--headroom " + exact_num(o.headroom),
@@ -563,7 +578,7 @@ std::vector<std::string> option_words(const CodegenOptions& o) {
           "--w2 " + exact_num(o.control.w2),
           "--w3 " + exact_num(o.control.w3),
           std::string("--loss-units ") + (o.control.physical_units ? "physical" : "standardised"),
-          "--control-commands " + (o.control.commands.empty() ? std::string("all") : commands)};
+          "--control-commands " + (names.empty() ? std::string("all") : commands)};
 }
 
 }  // namespace
@@ -695,7 +710,8 @@ Formats choose_formats(const HadynetModel& model, const CodegenOptions& options)
 }
 
 GeneratedHeader generate(const HadynetModel& model, const ModelIdentity& identity,
-                         const CodegenOptions& options) {
+                         const CodegenOptions& given) {
+  const CodegenOptions options = with_profile(given, model);
   const Formats f = choose_formats(model, options);
   const bool q15 = options.numeric == Numeric::kQ15;
   const trainer::HadynetDims& d = model.params.dims;

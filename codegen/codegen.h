@@ -52,11 +52,15 @@ struct ControlOptions {
   // losses matter). Standardised: the class weights as given (<= 7.99).
   bool physical_units = true;
   // u channels the stabiliser may change (names); the others stay at "no
-  // change". Empty: all.
-  std::vector<std::string> commands;
-  std::vector<std::string> force_groups = {"f", "fc"};
-  std::vector<std::string> angle_groups = {"th"};
-  std::vector<std::string> length_groups = {"l"};
+  // change". Empty: all. None: the model's robot profile (its
+  // control_commands; all when it names none).
+  std::optional<std::vector<std::string>> commands;
+  // The groups of each loss class. None: the model's robot profile
+  // (datalog/robot_profile.h: the hand's logs say f, fc / th / l); a model
+  // without a profile has no loss classes unless they are given.
+  std::optional<std::vector<std::string>> force_groups;
+  std::optional<std::vector<std::string>> angle_groups;
+  std::optional<std::vector<std::string>> length_groups;
 };
 
 struct CodegenOptions {

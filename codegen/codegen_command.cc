@@ -1,5 +1,7 @@
 #include "codegen/codegen_command.h"
 
+#include "datalog/robot_profile.h"
+
 #include <charconv>
 #include <cstdio>
 #include <stdexcept>
@@ -72,8 +74,14 @@ int run_codegen_command(const std::string& program, const std::string& command, 
   opt.value("loss-units", "physical|standardised",
             "units of the stabiliser's loss: physical (the paper's raw values; weights x std^2) or "
             "standardised", "physical");
-  opt.value("control-commands", "NAMES|all",
-            "u channels the stabiliser may change, comma-separated (others stay at 'no change')", "all");
+  opt.value("control-commands", "NAMES|all|profile",
+            "u channels the stabiliser may change, comma-separated (others stay at 'no change'); profile:\n"
+            "the model's robot profile (the logs' control_commands; all when they name none)", "profile");
+  opt.value("force-groups", "GROUPS|none|profile", "y groups in the stabiliser's force loss class (profile: the model's)",
+            "profile");
+  opt.value("angle-groups", "GROUPS|none|profile", "y groups in its angle loss class (profile: the model's)", "profile");
+  opt.value("length-groups", "GROUPS|none|profile", "y groups in its length loss class (profile: the model's)",
+            "profile");
   opt.flag("logs", "measure the value ranges on the logs/folders given after MODEL");
   if (!opt.parse(argc, argv)) return 2;
   if (opt.help_requested()) return 0;
@@ -126,20 +134,28 @@ int run_codegen_command(const std::string& program, const std::string& command, 
                  opt.get("loss-units").c_str());
     return 2;
   }
-  if (opt.get("control-commands") != "all") {
-    const std::string list = opt.get("control-commands");
-    std::size_t pos = 0;
-    while (true) {
-      const std::size_t comma = list.find(',', pos);
-      const std::string name = list.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
-      if (name.empty()) {
-        std::fprintf(stderr, "%s: --control-commands: empty name in '%s'\n", who.c_str(), list.c_str());
-        return 2;
-      }
-      options.control.commands.push_back(name);
-      if (comma == std::string::npos) break;
-      pos = comma + 1;
+  // Lists that default to the model's robot profile (datalog/robot_profile.h).
+  const auto profile_list = [&](const char* name, const char* all_word,
+                                std::optional<std::vector<std::string>>& out) {
+    const std::string text = opt.get(name);
+    if (text == "profile") return true;
+    if (text == all_word) {
+      out.emplace();
+      return true;
     }
+    try {
+      out = datalog::split_list(text);
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "%s: --%s: %s\n", who.c_str(), name, e.what());
+      return false;
+    }
+    return true;
+  };
+  if (!profile_list("control-commands", "all", options.control.commands) ||
+      !profile_list("force-groups", "none", options.control.force_groups) ||
+      !profile_list("angle-groups", "none", options.control.angle_groups) ||
+      !profile_list("length-groups", "none", options.control.length_groups)) {
+    return 2;
   }
 
   const std::string model_path = opt.positional().front();

@@ -106,6 +106,12 @@ HadynetModel synthetic_model(bool with_detection) {
   HadynetModel m;
   m.layout = trainer::feature_layout_from_names({"l0", "l1", "f0", "fc0", "fc1", "th0"},
                                                 {"u0", "u1"}, {"l", "th"});
+  // The hand's kinds of channel, as its logs' robot profile names them: the
+  // stabiliser's loss classes come from here.
+  m.profile.delta_groups = m.layout.delta_groups;
+  m.profile.force_groups = {"f", "fc"};
+  m.profile.angle_groups = {"th"};
+  m.profile.length_groups = {"l"};
   trainer::HadynetDims d;
   d.x = static_cast<int>(m.layout.x_names.size());
   d.u = 2;
@@ -362,17 +368,18 @@ TEST(Rejects, BadAlphas) {
 TEST(Rejects, LossGroupsAndWeights) {
   const HadynetModel m = synthetic_model(true);
   CodegenOptions o;
-  o.control.angle_groups = {"wrist"};
+  o.control.angle_groups = std::vector<std::string>{"wrist"};
   expect_unsupported(m, o, "angle loss group 'wrist' names no y channel");
   o = {};
-  o.control.length_groups = {"l", "f"};  // f is a force group too
+  o.control.force_groups = std::vector<std::string>{"f"};
+  o.control.length_groups = std::vector<std::string>{"l", "f"};  // f is a force group too
   expect_unsupported(m, o, "loss group 'f' is in both");
   o = {};
   o.control.physical_units = false;
   o.control.beta = 8.0;  // standardised units: Q12 holds up to 7.99976
   expect_unsupported(m, o, "loss weight beta");
   o = {};
-  o.control.commands = {"u0", "nope"};
+  o.control.commands = std::vector<std::string>{"u0", "nope"};
   expect_unsupported(m, o, "control command 'nope' is not a u channel");
   o = {};
   o.control.w2 = -1.0;
@@ -585,7 +592,7 @@ TEST(Generate, PhysicalLossWeightsFoldTheStdSquaredAndCommandsAreMasked) {
   CodegenOptions o;
   o.numeric = Numeric::kF32;
   o.control.beta = 3.0;
-  o.control.commands = {m.layout.u_names.back()};
+  o.control.commands = std::vector<std::string>{m.layout.u_names.back()};
   const std::string f32 = generate(m, kIdentity, o).text;
   o.numeric = Numeric::kQ15;
   const std::string q15 = generate(m, kIdentity, o).text;
@@ -614,6 +621,33 @@ TEST(Generate, PhysicalLossWeightsFoldTheStdSquaredAndCommandsAreMasked) {
   const std::string mask = f32.substr(f32.find(active), 200);
   EXPECT_TRUE(contains(mask, "false")) << mask;
   EXPECT_TRUE(contains(mask, "true}")) << mask;  // only the last command is active
+}
+
+}  // namespace
+}  // namespace hadynet::codegen
+
+namespace hadynet::codegen {
+namespace {
+
+// The stabiliser's commands and loss classes come from the model's robot
+// profile unless options give them; a model without a profile has no loss
+// classes (codegen then refuses it: nothing to minimise) until they are given.
+TEST(Generate, TheRobotProfileGivesTheDefaultsAndOptionsOverrideIt) {
+  HadynetModel m = synthetic_model(true);
+  m.profile.control_commands = {"u1"};
+  CodegenOptions o;
+  EXPECT_TRUE(contains(generate(m, kIdentity, o).text, "--control-commands u1\n")) << "from the profile";
+  o.control.commands = std::vector<std::string>{};
+  EXPECT_TRUE(contains(generate(m, kIdentity, o).text, "--control-commands all\n")) << "all, given";
+
+  m.profile = {};
+  m.profile.delta_groups = m.layout.delta_groups;
+  expect_unsupported(m, CodegenOptions{}, "every loss weight is zero");
+  o = {};
+  o.control.force_groups = std::vector<std::string>{"fc"};
+  const std::string t = generate(m, kIdentity, o).text;
+  EXPECT_TRUE(contains(t, "hadynet::firmware::LossClass::kForce")) << "given";
+  EXPECT_FALSE(contains(t, "hadynet::firmware::LossClass::kLength")) << "not in the options, no profile";
 }
 
 }  // namespace

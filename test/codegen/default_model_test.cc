@@ -377,9 +377,10 @@ TEST(DefaultModel, TheBuildsHeadersAreWhatTheGeneratorWritesNow) {
       if (build_options.rfind(flag, 0) != 0 || build_options.find(' ', flag.size()) != std::string::npos)
         GTEST_SKIP() << "HADYNET_CODEGEN_OPTIONS '" << build_options << "' is more than --control-commands";
       std::string list = build_options.substr(flag.size());
+      o.control.commands.emplace();
       for (std::size_t pos = 0; pos <= list.size();) {
         const std::size_t comma = std::min(list.find(',', pos), list.size());
-        o.control.commands.push_back(list.substr(pos, comma - pos));
+        o.control.commands->push_back(list.substr(pos, comma - pos));
         pos = comma + 1;
       }
     }
