@@ -315,15 +315,15 @@ SensorArrays sensor_arrays(const HadynetModel& model, bool q15, int frac_y) {
   for (std::size_t i = 0; i < u.size(); ++i) {
     const auto d = trainer::parse_derived_input(u[i]);
     if (!d) {
-      a.derived.push_back("hadynet::firmware::DerivedInput::kNone");
+      a.derived.push_back("hadynet::firmware::DerivedKind::kNone");
       a.derived_base.push_back(std::to_string(i));
       continue;
     }
     const auto it = std::find(u.begin(), u.end(), d->base);
     if (it == u.end()) reject("derived input '" + u[i] + "': no command '" + d->base + "' in the model");
     if (trainer::parse_derived_input(d->base)) reject("derived input '" + u[i] + "' is derived from a derived input");
-    a.derived.push_back(d->kind == trainer::DerivedKind::kSign ? "hadynet::firmware::DerivedInput::kSign"
-                                                               : "hadynet::firmware::DerivedInput::kHysteresis");
+    a.derived.push_back(d->kind == trainer::DerivedKind::kSign ? "hadynet::firmware::DerivedKind::kSign"
+                                                               : "hadynet::firmware::DerivedKind::kHysteresis");
     a.derived_base.push_back(std::to_string(it - u.begin()));
   }
   const trainer::SensorModel& s = model.sensor;
@@ -1034,7 +1034,7 @@ GeneratedHeader generate(const HadynetModel& model, const ModelIdentity& identit
   e.array1("bool", "kControlActive[kU]", items);
   e.line();
   e.line("  // ---- derived inputs: computed by the firmware from their base command");
-  e.array1("hadynet::firmware::DerivedInput", "kUDerived[kU]", sensor.derived);
+  e.array1("hadynet::firmware::DerivedKind", "kUDerived[kU]", sensor.derived);
   e.array1("int", "kUDerivedBase[kU]", sensor.derived_base);
   e.line();
   e.line("  // ---- sensor model: measured y_c = clip(y'_c + sum gain y'_source + rate D_c)");

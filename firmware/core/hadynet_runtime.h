@@ -134,7 +134,7 @@ class HadynetRuntime {
           // Derived inputs keep their value of the newest frame over the horizon.
           B::u_to_model(u_frame, u);
           for (int i = 0; i < M::kU; ++i)
-            if (M::kUDerived[i] != DerivedInput::kNone) stabilizer_.hold_input(i, u[i]);
+            if (M::kUDerived[i] != DerivedKind::kNone) stabilizer_.hold_input(i, u[i]);
         }
         stabilizer_.plan(net_, x, y_now, pb_, u);
         B::u_to_physical(u, out.command);

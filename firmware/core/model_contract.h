@@ -69,9 +69,10 @@ enum class LossClass : std::uint8_t {
   kLength = 3,  // l: weight w3
 };
 
-// A command channel computed from another command (trainer/derived_inputs.h):
-// the firmware computes it, the stabiliser never sets it.
-enum class DerivedInput : std::uint8_t {
+// The kind of a command channel: a command the host sets (kNone), or one
+// computed from another command (trainer::DerivedKind, trainer/derived_inputs.h)
+// that the firmware computes and the stabiliser never sets.
+enum class DerivedKind : std::uint8_t {
   kNone = 0,        // a command
   kSign = 1,        // sign(u_base): -1, 0, +1
   kHysteresis = 2,  // sign of the last non-zero u_base (0 before the first)
@@ -162,8 +163,8 @@ concept GeneratedModel = requires {
   M::kLossWeightDown;     // Value[kY] weight where est <  ref, Q(kFracLossW)
   M::kControlActive;      // bool[kU]  commands the stabiliser may change (others: "no change")
 
-  // ---- derived inputs (DerivedInput; a model fixed for friction has some)
-  M::kUDerived;           // DerivedInput[kU]
+  // ---- derived inputs (DerivedKind, as trainer::DerivedKind; a model fixed for friction has some)
+  M::kUDerived;           // DerivedKind[kU]
   M::kUDerivedBase;       // int[kU]  the command it is computed from (itself for kNone)
 
   // ---- sensor model (trainer/sensor_model.h; counts 0 for a model trained on

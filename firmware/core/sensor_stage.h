@@ -41,9 +41,9 @@ class SensorStage {
       const float base = u_prev[M::kUDerivedBase[i]];
       const float sign = base > 0.0f ? 1.0f : (base < 0.0f ? -1.0f : 0.0f);
       switch (M::kUDerived[i]) {
-        case DerivedInput::kNone: u_model[i] = u_prev[i]; break;
-        case DerivedInput::kSign: u_model[i] = sign; break;
-        case DerivedInput::kHysteresis:
+        case DerivedKind::kNone: u_model[i] = u_prev[i]; break;
+        case DerivedKind::kSign: u_model[i] = sign; break;
+        case DerivedKind::kHysteresis:
           if (sign != 0.0f) hysteresis_[i] = sign;
           u_model[i] = hysteresis_[i];
           break;
@@ -86,7 +86,7 @@ class SensorStage {
 
   static constexpr bool has_derived_inputs() noexcept {
     for (int i = 0; i < kU; ++i)
-      if (M::kUDerived[i] != DerivedInput::kNone) return true;
+      if (M::kUDerived[i] != DerivedKind::kNone) return true;
     return false;
   }
 

@@ -26,7 +26,7 @@ ClosedLoopRun run_with(const ClosedLoopOptions& opt) {
   // The model's channels in the plant's order; a derived input is computed
   // by the firmware from its base command, not sent to the plant (kNoCommand).
   constexpr std::size_t kNoCommand = static_cast<std::size_t>(-1);
-  const auto derived = [](int i) { return M::kUDerived[i] != firmware::DerivedInput::kNone; };
+  const auto derived = [](int i) { return M::kUDerived[i] != firmware::DerivedKind::kNone; };
   std::vector<std::size_t> y_index, u_index;
   for (int i = 0; i < M::kY; ++i) y_index.push_back(index_of(session.y_names(), M::kYNames[i], "channel"));
   for (int i = 0; i < M::kU; ++i)

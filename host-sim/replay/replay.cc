@@ -116,7 +116,7 @@ ReplayResult replay_on(Device& device, const datalog::LogTable& log, const std::
   const CompiledModelInfo info = info_of<M>();
   const auto y_cols = map_columns(log, file, info.y_names);
   std::vector<bool> derived;
-  for (int i = 0; i < M::kU; ++i) derived.push_back(M::kUDerived[i] != firmware::DerivedInput::kNone);
+  for (int i = 0; i < M::kU; ++i) derived.push_back(M::kUDerived[i] != firmware::DerivedKind::kNone);
   const auto u_cols = map_columns(log, file, info.u_names, derived);
   const auto t_col = log.column_index("t");
   std::vector<std::size_t> signal_cols = y_cols;

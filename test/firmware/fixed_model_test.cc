@@ -34,8 +34,8 @@ TEST(FixedModelHeader, CarriesTheDerivedInputsAndTheSensorModel) {
   const auto& m = fixed_model();
   ASSERT_EQ(F::kU, m.params.dims.u);
   EXPECT_EQ(F::kU, test::build_model().params.dims.u + 2);
-  EXPECT_EQ(F::kUDerived[F::kU - 2], firmware::DerivedInput::kSign);
-  EXPECT_EQ(F::kUDerived[F::kU - 1], firmware::DerivedInput::kHysteresis);
+  EXPECT_EQ(F::kUDerived[F::kU - 2], firmware::DerivedKind::kSign);
+  EXPECT_EQ(F::kUDerived[F::kU - 1], firmware::DerivedKind::kHysteresis);
   EXPECT_EQ(F::kUDerivedBase[F::kU - 1], 0);
   EXPECT_FALSE(F::kControlActive[F::kU - 1]);  // never set by the stabiliser
   EXPECT_EQ(F::kCrosstalkCount, 1);
@@ -130,7 +130,7 @@ TEST(FixedModelRuntime, ResetRestartsTheDriftAndHysteresisStates) {
       firmware::SensorFrame<Q> f{};
       for (int i = 0; i < Q::kY; ++i) f.y[i] = static_cast<float>(table.at(t, *table.column_index(Q::kYNames[i])));
       for (int i = 0; i < Q::kU; ++i)
-        if (Q::kUDerived[i] == firmware::DerivedInput::kNone && t > 0)
+        if (Q::kUDerived[i] == firmware::DerivedKind::kNone && t > 0)
           f.u_prev[i] = static_cast<float>(table.at(t - 1, *table.column_index(Q::kUNames[i])));
       const auto r = rt->step(f);
       (pass == 0 ? first : second).insert((pass == 0 ? first : second).end(), r.prediction, r.prediction + Q::kY);
