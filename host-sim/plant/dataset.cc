@@ -13,6 +13,7 @@
 
 #include "datalog/atomic_file.h"
 #include "datalog/log_writer.h"
+#include "host-sim/plant/hand_geometry.h"
 
 namespace hadynet::plant {
 
@@ -99,7 +100,7 @@ DatasetSummary collect_dataset(const std::vector<ExperimentSpec>& specs, const C
   manifest["format_version"] = 1;
   manifest["preset"] = options.preset;
   manifest["seed"] = options.seed;
-  manifest["dt_s"] = 0.2;
+  manifest["dt_s"] = geometry::kControlStep_s;
   manifest["plant"] = std::string("MuJoCo ") + mj_versionString() + ", host-sim/plant";
   auto& logs = manifest["logs"] = nlohmann::ordered_json::array();
   for (std::size_t i = 0; i < specs.size(); ++i) {

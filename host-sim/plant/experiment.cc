@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "datalog/log_rules.h"
 #include "host-sim/plant/hand_geometry.h"
 #include "host-sim/plant/rng.h"
 
@@ -89,7 +90,7 @@ ExperimentResult run_experiment(const ExperimentSpec& spec) {
   auto& meta = log.metadata;
   meta.set("format", "hadynet-log");
   meta.set("format_version", std::to_string(datalog::kFormatVersion));
-  meta.set("dt_s", "0.2");
+  meta.set("dt_s", datalog::rules::format_number(g::kControlStep_s));
   meta.set("state", state_id(spec));
   meta.set("object", std::string(object_name(spec.object)));
   meta.set("motion", std::string(motion_name(spec.motion)));
