@@ -11,11 +11,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 
 namespace hadynet::board {
-
-// Number of loadcell channels a board can scan (the hand's tendon loadcells).
-inline constexpr int kLoadcells = 9;
 
 // The control period: period_elapsed() turns true every 1 / kPeriodHz s.
 inline constexpr std::uint32_t kPeriodHz = 5;
@@ -54,12 +52,16 @@ bool uart_read_byte(std::uint8_t& byte) noexcept;
 // Sends `size` bytes; returns when the last one is in the transmitter.
 void uart_write(const std::uint8_t* data, std::size_t size) noexcept;
 
-// The nine loadcell readings, in newtons; reading k is the model's channel
-// "fc<k>" (firmware/app/channel_layout.h). The scaling from the sensor to
-// newtons is the board's data (boards/<board>/). False (and `newtons`
-// unchanged) if the board has no loadcells or no complete scan has arrived
-// yet. mps2-an386 has no ADC and returns synthetic readings.
-bool read_loadcells(float (&newtons)[kLoadcells]) noexcept;
+// The board's loadcell readings, in newtons; reading k is the model's
+// channel "<board group><k>" (the model's robot profile; for the hand fc<k>:
+// firmware/app/channel_layout.h). The board scans config::kLoadcells of them
+// (board_config.h, from BOARD_LOADCELLS in its board.cmake; an image checks
+// that the model has as many at compile time), and the scaling from the
+// sensor to newtons is the board's data (boards/<board>/). False (and
+// `newtons` unchanged) if `newtons` does not hold exactly config::kLoadcells
+// readings or no complete scan has arrived yet. mps2-an386 has no ADC and
+// returns synthetic readings.
+bool read_loadcells(std::span<float> newtons) noexcept;
 
 // Bytes of stack the firmware has used so far (high-water mark of a pattern
 // painted at reset), and the stack's size.

@@ -149,6 +149,7 @@ int run_train(int argc, char** argv) {
     for (std::size_t i = 1; i < paths.size(); ++i) {  // one table in memory at a time
       const datalog::LogTable table = datalog::read_log(paths[i]);
       trainer::check_profile_metadata(delta_choice, first, paths.front(), table, paths[i]);
+      trainer::check_same_period(first, paths.front(), table, paths[i]);
       sequences.push_back(trainer::log_sequence(table, paths[i], layout));
     }
 
@@ -165,6 +166,7 @@ int run_train(int argc, char** argv) {
         trainer::new_model(layout, norm, states, static_cast<int>(*pb), static_cast<int>(*hidden),
                            static_cast<int>(*steps), options.seed);
     model.profile = profile;
+    model.period_s = datalog::log_dt_s(first, paths.front());
     model.provenance = trainer::training_provenance(paths, HADYNET_GIT_COMMIT, HADYNET_VERSION);
     model.hyper_parameters = trainer::training_hyper_parameters(
         options, {static_cast<int>(*steps), opt.get("lr"), opt.get("held-out"), split.train.size(), split.held_out.size()});

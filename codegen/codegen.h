@@ -3,72 +3,30 @@
 // constants and arrays that satisfies hadynet::firmware::GeneratedModel
 // (firmware/core/model_contract.h, the specification of every member).
 //
+// generate() runs three steps: prepare (prepared_model.h: check the model and
+// the options, fold the batch norm, whiten the detection statistics, weigh
+// the loss, once), quantise (formats.h chooses the formats, tensor_writer.h
+// rounds every tensor into them) and emit (header_text.h). load_model_file
+// and write_header (model_io.cc) are its only I/O.
+//
 // Everything here is pure: the same model, hash and options give the same
 // text, byte for byte. An unsupported or malformed model is rejected with
 // UnsupportedModel before any text exists, so a caller that writes only
 // after generate() returned never leaves a partial or stale file.
 #pragma once
 
-#include <Eigen/Core>
 #include <cstdint>
-#include <optional>
-#include <stdexcept>
 #include <string>
-#include <string_view>
-#include <vector>
 
+#include "codegen/codegen_options.h"
+#include "codegen/formats.h"
+#include "codegen/unsupported_model.h"
 #include "firmware/core/model_contract.h"
 #include "trainer/hadynet_model.h"
 
 namespace hadynet::codegen {
 
-using Numeric = hadynet::firmware::Numeric;
-
 using hadynet::firmware::numeric_name;  // "q15" or "f32"
-
-// The model (or the options) cannot be generated; what() names the problem.
-class UnsupportedModel : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-// Grasp stabiliser constants written into the header (seed paper III-F,
-// DESIGN.md §4).
-struct ControlOptions {
-  int horizon = 8;                                     // N_control, 1 .. N_train
-  int epochs = 3;                                      // N_epoch >= 1
-  std::vector<double> alphas = {1.0, 0.5, 0.25, 0.125};  // step sizes (standardised units), > 0
-  std::optional<int> truncation;                       // K >= 1; none: = horizon (full BPTT)
-  double beta = 3.0;                                   // force weight where est < ref
-  double w2 = 1.0;                                     // angle weight
-  double w3 = 1.0;                                     // length weight
-  // Loss classes of y channels, by channel group (trainer::channel_group:
-  // "fc3" -> "fc"). Each group must name at least one y channel; a group in
-  // two classes is an error. Other channels are not in the loss.
-  // Units the loss is computed in. Physical (default, the seed paper's raw
-  // sensor values): channel i's weight is multiplied by std_i^2, so that the
-  // standardised error gives the physical one; the weights are then scaled
-  // so that the largest is 1 (only the direction of dL/du and the order of
-  // losses matter). Standardised: the class weights as given (<= 7.99).
-  bool physical_units = true;
-  // u channels the stabiliser may change (names); the others stay at "no
-  // change". Empty: all. None: the model's robot profile (its
-  // control_commands; all when it names none).
-  std::optional<std::vector<std::string>> commands;
-  // The groups of each loss class. None: the model's robot profile
-  // (datalog/robot_profile.h: the hand's logs say f, fc / th / l); a model
-  // without a profile has no loss classes unless they are given.
-  std::optional<std::vector<std::string>> force_groups;
-  std::optional<std::vector<std::string>> angle_groups;
-  std::optional<std::vector<std::string>> length_groups;
-};
-
-struct CodegenOptions {
-  Numeric numeric = Numeric::kQ15;
-  std::string ns;         // C++ namespace; empty: "hadynet::model_q15" / "hadynet::model_f32"
-  double headroom = 1.5;  // measured activation ranges are multiplied by it (>= 1)
-  ControlOptions control;
-};
 
 // The namespace the header uses (options.ns or the default).
 std::string namespace_of(const CodegenOptions& options);
@@ -76,42 +34,9 @@ std::string namespace_of(const CodegenOptions& options);
 // The file the header is written to: "hadynet_model_q15.h" / "hadynet_model_f32.h".
 std::string header_file_name(Numeric numeric);
 
-// The format rule (docs/codegen.md): for a largest magnitude m >= 0,
-//   F = 15 - ceil(log2 m), clamped to [0, 15], then lowered while
-//   round(m 2^F) > 32767 (rounding half away from zero, as real_to_fixed),
-// so that m and -m fit an int16 Q(F); m == 0 gives 15. Throws
-// UnsupportedModel naming `what` when m is negative or not finite, or does
-// not fit even Q0 (round(m) > 32767).
-int frac_bits_for(double max_abs, const std::string& what = "value");
-
-// real * 2^frac rounded half away from zero: firmware/core/fixed_point.h's
-// real_to_fixed<int64_t, frac> (0 <= frac <= 62).
-std::int64_t to_fixed(double real, int frac);
-
-// One chosen format and where it came from.
-struct FormatChoice {
-  int frac = 0;      // frac bits of Q(frac)
-  double m = 0;      // largest magnitude the format must hold (0 for fixed formats)
-  std::string from;  // e.g. "1.5 x |h| 3.21" or "fixed: activation input Q3.12"
-};
-
-// Every kFrac* of the contract (q15; an f32 header writes 0 for all).
-struct Formats {
-  FormatChoice in, h, c, y, gate, enc_w, lstm_w, lstm_acc, dec_w, whiten, z, loss_w;
-};
-
-// Checks the model and options (throws UnsupportedModel) and chooses the
-// formats from model.ranges, the weights, the PB table, the detection
-// statistics and the control constants.
+// The formats generate() would choose for `model` (checks the model and the
+// options first; throws UnsupportedModel).
 Formats choose_formats(const trainer::HadynetModel& model, const CodegenOptions& options);
-
-// Detection whitening: for the regularised inverse covariance S (symmetric
-// positive definite), S = V diag(lambda) V^T and W = diag(sqrt(lambda)) V^T,
-// so W^T W = S and d^2 = |W (e - mu)|^2. Eigenvalues ascending; each
-// eigenvector's largest-magnitude entry is made positive (deterministic
-// signs). Throws UnsupportedModel if S is not square, not symmetric (relative
-// 1e-9) or not positive definite.
-Eigen::MatrixXd whitening_matrix(const Eigen::MatrixXd& inverse);
 
 // Where the model came from, stamped into the header.
 struct ModelIdentity {

@@ -82,6 +82,9 @@ int run_codegen_command(const std::string& program, const std::string& command, 
   opt.value("angle-groups", "GROUPS|none|profile", "y groups in its angle loss class (profile: the model's)", "profile");
   opt.value("length-groups", "GROUPS|none|profile", "y groups in its length loss class (profile: the model's)",
             "profile");
+  opt.value("period-s", "S",
+            "the control period (s) for a model file that does not record it (trained before model files\n"
+            "stored the logs' dt_s); a model that records its period must not be given another");
   opt.flag("logs", "measure the value ranges on the logs/folders given after MODEL");
   if (!opt.parse(argc, argv)) return 2;
   if (opt.help_requested()) return 0;
@@ -117,18 +120,23 @@ int run_codegen_command(const std::string& program, const std::string& command, 
   const auto w2 = opt.get_double("w2", 0.0, 1e6);
   const auto w3 = opt.get_double("w3", 0.0, 1e6);
   if (!headroom || !horizon || !epochs || !alphas || !beta || !w2 || !w3) return 2;
+  if (opt.has("period-s")) {
+    const auto period = opt.get_double("period-s", 1e-6, 4294.0);
+    if (!period) return 2;
+    options.period_s = *period;
+  }
   options.headroom = *headroom;
   options.control.horizon = static_cast<int>(*horizon);
   options.control.epochs = static_cast<int>(*epochs);
   options.control.alphas = *alphas;
   if (truncation) options.control.truncation = static_cast<int>(*truncation);
-  options.control.beta = *beta;
-  options.control.w2 = *w2;
-  options.control.w3 = *w3;
+  options.control.loss.beta = *beta;
+  options.control.loss.w2 = *w2;
+  options.control.loss.w3 = *w3;
   if (opt.get("loss-units") == "physical") {
-    options.control.physical_units = true;
+    options.control.loss.physical_units = true;
   } else if (opt.get("loss-units") == "standardised") {
-    options.control.physical_units = false;
+    options.control.loss.physical_units = false;
   } else {
     std::fprintf(stderr, "%s: --loss-units must be physical or standardised, got '%s'\n", who.c_str(),
                  opt.get("loss-units").c_str());

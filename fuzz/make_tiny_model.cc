@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
     tiny.detection = base.detection;
     tiny.sensor = base.sensor;
     tiny.profile = base.profile;
+    tiny.period_s = base.period_s;
     tiny.hyper_parameters = base.hyper_parameters;
     tiny.provenance = {{"source", "fuzz/make_tiny_model.cc: " + std::string(argv[1]) + " with 4 LSTM units, untrained"}};
 

@@ -82,6 +82,10 @@ struct HadynetModel {
   HadynetParams<float> params;
   std::vector<PbState> states;  // params.pb row k belongs to states[k]
   int train_steps = 10;         // N_train of the windows it was trained on
+  // The control period of the logs it was trained on (their dt_s), s: one
+  // step of the network. 0: not recorded (a model file written before the
+  // format stored it); codegen then needs the period as an option.
+  double period_s = 0;
   long bn_batches_tracked = 0;  // enc_bn.num_batches_tracked (PyTorch buffer)
   std::optional<DetectionCalibration> detection;
   std::optional<ValueRanges> ranges;  // measured value ranges (needed by codegen)

@@ -1,6 +1,7 @@
 #include "trainer/log_dataset.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -9,6 +10,7 @@
 
 #include "datalog/log_limits.h"
 #include "datalog/log_reader.h"
+#include "datalog/log_rules.h"
 #include "trainer/derived_inputs.h"
 
 namespace hadynet::trainer {
@@ -221,6 +223,16 @@ void check_profile_metadata(const std::string& choice, const datalog::LogTable& 
                              (std::string_view(key) == datalog::kDeltaGroupsKey ? "; give --delta-groups"
                                                                                  : "; the logs come from different robots"));
   }
+}
+
+void check_same_period(const datalog::LogTable& first, const std::string& first_file,
+                       const datalog::LogTable& table, const std::string& file) {
+  const double expected = datalog::log_dt_s(first, first_file);
+  const double here = datalog::log_dt_s(table, file);
+  if (std::abs(here - expected) <= 1e-9 * expected) return;
+  throw std::runtime_error(file + ": metadata 'dt_s' is " + datalog::rules::format_number(here) + " s but " +
+                           datalog::rules::format_number(expected) + " s in " + first_file +
+                           "; a model learns one control period: train on logs of one dt_s");
 }
 
 }  // namespace hadynet::trainer

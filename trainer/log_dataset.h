@@ -97,4 +97,10 @@ void check_profile_metadata(const std::string& choice, const datalog::LogTable& 
                             const std::string& first_file, const datalog::LogTable& table,
                             const std::string& file);
 
+// Every log of a training set must have the first log's control period
+// (metadata dt_s, to within 1e-9 relative: the network learns one step of
+// one length): throws std::runtime_error naming both files and periods.
+void check_same_period(const datalog::LogTable& first, const std::string& first_file,
+                       const datalog::LogTable& table, const std::string& file);
+
 }  // namespace hadynet::trainer

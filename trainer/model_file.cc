@@ -226,6 +226,7 @@ void HadynetModel::check_consistent() const {
            (norm.y.std.array() > 0).all(),
        "a normalisation std is not positive");
   need(train_steps >= 1, "train_steps < 1");
+  need(period_s >= 0 && std::isfinite(period_s), "period_s negative or not finite");
   if (detection) {
     const DetectionCalibration& c = *detection;
     need(c.steps >= 1, "detection steps < 1");
@@ -305,6 +306,7 @@ st::File model_to_safetensors(const HadynetModel& model) {
   }
   if (!model.sensor.empty()) file.metadata["sensor"] = sensor_json(model.sensor).dump();
   if (!model.profile.empty()) file.metadata["profile"] = profile_json(model.profile).dump();
+  if (model.period_s > 0) file.metadata["period_s"] = json(model.period_s).dump();
   return file;
 }
 
@@ -357,6 +359,13 @@ HadynetModel model_from_safetensors(const st::File& file, const std::string& ori
     model.profile.delta_groups = model.layout.delta_groups;
     if (file.metadata.count("profile") != 0) {
       model.profile = profile_from_json(parse_metadata_json(file, "profile", origin), model.layout.delta_groups, origin);
+    }
+
+    if (file.metadata.count("period_s") != 0) {
+      // One network step, s (the training logs' dt_s); a JSON number.
+      const json period = json{{"period_s", parse_metadata_json(file, "period_s", origin)}};
+      model.period_s = json_number(period, "period_s", "metadata", origin, 1e-9, 1e6);
+      if (!(model.period_s > 0)) fail(origin, "metadata 'period_s' must be a positive number of seconds");
     }
 
     const json states = parse_metadata_json(file, "states", origin);

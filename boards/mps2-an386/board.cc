@@ -71,9 +71,12 @@ void uart_write(const std::uint8_t* data, std::size_t size) noexcept {
 }
 
 // Scan n = the n-th call (synthetic_loadcells.h); always available.
-bool read_loadcells(float (&newtons)[kLoadcells]) noexcept {
-  mps2::synthetic_loadcells(g_loadcell_scans, newtons);
+bool read_loadcells(std::span<float> newtons) noexcept {
+  if (newtons.size() != static_cast<std::size_t>(config::kLoadcells)) return false;
+  float scan[config::kLoadcells];
+  mps2::synthetic_loadcells(g_loadcell_scans, scan);
   ++g_loadcell_scans;
+  for (int k = 0; k < config::kLoadcells; ++k) newtons[static_cast<std::size_t>(k)] = scan[k];
   return true;
 }
 

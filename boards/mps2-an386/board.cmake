@@ -18,5 +18,8 @@ set(BOARD_MEMORY
 set(BOARD_REGION_TEXT FLASH)
 set(BOARD_REGION_DATA RAM)
 set(BOARD_REGION_STACK RAM)
+# Loadcell channels the board scans (board::read_loadcells; the hand's
+# tendon loadcells fc0..fc8, board_config.h kLoadcells).
+set(BOARD_LOADCELLS 9)
 set(BOARD_STACK_BYTES 65536)
 set(BOARD_SOURCES board.cc)

@@ -7,7 +7,7 @@
 //   scan n (the n-th call of board::read_loadcells since reset, from 0),
 //   loadcell k:  millivolts = kZeroMillivolts + kStepMillivolts * ((7 n + 13 k) mod 41)
 //                volts      = millivolts * 0.001f                   (one IEEE multiply)
-//                newtons    = (volts - kLoadcellZeroVolts[k]) * kLoadcellNewtonsPerVolt[k]
+//                newtons    = (volts - kLoadcellZeroVolts) * kLoadcellNewtonsPerVolt
 //
 // so each loadcell walks through 0 .. 4.8 N in 41 steps, every channel at its
 // own phase. Every operation is one IEEE binary32 operation, written out
@@ -19,18 +19,17 @@
 
 #include <cstdint>
 
-#include "boards/board.h"
+#include <cstddef>
 
 namespace hadynet::board::mps2 {
 
 inline constexpr std::int32_t kZeroMillivolts = 1650;  // no load
 inline constexpr std::int32_t kStepMillivolts = 12;
 
-// Calibration of the (synthetic) amplifier: zero-load voltage and gain.
-inline constexpr float kLoadcellZeroVolts[kLoadcells] = {1.65f, 1.65f, 1.65f, 1.65f, 1.65f,
-                                                          1.65f, 1.65f, 1.65f, 1.65f};
-inline constexpr float kLoadcellNewtonsPerVolt[kLoadcells] = {10.0f, 10.0f, 10.0f, 10.0f, 10.0f,
-                                                               10.0f, 10.0f, 10.0f, 10.0f};
+// Calibration of the (synthetic) amplifiers, the same for every loadcell:
+// zero-load voltage and gain.
+inline constexpr float kLoadcellZeroVolts = 1.65f;
+inline constexpr float kLoadcellNewtonsPerVolt = 10.0f;
 
 // The voltage of loadcell k in scan n.
 constexpr float synthetic_loadcell_volts(std::uint32_t scan, int k) noexcept {
@@ -39,11 +38,13 @@ constexpr float synthetic_loadcell_volts(std::uint32_t scan, int k) noexcept {
   return static_cast<float>(millivolts) * 0.001f;
 }
 
-// Scan n in newtons, as board::read_loadcells reports it.
-constexpr void synthetic_loadcells(std::uint32_t scan, float (&newtons)[kLoadcells]) noexcept {
-  for (int k = 0; k < kLoadcells; ++k) {
-    const float volts = synthetic_loadcell_volts(scan, k);
-    newtons[k] = (volts - kLoadcellZeroVolts[k]) * kLoadcellNewtonsPerVolt[k];
+// Scan n of N loadcells in newtons, as board::read_loadcells reports it
+// (the board scans board_config.h's kLoadcells).
+template <std::size_t N>
+constexpr void synthetic_loadcells(std::uint32_t scan, float (&newtons)[N]) noexcept {
+  for (std::size_t k = 0; k < N; ++k) {
+    const float volts = synthetic_loadcell_volts(scan, static_cast<int>(k));
+    newtons[k] = (volts - kLoadcellZeroVolts) * kLoadcellNewtonsPerVolt;
   }
 }
 

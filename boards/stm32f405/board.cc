@@ -75,12 +75,13 @@ void uart_write(const std::uint8_t* data, std::size_t size) noexcept {
   }
 }
 
-bool read_loadcells(float (&newtons)[kLoadcells]) noexcept {
-  std::uint16_t counts[kLoadcells];
+bool read_loadcells(std::span<float> newtons) noexcept {
+  if (newtons.size() != static_cast<std::size_t>(config::kLoadcells)) return false;
+  std::uint16_t counts[config::kLoadcells];
   if (!stm32::loadcell_counts(counts)) return false;
-  for (int i = 0; i < kLoadcells; ++i) {
+  for (int i = 0; i < config::kLoadcells; ++i) {
     const float volts = static_cast<float>(counts[i]) * stm32::kAdcVoltsPerCount;
-    newtons[i] = (volts - stm32::kLoadcellZeroVolts[i]) * stm32::kLoadcellNewtonsPerVolt[i];
+    newtons[static_cast<std::size_t>(i)] = (volts - stm32::kLoadcellZeroVolts[i]) * stm32::kLoadcellNewtonsPerVolt[i];
   }
   return true;
 }

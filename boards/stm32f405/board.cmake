@@ -26,6 +26,9 @@ set(BOARD_MEMORY
 set(BOARD_REGION_TEXT FLASH)
 set(BOARD_REGION_DATA SRAM)
 set(BOARD_REGION_STACK SRAM)
+# Loadcell channels the board scans (board::read_loadcells; the hand's
+# tendon loadcells fc0..fc8, board_config.h kLoadcells).
+set(BOARD_LOADCELLS 9)
 set(BOARD_STACK_BYTES 32768)
 set(BOARD_SOURCES board.cc clock_tree.cc loadcells.cc
   # The USB device port (boards/board_usb.h): OTG FS driver, embedded flash

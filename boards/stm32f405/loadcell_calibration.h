@@ -11,9 +11,11 @@
 #ifndef HADYNET_BOARDS_STM32F405_LOADCELL_CALIBRATION_H_
 #define HADYNET_BOARDS_STM32F405_LOADCELL_CALIBRATION_H_
 
-#include "boards/board.h"
+#include "board_config.h"
 
 namespace hadynet::board::stm32 {
+
+using config::kLoadcells;
 
 inline constexpr float kAdcVoltsPerCount = 3.3f / 4096.0f;
 

@@ -9,9 +9,11 @@
 
 #include <cstdint>
 
-#include "boards/board.h"
+#include "board_config.h"
 
 namespace hadynet::board::stm32 {
+
+using config::kLoadcells;
 
 // ADC1 input of loadcell i (the scan order).
 inline constexpr std::uint8_t kLoadcellChannel[kLoadcells] = {0, 1, 2, 3, 4, 5, 6, 7, 8};

@@ -62,6 +62,7 @@
 
 #include "boards/board.h"
 #include "firmware/app/channel_layout.h"
+#include "firmware/app/image_checks.h"
 #include "firmware/app/period_loop.h"
 #include "firmware/app/synthetic_frames.h"
 #include "firmware/app/text.h"
@@ -96,7 +97,7 @@ using Loop = app::PeriodLoop<Model>;
 using usb::host::FakeController;
 using usb::host::Handshake;
 
-static_assert(Loop::kLoadcellSlots == board::kLoadcells, "board reading k is the model's loadcell k");
+static_assert(app::model_fits_board<Model>());  // board reading k is the model's loadcell k
 
 constexpr int kPeriods = 50;                     // timed periods per mode
 constexpr int kWarmup = Model::kDetectSteps + 2;  // untimed detect periods first (bench.h)

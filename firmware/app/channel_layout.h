@@ -2,15 +2,17 @@
 // which ones the host sends: THE one place that maps the generated model's
 // channels onto the firmware's 5 Hz loop (period_loop.h).
 //
-// The rule, from the model's own channel names (M::kYNames, written by
-// codegen from the log header; docs/log-format.md):
-//   * y channel "fc<k>" (group kLoadcellGroup) is loadcell k: the board
-//     scans it (board::read_loadcells reading k);
+// The rule, from the model's own channel names and robot profile
+// (M::kYNames and M::kBoardGroup, written by codegen from the logs' header;
+// docs/log-format.md):
+//   * y channel "<kBoardGroup><k>" is the board's loadcell k (the hand:
+//     "fc3" is reading 3 of board::read_loadcells);
 //   * every other y channel is part of the muscle state the host sends over
 //     the link (for the hand: l0..l7, f0..f7, th0, th1), in y order;
 //   * the muscle state also carries u_{t-1}, all M::kU commands.
-// Nothing here knows the hand's sizes: they follow from the names at compile
-// time, and a model whose "fc" indices are not exactly 0..n-1 fails the build.
+// Nothing here knows the hand: the sizes follow from the names at compile
+// time, and a model whose board channels are not exactly <group>0 ..
+// <group>n-1 fails the build.
 #ifndef HADYNET_FIRMWARE_APP_CHANNEL_LAYOUT_H_
 #define HADYNET_FIRMWARE_APP_CHANNEL_LAYOUT_H_
 
@@ -21,15 +23,14 @@
 
 namespace hadynet::app {
 
-// Log group of the loadcells (DESIGN.md §2: f_contact, logged as fc0..fc8).
-inline constexpr char kLoadcellGroup[] = "fc";
-
-// k if `name` is kLoadcellGroup followed by decimal digits only ("fc3" -> 3),
-// else -1.
-constexpr int loadcell_index_of(const char* name) noexcept {
+// k if `name` is `group` followed by decimal digits only ("fc3" in group
+// "fc" -> 3), else -1; always -1 for an empty group (a model whose board
+// measures nothing).
+constexpr int loadcell_index_of(const char* group, const char* name) noexcept {
+  if (group[0] == '\0') return -1;
   int i = 0;
-  for (; kLoadcellGroup[i] != '\0'; ++i) {
-    if (name[i] != kLoadcellGroup[i]) return -1;
+  for (; group[i] != '\0'; ++i) {
+    if (name[i] != group[i]) return -1;
   }
   if (name[i] == '\0') return -1;
   int k = 0;
@@ -44,13 +45,13 @@ constexpr int loadcell_index_of(const char* name) noexcept {
 template <firmware::GeneratedModel M>
 constexpr int count_loadcell_channels() noexcept {
   int n = 0;
-  for (int i = 0; i < M::kY; ++i) n += loadcell_index_of(M::kYNames[i]) >= 0 ? 1 : 0;
+  for (int i = 0; i < M::kY; ++i) n += loadcell_index_of(M::kBoardGroup, M::kYNames[i]) >= 0 ? 1 : 0;
   return n;
 }
 
 template <firmware::GeneratedModel M>
 struct ChannelLayout {
-  // Loadcell channels in the model (9 for the hand) and the other observed
+  // Board (loadcell) channels in the model (9 for the hand) and the other observed
   // channels (18 for the hand: l, f, theta).
   static constexpr int kLoadcells = count_loadcell_channels<M>();
   static constexpr int kMuscleY = M::kY - kLoadcells;
@@ -59,12 +60,12 @@ struct ChannelLayout {
   static constexpr int kLoadcellSlots = kLoadcells > 0 ? kLoadcells : 1;
   static_assert(kMuscleY >= 1, "the model observes nothing but loadcells: no muscle state to receive");
 
-  // y channel of loadcell k ("fc<k>").
+  // y channel of loadcell k ("<kBoardGroup><k>").
   static constexpr std::array<int, kLoadcells> kLoadcellY = [] {
     std::array<int, kLoadcells> out{};
     for (int k = 0; k < kLoadcells; ++k) out[k] = -1;
     for (int i = 0; i < M::kY; ++i) {
-      const int k = loadcell_index_of(M::kYNames[i]);
+      const int k = loadcell_index_of(M::kBoardGroup, M::kYNames[i]);
       if (k >= 0 && k < kLoadcells) out[k] = i;
     }
     return out;
@@ -75,7 +76,7 @@ struct ChannelLayout {
     std::array<int, kMuscleY> out{};
     int j = 0;
     for (int i = 0; i < M::kY; ++i) {
-      if (loadcell_index_of(M::kYNames[i]) < 0) out[j++] = i;
+      if (loadcell_index_of(M::kBoardGroup, M::kYNames[i]) < 0) out[j++] = i;
     }
     return out;
   }();
@@ -89,7 +90,7 @@ struct ChannelLayout {
         }
         return true;
       }(),
-      "the model's fc<k> channels must be exactly fc0..fc<n-1>");
+      "the model's board channels <kBoardGroup><k> must be exactly <kBoardGroup>0 .. <kBoardGroup>n-1");
 };
 
 // The part of one sensor frame that comes over the link: every observed
@@ -102,7 +103,7 @@ struct MuscleState {
 };
 
 // One sensor frame from a muscle state and the loadcells (newtons, loadcell
-// k = "fc<k>"). Copies only: the frame holds exactly these bits.
+// k = "<kBoardGroup><k>"). Copies only: the frame holds exactly these bits.
 template <firmware::GeneratedModel M>
 constexpr void assemble_frame(const MuscleState<M>& muscle,
                               const float (&loadcells_N)[ChannelLayout<M>::kLoadcellSlots],

@@ -21,6 +21,7 @@
 
 #include "boards/board.h"
 #include "firmware/app/channel_layout.h"
+#include "firmware/app/image_checks.h"
 #include "firmware/app/period_loop.h"
 #include "firmware/app/uart_endpoint.h"
 #include "firmware/app/usb_link.h"
@@ -32,10 +33,9 @@ namespace {
 using Model = hadynet::model_q15::Model;
 using Loop = hadynet::app::PeriodLoop<Model>;
 
-// Board reading k is the model's loadcell k ("fc<k>"): the counts must agree.
 static_assert(std::is_same_v<Model, hadynet::app::FirmwareModel>, "usb_link.h serves the firmware's model");
-static_assert(hadynet::app::ChannelLayout<Model>::kLoadcells == hadynet::board::kLoadcells,
-              "the model's loadcell channels (fc<k>) and the board's loadcells differ in number");
+// Board reading k is the model's loadcell k, and the model steps at the board's period.
+static_assert(hadynet::app::model_fits_board<Model>());
 
 hadynet::firmware::HadynetRuntime<Model> g_runtime;
 hadynet::app::UartEndpoint<Model> g_endpoint(g_runtime);

@@ -56,10 +56,11 @@ constexpr bool parse_numeric(std::string_view text, Numeric& out) noexcept {
   return true;
 }
 
-// The generator version the core was written against; codegen writes the
-// same number into kGeneratorVersion and the core rejects other versions at
-// compile time (a stale generated header fails the build, not the robot).
-inline constexpr int kModelContractVersion = 2;
+// The version of this contract; codegen writes the same number into
+// kContractVersion (kGeneratorVersion names the generator, not the contract)
+// and the core rejects other versions at compile time (a stale generated
+// header fails the build, not the robot). 3 added kPeriodUs and kBoardGroup.
+inline constexpr int kModelContractVersion = 3;
 
 // Loss class of each observed channel for the grasp stabiliser.
 enum class LossClass : std::uint8_t {
@@ -97,6 +98,11 @@ concept GeneratedModel = requires {
   { M::kHidden } -> std::convertible_to<int>;     // LSTM units (128)
   { M::kStates } -> std::convertible_to<int>;     // rows of the PB table
   { M::kTrainSteps } -> std::convertible_to<int>; // N_train
+  // The control period the model was trained at (its logs' dt_s), in whole
+  // microseconds: one network step. The firmware's loop must run at it; an
+  // image checks it against its board's period at compile time
+  // (firmware/app/firmware_main.cc).
+  { M::kPeriodUs } -> std::convertible_to<std::uint32_t>;
 
   // ---- formats (see above; 0 in an f32 model)
   { M::kFracIn } -> std::convertible_to<int>;
@@ -127,6 +133,11 @@ concept GeneratedModel = requires {
   M::kYInvStd;    // const float[kY]
   M::kYNames;     // const char* const[kY]
   M::kUNames;     // const char* const[kU]
+  // The log group of the observed channels the board measures itself (the
+  // robot profile's board_group; the hand: "fc", its loadcells fc0..fc8):
+  // y channel "<group><k>" is the board's reading k
+  // (firmware/app/channel_layout.h). "" for a model whose logs name none.
+  M::kBoardGroup;  // const char[]
 
   // ---- network (standardised units)
   M::kEncWeight;     // Value[kHidden][kX + kPb]   BN folded; input [x ; p]

@@ -22,12 +22,14 @@
 #include "trainer/deploy_prep.h"
 #include "trainer/detection.h"
 #include "trainer/model_file.h"
+#include "test/codegen/synthetic_model.h"
 
 namespace hadynet::codegen {
 namespace {
 
 namespace fs = std::filesystem;
 using trainer::HadynetModel;
+using test::synthetic_model;
 
 bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
@@ -97,84 +99,6 @@ TEST(FormatRule, ToFixedIsTheFirmwaresRealToFixed) {
   EXPECT_THROW(to_fixed(1.0, 63), std::invalid_argument);
 }
 
-// ---- a small synthetic model -------------------------------------------------
-
-// 6 observed channels in groups l, f, fc, th; x = (l, dl, f, fc, th, dth);
-// hidden 5, PB 2, 3 states, N_train 10, generic weights and BN statistics,
-// ranges consistent with the weights, and optionally detection statistics.
-HadynetModel synthetic_model(bool with_detection) {
-  HadynetModel m;
-  m.layout = trainer::feature_layout_from_names({"l0", "l1", "f0", "fc0", "fc1", "th0"},
-                                                {"u0", "u1"}, {"l", "th"});
-  // The hand's kinds of channel, as its logs' robot profile names them: the
-  // stabiliser's loss classes come from here.
-  m.profile.delta_groups = m.layout.delta_groups;
-  m.profile.force_groups = {"f", "fc"};
-  m.profile.angle_groups = {"th"};
-  m.profile.length_groups = {"l"};
-  trainer::HadynetDims d;
-  d.x = static_cast<int>(m.layout.x_names.size());
-  d.u = 2;
-  d.y = 6;
-  d.pb = 2;
-  d.hidden = 5;
-  d.states = 3;
-  m.params = trainer::HadynetParams<float>::initialized(d, 7);
-  std::mt19937_64 rng(9);
-  std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
-  for (Eigen::Index i = 0; i < d.hidden; ++i) {
-    m.params.enc_bn_weight(i) = 1.0f + 0.3f * uni(rng);
-    m.params.enc_bn_bias(i) = 0.2f * uni(rng);
-    m.params.enc_bn_running_mean(i) = 0.1f * uni(rng);
-    m.params.enc_bn_running_var(i) = 1.5f + uni(rng);
-  }
-  for (Eigen::Index i = 0; i < m.params.pb.size(); ++i) m.params.pb.data()[i] = 0.8f * uni(rng);
-  m.states = {{"soft/i0", "Ball"}, {"stiff/i0", "Hammer \"big\""}, {"none", ""}};
-  m.train_steps = 10;
-  const auto scaling = [&](int n, double mean0) {
-    trainer::ChannelScaling s;
-    s.mean = Eigen::VectorXd::LinSpaced(n, mean0, mean0 + 3.0);
-    s.std = Eigen::VectorXd::LinSpaced(n, 0.5, 2.0);
-    return s;
-  };
-  m.norm.x = scaling(d.x, 1.0);
-  m.norm.u = scaling(d.u, 0.0);
-  m.norm.y = scaling(d.y, -2.0);
-  trainer::ValueRanges r;
-  r.x = 2.5;
-  r.u = 1.2;
-  r.pb = m.params.pb.cwiseAbs().maxCoeff();
-  r.enc_pre = 3.0;
-  r.h = 0.9;
-  r.gate_pre = 4.0;
-  r.c = 1.7;
-  r.y = 3.1;
-  const trainer::FoldedEncoder enc = trainer::fold_batch_norm(m.params);
-  r.enc_weight = enc.weight.cwiseAbs().maxCoeff();
-  r.lstm_weight = std::max(m.params.lstm_weight_ih.cwiseAbs().maxCoeff(),
-                           m.params.lstm_weight_hh.cwiseAbs().maxCoeff());
-  r.dec_weight = m.params.dec_weight.cwiseAbs().maxCoeff();
-  r.windows = 100;
-  r.source = "synthetic";
-  m.ranges = r;
-  if (with_detection) {
-    trainer::DetectionCalibration c;
-    c.steps = 3;
-    c.pb = Eigen::VectorXd::Constant(d.pb, 0.3);
-    c.mean = Eigen::VectorXd::LinSpaced(d.y, -0.2, 0.2);
-    Eigen::MatrixXd a(d.y, d.y);
-    std::normal_distribution<double> normal;
-    for (Eigen::Index i = 0; i < a.size(); ++i) a.data()[i] = normal(rng);
-    c.covariance = a * a.transpose() + 0.1 * Eigen::MatrixXd::Identity(d.y, d.y);
-    c.inverse = trainer::regularised_inverse(c.covariance);
-    c.threshold = 5.0;
-    c.samples = 200;
-    c.source = "synthetic";
-    m.detection = c;
-  }
-  return m;
-}
-
 const ModelIdentity kIdentity{"synthetic.safetensors", 0x0123456789abcdefULL};
 
 GeneratedHeader generate_q15(const HadynetModel& m, CodegenOptions o = {}) {
@@ -190,40 +114,6 @@ void expect_unsupported(const HadynetModel& m, const CodegenOptions& o, const st
   } catch (const UnsupportedModel& e) {
     EXPECT_TRUE(contains(e.what(), part)) << e.what() << "\n  lacks: " << part;
   }
-}
-
-// ---- whitening ------------------------------------------------------------------
-
-TEST(Whitening, WTransposeWIsTheInverseCovariance) {
-  const HadynetModel m = synthetic_model(true);
-  const Eigen::MatrixXd& s = m.detection->inverse;
-  const Eigen::MatrixXd w = whitening_matrix(s);
-  // A backward-stable double eigendecomposition of a 6 x 6 matrix: errors of
-  // a few n eps |S|; 1e-12 |S| leaves a margin of ~100.
-  EXPECT_LT((w.transpose() * w - s).cwiseAbs().maxCoeff(), 1e-12 * s.cwiseAbs().maxCoeff());
-  // Deterministic signs: each row's largest-magnitude entry is positive.
-  for (Eigen::Index k = 0; k < w.rows(); ++k) {
-    Eigen::Index arg = 0;
-    w.row(k).cwiseAbs().maxCoeff(&arg);
-    EXPECT_GT(w(k, arg), 0.0);
-  }
-  // d^2 = |W (e - mu)|^2 = (e - mu)^T S (e - mu) for an arbitrary error
-  // (same 1e-12 relative bound).
-  const Eigen::VectorXd e = Eigen::VectorXd::LinSpaced(6, -1.0, 2.0);
-  const double want = e.dot(s * e);
-  EXPECT_NEAR((w * e).squaredNorm(), want, 1e-12 * want);
-}
-
-TEST(Whitening, RejectsWhatIsNotSymmetricPositiveDefinite) {
-  Eigen::MatrixXd s = Eigen::MatrixXd::Identity(3, 3);
-  s(0, 1) = 0.5;  // not symmetric
-  EXPECT_THROW(whitening_matrix(s), UnsupportedModel);
-  s(1, 0) = 0.5;
-  EXPECT_NO_THROW(whitening_matrix(s));
-  s(2, 2) = -1.0;  // indefinite
-  EXPECT_THROW(whitening_matrix(s), UnsupportedModel);
-  EXPECT_THROW(whitening_matrix(Eigen::MatrixXd::Zero(3, 3)), UnsupportedModel);
-  EXPECT_THROW(whitening_matrix(Eigen::MatrixXd::Identity(2, 3)), UnsupportedModel);
 }
 
 // ---- formats of a model -------------------------------------------------------
@@ -375,14 +265,14 @@ TEST(Rejects, LossGroupsAndWeights) {
   o.control.length_groups = std::vector<std::string>{"l", "f"};  // f is a force group too
   expect_unsupported(m, o, "loss group 'f' is in both");
   o = {};
-  o.control.physical_units = false;
-  o.control.beta = 8.0;  // standardised units: Q12 holds up to 7.99976
+  o.control.loss.physical_units = false;
+  o.control.loss.beta = 8.0;  // standardised units: Q12 holds up to 7.99976
   expect_unsupported(m, o, "loss weight beta");
   o = {};
   o.control.commands = std::vector<std::string>{"u0", "nope"};
   expect_unsupported(m, o, "control command 'nope' is not a u channel");
   o = {};
-  o.control.w2 = -1.0;
+  o.control.loss.w2 = -1.0;
   expect_unsupported(m, o, "loss weight w2");
 }
 
@@ -419,7 +309,7 @@ TEST(Generate, IsDeterministic) {
 
 TEST(Generate, ContentsOfASmallModel) {
   CodegenOptions standardised;
-  standardised.control.physical_units = false;
+  standardised.control.loss.physical_units = false;
   const GeneratedHeader h = generate_q15(synthetic_model(true), standardised);
   const std::string& t = h.text;
   EXPECT_EQ(h.file_name, "hadynet_model_q15.h");
@@ -591,7 +481,7 @@ TEST(Generate, PhysicalLossWeightsFoldTheStdSquaredAndCommandsAreMasked) {
   const HadynetModel m = synthetic_model(true);
   CodegenOptions o;
   o.numeric = Numeric::kF32;
-  o.control.beta = 3.0;
+  o.control.loss.beta = 3.0;
   o.control.commands = std::vector<std::string>{m.layout.u_names.back()};
   const std::string f32 = generate(m, kIdentity, o).text;
   o.numeric = Numeric::kQ15;
@@ -648,6 +538,37 @@ TEST(Generate, TheRobotProfileGivesTheDefaultsAndOptionsOverrideIt) {
   const std::string t = generate(m, kIdentity, o).text;
   EXPECT_TRUE(contains(t, "hadynet::firmware::LossClass::kForce")) << "given";
   EXPECT_FALSE(contains(t, "hadynet::firmware::LossClass::kLength")) << "not in the options, no profile";
+}
+
+// The control period and the board group come from the model (its logs'
+// dt_s and robot profile); --period-s only fills in a period a model file
+// does not record.
+TEST(Generate, PeriodAndBoardGroupComeFromTheModel) {
+  HadynetModel m = synthetic_model(true);
+  m.profile.board_group = "fc";
+  std::string t = generate(m, kIdentity, CodegenOptions{}).text;
+  EXPECT_TRUE(contains(t, "static constexpr std::uint32_t kPeriodUs = 200000;"));
+  EXPECT_TRUE(contains(t, "static constexpr char kBoardGroup[] = \"fc\";"));
+  EXPECT_FALSE(contains(t, "--period-s")) << "the model's own period needs no option";
+
+  CodegenOptions o;
+  o.period_s = 0.1;
+  EXPECT_THROW(generate(m, kIdentity, o), UnsupportedModel) << "another period than the model's";
+  o.period_s = 0.2;
+  EXPECT_NO_THROW(generate(m, kIdentity, o)) << "the same period";
+
+  m.period_s = 0;  // a file from before models stored their period
+  m.profile.board_group.clear();
+  EXPECT_THROW(generate(m, kIdentity, CodegenOptions{}), UnsupportedModel);
+  o.period_s = 0.05;
+  t = generate(m, kIdentity, o).text;
+  EXPECT_TRUE(contains(t, "kPeriodUs = 50000;"));
+  EXPECT_TRUE(contains(t, "--period-s 0.05\n")) << "the regenerate line repeats the option";
+  EXPECT_TRUE(contains(t, "static constexpr char kBoardGroup[] = \"\";")) << "no profile: no board channels";
+  for (const double bad : {0.0, -1.0, std::nan("")}) {
+    o.period_s = bad;
+    EXPECT_THROW(generate(m, kIdentity, o), UnsupportedModel) << bad;
+  }
 }
 
 }  // namespace

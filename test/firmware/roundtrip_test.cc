@@ -17,6 +17,7 @@
 #include "hadynet_model_q15.h"
 #include "test/firmware/held_out_logs.h"
 #include "test/firmware/tolerances.h"
+#include "trainer/control/reference_stabiliser.h"
 #include "trainer/detection.h"
 #include "trainer/hadynet_network.h"
 
@@ -127,11 +128,7 @@ TEST(FirmwareRoundTrip, ForwardMatchesTrainerPerChannel) {
 
 // ---- the stabiliser: gradient direction and chosen command
 
-struct Plan {
-  Eigen::VectorXd direction;  // first epoch's g/|g|, step-major (k * U + i)
-  Eigen::VectorXd command;    // adopted u_t, standardised
-  int alpha = -1;             // last epoch's best step size
-};
+using Plan = trainer::control::StabiliserPlan;
 
 // Standardised command "no change" (u = 0 physical).
 Eigen::VectorXd hold_command() {
@@ -174,63 +171,46 @@ Plan firmware_plan(const LogSequence& s, int t, int t_ref, int epochs, int trunc
   return p;
 }
 
-// The same optimiser on the trainer's double network (the reference).
+// The build's loss weights by the one rule (trainer/control/loss_weights.h):
+// the model's profile groups and codegen's default rule, as the build
+// generates its headers (HADYNET_CODEGEN_OPTIONS empty).
+const trainer::control::LossWeights& rule_weights() {
+  static const trainer::control::LossWeights w = [] {
+    const HadynetModel& m = test::build_model();
+    const auto classes = trainer::control::loss_classes(
+        m.layout.y_names, {m.profile.force_groups, m.profile.angle_groups, m.profile.length_groups});
+    return trainer::control::loss_weights(classes, m.norm.y.std, trainer::control::LossRule{});
+  }();
+  return w;
+}
+
+// The same optimiser on the trainer's double network (the reference,
+// trainer/control/reference_stabiliser.h), with the firmware's settings.
 Plan reference_plan(const LogSequence& s, int t, int t_ref, int epochs, int truncation) {
   const HadynetModel& m = test::build_model();
   static const trainer::HadynetParams<double> params = m.params.cast<double>();
-  const int hc = F::kControlHorizon, nu = F::kU, ny = F::kY;
-  const Eigen::VectorXd y_ref = m.norm.y.standardize(s.y.col(t_ref));
-  trainer::WindowBatch<double> batch;
-  batch.x0 = m.norm.x.standardize(trainer::initial_state(m.layout, s, t));
-  batch.pb = detection_pb();
-  batch.u = hold_command().replicate(1, hc);
-  trainer::HadynetNetwork<double> net;
-  // Per-step references relative to holding still (the firmware's default,
-  // grasp_stabilizer.h): r_k = y_ref + y_hold,k - y_t.
-  const Eigen::MatrixXd y_hold = net.forward(params, batch, trainer::BnMode::kEval);
-  const Eigen::MatrixXd ref =
-      (y_hold.colwise() + (y_ref - m.norm.y.standardize(s.y.col(t))));
-  auto loss_and_dy = [&](const Eigen::MatrixXd& y, Eigen::MatrixXd* dy) {
-    double l = 0;
-    if (dy) dy->resize(ny, hc);
-    for (int k = 0; k < hc; ++k)
-      for (int i = 0; i < ny; ++i) {
-        const double e = y(i, k) - ref(i, k);
-        const double w = e >= 0 ? F::kLossWeightUp[i] : F::kLossWeightDown[i];
-        l += w * e * e;
-        if (dy) (*dy)(i, k) = 2 * w * e;
-      }
-    return l;
-  };
-  Plan p;
-  for (int epoch = 0; epoch < epochs; ++epoch) {
-    Eigen::MatrixXd dy;
-    const double current = loss_and_dy(net.forward(params, batch, trainer::BnMode::kEval), &dy);
-    trainer::HadynetGrads<double> grads;
-    net.backward(params, dy, grads, truncation);
-    for (int i = 0; i < nu; ++i)
-      if (!F::kControlActive[i]) grads.u.row(i).setZero();  // commands the stabiliser holds
-    const Eigen::MatrixXd unit = grads.u / grads.u.norm();
-    if (epoch == 0) p.direction = Eigen::Map<const Eigen::VectorXd>(unit.data(), unit.size());
-    // Monotone line search: a step is taken only if it lowers L.
-    Eigen::MatrixXd best_u = batch.u;
-    double best = current;
-    p.alpha = -1;
-    for (int a = 0; a < F::kControlAlphaCount; ++a) {
-      trainer::WindowBatch<double> cand = batch;
-      cand.u = batch.u - static_cast<double>(F::kControlAlpha[a]) * unit;
-      const double l = loss_and_dy(net.forward(params, cand, trainer::BnMode::kEval), nullptr);
-      if (l < best) {
-        best = l;
-        best_u = cand.u;
-        p.alpha = a;
-      }
-    }
-    batch.u = best_u;
-    if (p.alpha < 0) break;
+  trainer::control::StabiliserSettings settings;
+  settings.horizon = F::kControlHorizon;
+  settings.epochs = epochs;
+  settings.truncation = truncation;
+  for (int a = 0; a < F::kControlAlphaCount; ++a) settings.alphas.push_back(static_cast<double>(F::kControlAlpha[a]));
+  for (int i = 0; i < F::kU; ++i) settings.active.push_back(F::kControlActive[i]);
+  trainer::control::StabiliserProblem problem;
+  problem.x0 = m.norm.x.standardize(trainer::initial_state(m.layout, s, t));
+  problem.pb = detection_pb();
+  problem.y_now = m.norm.y.standardize(s.y.col(t));
+  problem.y_ref = m.norm.y.standardize(s.y.col(t_ref));
+  problem.hold = hold_command();
+  return trainer::control::reference_plan(params, problem, rule_weights(), settings);
+}
+
+// The generated loss weights are the rule's, rounded once to float.
+TEST(FirmwareRoundTrip, GeneratedLossWeightsFollowTheRule) {
+  const trainer::control::LossWeights& w = rule_weights();
+  for (int i = 0; i < F::kY; ++i) {
+    EXPECT_EQ(F::kLossWeightUp[i], static_cast<float>(w.up(i))) << F::kYNames[i];
+    EXPECT_EQ(F::kLossWeightDown[i], static_cast<float>(w.down(i))) << F::kYNames[i];
   }
-  p.command = batch.u.col(0);
-  return p;
 }
 
 double cosine(const Eigen::VectorXd& a, const Eigen::VectorXd& b) { return a.dot(b) / (a.norm() * b.norm()); }

@@ -89,16 +89,20 @@ void expect_record_is_step(const app::PeriodRecord<M>& r, const firmware::StepRe
 
 // ---- channel layout: from the generated model's names
 
-TEST(ChannelLayout, LoadcellIndexParsesOnlyTheLoadcellGroup) {
-  EXPECT_EQ(app::loadcell_index_of("fc0"), 0);
-  EXPECT_EQ(app::loadcell_index_of("fc8"), 8);
-  EXPECT_EQ(app::loadcell_index_of("fc12"), 12);
-  EXPECT_EQ(app::loadcell_index_of("fc"), -1);
-  EXPECT_EQ(app::loadcell_index_of("f0"), -1);
-  EXPECT_EQ(app::loadcell_index_of("fcx"), -1);
-  EXPECT_EQ(app::loadcell_index_of("fc1a"), -1);
-  EXPECT_EQ(app::loadcell_index_of("th0"), -1);
-  EXPECT_EQ(app::loadcell_index_of(""), -1);
+TEST(ChannelLayout, LoadcellIndexParsesOnlyTheBoardGroup) {
+  EXPECT_EQ(app::loadcell_index_of("fc", "fc0"), 0);
+  EXPECT_EQ(app::loadcell_index_of("fc", "fc8"), 8);
+  EXPECT_EQ(app::loadcell_index_of("fc", "fc12"), 12);
+  EXPECT_EQ(app::loadcell_index_of("fc", "fc"), -1);
+  EXPECT_EQ(app::loadcell_index_of("fc", "f0"), -1);
+  EXPECT_EQ(app::loadcell_index_of("fc", "fcx"), -1);
+  EXPECT_EQ(app::loadcell_index_of("fc", "fc1a"), -1);
+  EXPECT_EQ(app::loadcell_index_of("fc", "th0"), -1);
+  EXPECT_EQ(app::loadcell_index_of("fc", ""), -1);
+  EXPECT_EQ(app::loadcell_index_of("lc", "lc3"), 3);
+  EXPECT_EQ(app::loadcell_index_of("lc", "fc3"), -1);
+  EXPECT_EQ(app::loadcell_index_of("", "3"), -1) << "an empty group names no channel";
+  EXPECT_EQ(app::loadcell_index_of("", "fc3"), -1);
 }
 
 // The layout against the model's names, read here with std::string: every
@@ -195,6 +199,13 @@ struct ShuffledLoadcells : Q {
       "fc2", "l0", "l1", "l2", "l3", "l4", "l5", "l6", "l7", "f0", "f1", "f2", "f3", "f4",
       "fc0", "f5", "f6", "f7", "fc1", "fc3", "fc4", "fc5", "fc6", "fc7", "fc8", "th0", "th1"};
 };
+// The board group is the model's (its profile's), not the hand's "fc".
+struct OtherBoardGroup : Q {
+  static constexpr char kBoardGroup[] = "f";
+};
+struct NoBoardGroup : Q {
+  static constexpr char kBoardGroup[] = "";
+};
 struct NoLoadcells : Q {
   static constexpr const char* const kYNames[Q::kY] = {
       "q0",  "q1",  "q2",  "q3",  "q4",  "q5",  "q6",  "q7",  "q8",  "q9",  "q10", "q11", "q12", "q13",
@@ -215,6 +226,10 @@ TEST(ChannelLayout, TakesTheSplitFromTheNamesNotFromTheHand) {
   EXPECT_EQ(N::kMuscleY, Q::kY);
   EXPECT_EQ(PayloadSizes<NoLoadcells>::kTareAck, 0u);
   EXPECT_EQ(PayloadSizes<NoLoadcells>::kPeriodResult, 23u + 4u * (1 + 27 + 8));
+  using G = app::ChannelLayout<OtherBoardGroup>;  // f0..f7 on the board, fc* over the link
+  EXPECT_EQ(G::kLoadcells, 8);
+  EXPECT_EQ(std::string(Q::kYNames[G::kLoadcellY[0]]), "f0");
+  EXPECT_EQ(app::ChannelLayout<NoBoardGroup>::kLoadcells, 0);
 }
 
 template <firmware::GeneratedModel M>

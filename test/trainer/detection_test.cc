@@ -66,6 +66,43 @@ DetectionCalibration diagonal_calibration() {
   return c;
 }
 
+// ---- whitening (the detector's W, written by codegen)
+
+TEST(Whitening, WTransposeWIsTheInverseCovariance) {
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd a(6, 6);
+  for (Eigen::Index i = 0; i < a.size(); ++i) a.data()[i] = normal(rng);
+  const Eigen::MatrixXd s = regularised_inverse(a * a.transpose() + 0.1 * Eigen::MatrixXd::Identity(6, 6));
+  const Eigen::MatrixXd w = whitening_matrix(s);
+  // A backward-stable double eigendecomposition of a 6 x 6 matrix: errors of
+  // a few n eps |S|; 1e-12 |S| leaves a margin of ~100.
+  EXPECT_LT((w.transpose() * w - s).cwiseAbs().maxCoeff(), 1e-12 * s.cwiseAbs().maxCoeff());
+  // Deterministic signs: each row's largest-magnitude entry is positive.
+  for (Eigen::Index k = 0; k < w.rows(); ++k) {
+    Eigen::Index arg = 0;
+    w.row(k).cwiseAbs().maxCoeff(&arg);
+    EXPECT_GT(w(k, arg), 0.0);
+  }
+  // d^2 = |W (e - mu)|^2 = (e - mu)^T S (e - mu) for an arbitrary error
+  // (same 1e-12 relative bound).
+  const Eigen::VectorXd e = Eigen::VectorXd::LinSpaced(6, -1.0, 2.0);
+  const double want = e.dot(s * e);
+  EXPECT_NEAR((w * e).squaredNorm(), want, 1e-12 * want);
+}
+
+TEST(Whitening, RejectsWhatIsNotSymmetricPositiveDefinite) {
+  Eigen::MatrixXd s = Eigen::MatrixXd::Identity(3, 3);
+  s(0, 1) = 0.5;  // not symmetric
+  EXPECT_THROW(whitening_matrix(s), std::invalid_argument);
+  s(1, 0) = 0.5;
+  EXPECT_NO_THROW(whitening_matrix(s));
+  s(2, 2) = -1.0;  // indefinite
+  EXPECT_THROW(whitening_matrix(s), std::invalid_argument);
+  EXPECT_THROW(whitening_matrix(Eigen::MatrixXd::Zero(3, 3)), std::invalid_argument);
+  EXPECT_THROW(whitening_matrix(Eigen::MatrixXd::Identity(2, 3)), std::invalid_argument);
+}
+
 TEST(Mahalanobis, IsZeroAtTheMeanAndCountsStandardDeviations) {
   const DetectionCalibration c = diagonal_calibration();
   const Eigen::Vector3d sigma(2.0, 0.5, 3.0);

@@ -100,6 +100,17 @@ TEST(FeatureLayout, ErrorsNameTheFile) {
       {"du.csv", "'u'"});
 }
 
+// A model learns one step of one length: every training log must have the
+// first one's dt_s (the period the model file then records).
+TEST(TrainingLogs, MustShareOneControlPeriod) {
+  const datalog::LogTable a = table_with({"t", "q0", "u0"});
+  datalog::LogTable b = table_with({"t", "q0", "u0"});
+  EXPECT_NO_THROW(check_same_period(a, "a.csv", b, "b.csv"));
+  b.metadata.set("dt_s", "0.1");
+  expect_runtime_error([&] { check_same_period(a, "a.csv", b, "b.csv"); },
+                       {"b.csv", "'dt_s' is 0.1 s", "0.2 s in a.csv"});
+}
+
 TEST(LogSequence, ExtractsChannelsByNameAndMetadata) {
   datalog::LogTable table = spring_log(2.0, 12, 5, "cyl/i1", "cylinder");
   // Reorder the header (and the values) to show extraction goes by name.

@@ -44,6 +44,7 @@ HadynetModel sample_model(bool with_detection) {
     m.profile.force_groups = {"q"};
     m.profile.control_commands = {"u0"};
     m.profile.board_group = "q";
+    m.period_s = 0.05;  // the other variant records none (0), as files from before periods
     m.profile.contact_sums = {{"all", {"q0", "q1"}}};
     std::mt19937_64 rng(17);
     DetectionCalibration c;
@@ -100,6 +101,7 @@ void expect_same_model(const HadynetModel& got, const HadynetModel& want) {
     EXPECT_EQ(got.states[k].object, want.states[k].object);
   }
   EXPECT_EQ(got.train_steps, want.train_steps);
+  EXPECT_EQ(got.period_s, want.period_s);
   EXPECT_EQ(got.bn_batches_tracked, want.bn_batches_tracked);
   EXPECT_EQ(got.hyper_parameters, want.hyper_parameters);
   EXPECT_EQ(got.provenance, want.provenance);
@@ -133,6 +135,7 @@ TEST(ModelFile, RoundTripKeepsEveryPartAndTheForwardBits) {
   expect_same_model(loaded, model);
   EXPECT_EQ(loaded.state_index("stiff"), 1);
   EXPECT_EQ(loaded.state_index("nope"), -1);
+  EXPECT_EQ(loaded.period_s, 0.05);
 
   // Same bits in, same bits out: the forward pass (BN eval) is bit-identical.
   const WindowBatch<float> batch = float_batch(model.params.dims, 6, 5);
@@ -157,6 +160,8 @@ TEST(ModelFile, RoundTripWithoutDetection) {
   EXPECT_FALSE(loaded.detection.has_value());
   EXPECT_FALSE(loaded.ranges.has_value());
   EXPECT_EQ(model_to_safetensors(loaded).metadata.count("ranges"), 0u);
+  EXPECT_EQ(loaded.period_s, 0.0) << "a file without 'period_s' has none recorded";
+  EXPECT_EQ(model_to_safetensors(loaded).metadata.count("period_s"), 0u);
   expect_same_model(loaded, model);
 }
 
@@ -445,6 +450,12 @@ TEST_F(ModelFileRejects, InconsistentOrMalformedMetadata) {
   f = good_;
   f.metadata.erase("channels");
   expect_rejected(f, "metadata has no 'channels'");
+
+  for (const char* bad : {"0", "-0.2", "\"0.2\"", "1e9"}) {
+    f = good_;
+    f.metadata["period_s"] = bad;
+    expect_rejected(f, "'period_s'");
+  }
 
   f = good_;
   edit_metadata(f, "detection", R"("threshold":4.25)", R"("threshold":-1.0)");

@@ -1,0 +1,74 @@
+#include "codegen/sensor_arrays.h"
+
+#include <algorithm>
+#include <cstdint>
+
+#include "codegen/formats.h"
+#include "codegen/header_text.h"
+#include "codegen/unsupported_model.h"
+#include "trainer/derived_inputs.h"
+
+namespace hadynet::codegen {
+
+SensorArrays sensor_arrays(const trainer::HadynetModel& model, bool q15, int frac_y) {
+  const auto& y = model.layout.y_names;
+  const auto& u = model.layout.u_names;
+  const auto y_index = [&](const std::string& name) -> Eigen::Index {
+    const auto it = std::find(y.begin(), y.end(), name);
+    if (it == y.end()) reject("sensor model names '" + name + "', not a y channel");
+    return it - y.begin();
+  };
+  SensorArrays a;
+  for (std::size_t i = 0; i < u.size(); ++i) {
+    const auto d = trainer::parse_derived_input(u[i]);
+    if (!d) {
+      a.derived.push_back("hadynet::firmware::DerivedKind::kNone");
+      a.derived_base.push_back(std::to_string(i));
+      continue;
+    }
+    const auto it = std::find(u.begin(), u.end(), d->base);
+    if (it == u.end()) reject("derived input '" + u[i] + "': no command '" + d->base + "' in the model");
+    if (trainer::parse_derived_input(d->base)) reject("derived input '" + u[i] + "' is derived from a derived input");
+    a.derived.push_back(d->kind == trainer::DerivedKind::kSign ? "hadynet::firmware::DerivedKind::kSign"
+                                                               : "hadynet::firmware::DerivedKind::kHysteresis");
+    a.derived_base.push_back(std::to_string(it - u.begin()));
+  }
+  const trainer::SensorModel& s = model.sensor;
+  for (const auto& x : s.crosstalk) {
+    a.crosstalk_target.push_back(std::to_string(y_index(x.target)));
+    a.crosstalk_source.push_back(std::to_string(y_index(x.source)));
+    a.crosstalk_gain.push_back(float_literal(static_cast<float>(x.gain)));
+  }
+  for (const auto& d : s.drifts) {
+    a.drift_channel.push_back(std::to_string(y_index(d.channel)));
+    a.drift_is_load.push_back(d.load ? "true" : "false");
+    a.drift_rate.push_back(float_literal(static_cast<float>(d.rate)));
+  }
+  if (!s.drifts.empty()) a.period = float_literal(static_cast<float>(s.period_s));
+  for (const auto& c : s.clips) {
+    const Eigen::Index r = y_index(c.channel);
+    a.clip_channel.push_back(std::to_string(r));
+    a.clip_side.push_back(std::to_string(c.side));
+    a.clip_rail.push_back(float_literal(static_cast<float>(c.rail)));
+    const double standardised = (c.rail - model.norm.y.mean(r)) / model.norm.y.std(r);
+    a.clip_rail_model.push_back(
+        q15 ? std::to_string(std::clamp<std::int64_t>(to_fixed(standardised, frac_y), -32768, 32767))
+            : float_literal(static_cast<float>(standardised)));
+  }
+  a.crosstalk_count = static_cast<int>(a.crosstalk_target.size());
+  a.drift_count = static_cast<int>(a.drift_channel.size());
+  a.clip_count = static_cast<int>(a.clip_channel.size());
+  for (auto* v : {&a.crosstalk_target, &a.crosstalk_source, &a.drift_channel, &a.clip_channel, &a.clip_side})
+    if (v->empty()) v->push_back("0");
+  for (auto* v : {&a.crosstalk_gain, &a.drift_rate, &a.clip_rail})
+    if (v->empty()) v->push_back("0.0f");
+  if (a.drift_is_load.empty()) a.drift_is_load.push_back("false");
+  if (a.clip_rail_model.empty()) a.clip_rail_model.push_back(q15 ? "0" : "0.0f");
+  for (const std::string& l : s.describe()) a.notes.push_back(l);
+  for (const auto& d : s.delays)
+    a.notes.push_back(d.channel + ": the firmware does not undo this delay (it needs future samples); the " +
+                      "network sees the late measurement");
+  return a;
+}
+
+}  // namespace hadynet::codegen
