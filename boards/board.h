@@ -1,4 +1,4 @@
-// The board interface (DESIGN.md §6, STYLE.md item 6): everything the
+// The board interface (docs/architecture.md §6 and "Seams of the firmware"): everything the
 // portable firmware (firmware/app/) needs from the hardware, and nothing
 // more. Each board directory (boards/mps2-an386/, boards/stm32f405/)
 // implements it; the build links exactly one of them into an image, so no

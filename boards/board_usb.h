@@ -1,4 +1,4 @@
-// The board's USB device port (DESIGN.md §6): what the firmware's USB side
+// The board's USB device port (docs/architecture.md §6): what the firmware's USB side
 // (firmware/app/usb_link.cc) needs from a board that has one. Only boards
 // whose board.cmake sets BOARD_HAS_USB implement it; boards/CMakeLists.txt
 // links usb_link.cc into their firmware image and usb_link_none.cc into the

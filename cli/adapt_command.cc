@@ -1,4 +1,4 @@
-// hadynet adapt: PB-only adaptation with frozen weights (DESIGN.md section 4).
+// hadynet adapt: PB-only adaptation with frozen weights (docs/method.md, "PB adaptation").
 // Offline: one PB per dynamics state of the given logs, full batch,
 // MomentumSGD, --epochs epochs. --online: the logs are streamed step by step;
 // the PB is updated once 100 windows exist, on the newest 200, 3 epochs per

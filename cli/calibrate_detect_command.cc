@@ -1,4 +1,4 @@
-// hadynet calibrate-detect: contact-detection statistics (DESIGN.md section 4,
+// hadynet calibrate-detect: contact-detection statistics (docs/method.md, "Detection";
 // seed paper III-D). The PB is fitted to the given contact-free logs (or
 // chosen with --pb), the N_detect-step prediction errors over them give mu_e
 // and Sigma_e, and the threshold C_detect is set by the rule in

@@ -1,5 +1,5 @@
 // hadynet residual: the analysis half of the residual loop (docs/residual.md,
-// DESIGN.md section 5): multi-step residuals of a model over logs, the
+// docs/architecture.md §5): multi-step residuals of a model over logs, the
 // residual tests (whiteness, independence), the effect library's feature
 // tests and their attribution, a Markdown report with PNG plots and a JSON
 // with every number.

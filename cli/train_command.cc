@@ -1,5 +1,5 @@
-// hadynet train: learns HADYNET and the PB table from logs (DESIGN.md
-// sections 3-4). Progress with loss and ETA on stderr, a checkpoint after
+// hadynet train: learns HADYNET and the PB table from logs (docs/method.md,
+// "Network" and "Training"). Progress with loss and ETA on stderr, a checkpoint after
 // every epoch (atomic; --resume continues exactly), the model file at the end,
 // and the loss history as CSV and PNG next to it.
 #include <Eigen/Core>

@@ -1,4 +1,4 @@
-// HADYNET codegen (DESIGN.md §3, §6; docs/codegen.md): a trained model file
+// HADYNET codegen (docs/method.md, "Network"; docs/architecture.md §6; docs/codegen.md): a trained model file
 // -> one allocation-free C++ header holding one struct of static constexpr
 // constants and arrays that satisfies hadynet::firmware::GeneratedModel
 // (firmware/core/model_contract.h, the specification of every member).

@@ -1,4 +1,4 @@
-// Contact detection statistics (DESIGN.md section 4, seed paper III-D):
+// Contact detection statistics (docs/method.md, "Detection"; seed paper III-D):
 // from N_detect-step prediction errors on contact-free data, the mean mu_e
 // and covariance Sigma_e, and d = sqrt((e - mu_e)^T Sigma_e^-1 (e - mu_e)).
 #pragma once

@@ -24,7 +24,7 @@ struct PbState {
   std::string object;  // grasped object label, e.g. "Cylinder" ("" if unknown)
 };
 
-// Contact detection statistics (DESIGN.md section 4), in standardised y units.
+// Contact detection statistics (docs/method.md, "Detection"), in standardised y units.
 struct DetectionCalibration {
   int steps = 0;              // N_detect: y_t is predicted from x_{t-N} and u_[t-N, t)
   Eigen::VectorXd pb;         // the PB detection runs with (fitted on contact-free data)

@@ -1,5 +1,5 @@
 // HADYNET forward pass and exact back-propagation through time over a batch
-// of windows (DESIGN.md section 3):
+// of windows (docs/method.md, "Network"):
 //
 //   z0        = ReLU(BN(W_enc [x ; p] + b_enc))          h_0 = z0, c_0 = 0
 //   h_{k+1}   = LSTM([u_k ; p], h_k, c_k)                 PyTorch LSTM, gates i, f, g, o

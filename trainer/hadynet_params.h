@@ -1,4 +1,4 @@
-// HADYNET parameters (DESIGN.md section 3): every tensor of the model with
+// HADYNET parameters (docs/method.md, "Network"): every tensor of the model with
 // PyTorch names and layouts, a uniform view of them for optimisers and model
 // I/O, and PyTorch-style initialisation from a seed.
 //

@@ -1,4 +1,4 @@
-// From recorded logs to HADYNET's signals (DESIGN.md sections 2 and 4).
+// From recorded logs to HADYNET's signals (docs/architecture.md §2; docs/method.md, "Windows and standardisation").
 //
 // Nothing here knows the hand: the channels come from the log header.
 //   y_t : every observed group (every numbered group but "u"), header order

@@ -1,4 +1,4 @@
-// Per-channel standardisation of x, u and y (DESIGN.md section 3): the
+// Per-channel standardisation of x, u and y (docs/method.md, "Windows and standardisation"): the
 // network sees (v - mean) / std. Fitted on the training logs and stored with
 // the model so every later use (adapt, detect, codegen) scales identically.
 #pragma once

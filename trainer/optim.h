@@ -1,5 +1,5 @@
 // Optimisers over HadynetParams: Adam for training weights and PB jointly,
-// MomentumSGD for PB-only adaptation (DESIGN.md section 4). Each updates only
+// MomentumSGD for PB-only adaptation (docs/method.md, "Training" and "PB adaptation"). Each updates only
 // the trainable tensors (not BN running statistics) of its `trainable`
 // groups; the tensors of other groups are frozen: neither they nor any
 // optimiser state of theirs change.

@@ -1,4 +1,4 @@
-// PB-only adaptation (DESIGN.md section 4, seed paper section III-C): the
+// PB-only adaptation (docs/method.md, "PB adaptation"; seed paper section III-C): the
 // weights stay frozen, one PB vector is fitted to data of the current
 // dynamics state by MomentumSGD on the full batch (BN in eval mode).
 //

@@ -1,5 +1,5 @@
-// Joint training of the HADYNET weights and the PB table (DESIGN.md section
-// 4): shuffled windows, mini-batches, Adam, BN running statistics, a
+// Joint training of the HADYNET weights and the PB table (docs/method.md,
+// "Training"): shuffled windows, mini-batches, Adam, BN running statistics, a
 // held-out loss per epoch, a checkpoint after every epoch.
 //
 // Determinism: for a seed and a thread count the run is bit-reproducible,

@@ -1,4 +1,4 @@
-// Training windows (DESIGN.md section 4): one per time step i of each log,
+// Training windows (docs/method.md, "Windows and standardisation"): one per time step i of each log,
 //   { x_i, u_[i, i+N), y_[i+1, i+N+1) },   1 <= i <= T-1-N,
 // standardised and stored as float, gathered into WindowBatch batches.
 #pragma once

@@ -1,6 +1,6 @@
-// Fixed-point activations for the LSTM (DESIGN.md §6): tanh and sigmoid.
+// Fixed-point activations for the LSTM (docs/architecture.md §6): tanh and sigmoid.
 //
-// Reference kernels (STYLE.md item 3): integer-only at run time, no float, no
+// Reference kernels (docs/architecture.md §6): integer-only at run time, no float, no
 // heap, no exceptions, no target #ifdefs; bit-identical on host and MCU.
 //
 // Contract (both functions):

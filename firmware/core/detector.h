@@ -1,4 +1,4 @@
-// Contact detection (DESIGN.md §4): the last N_detect + 2 sensor frames in a
+// Contact detection (docs/method.md, "Detection"): the last N_detect + 2 sensor frames in a
 // ring buffer, the model's estimate of y_t from x_{t-N} and u_[t-N, t) under
 // a PB, and the Mahalanobis distance of its error
 //   d = sqrt((e - mu)^T Sigma^-1 (e - mu)) = |W (e - mu)|,  e = y_est - y_t,

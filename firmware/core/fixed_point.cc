@@ -6,7 +6,7 @@
 // that the resulting library can be checked for heap/exception references
 // (see firmware/cmake/check_no_alloc.cmake).
 //
-// Shapes follow DESIGN.md §3 (x 37 + p 8 = 45 -> 128 encoder; LSTM input
+// Shapes follow docs/method.md, "Network" (x 37 + p 8 = 45 -> 128 encoder; LSTM input
 // u 8 + p 8 = 16, 128 units, 4 gates; 128 -> 27 decoder). The Q formats are
 // illustrative; codegen chooses the real ones from measured ranges.
 #include "firmware/core/fixed_point.h"

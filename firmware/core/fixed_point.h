@@ -1,6 +1,6 @@
-// Fixed-point arithmetic for the quantised HADYNET network (DESIGN.md §6).
+// Fixed-point arithmetic for the quantised HADYNET network (docs/architecture.md §6).
 //
-// This is the *reference kernel* (STYLE.md item 3): plain, readable integer
+// This is the *reference kernel* (docs/architecture.md §6): plain, readable integer
 // code that optimised kernels (e.g. Cortex-M DSP, `kernels/cortex_m4/`) are
 // tested against bit-exactly. Do not optimise it in place.
 //

@@ -1,4 +1,4 @@
-// Grasp stabiliser (seed paper section III-F; DESIGN.md §4): every control
+// Grasp stabiliser (seed paper section III-F; docs/method.md, "Grasp stabiliser"): every control
 // period, optimise the command sequence u_seq = u_[t, t+H) so that HADYNET's
 // predicted y_[t+1, t+H] stays at the reference y_ref (y at grasp start):
 //

@@ -1,5 +1,5 @@
 // Stateful, step-by-step HADYNET forward pass of a generated model
-// (DESIGN.md §3), in the model's numerics (q15 or f32), plus the input
+// (docs/method.md, "Network"), in the model's numerics (q15 or f32), plus the input
 // gradient (back-propagation through time) the grasp stabiliser needs.
 //
 //   encode:  h_0 = ReLU(W_enc' [x ; p] + b_enc')   (batch norm folded by codegen), c_0 = 0

@@ -1,4 +1,4 @@
-// What a generated model provides to the firmware core (DESIGN.md §3, §6).
+// What a generated model provides to the firmware core (docs/method.md, "Network"; docs/architecture.md §6).
 //
 // `hadynet codegen MODEL --numeric q15|f32` writes one header holding one
 // struct (default `hadynet::model_q15::Model` / `hadynet::model_f32::Model`)

@@ -1,7 +1,8 @@
 // ============================================================================
 //  THE FLASH SEAM: erase a sector, program bytes, read bytes, with the
 //  sectors described by a table. Backends: the STM32F405 flash interface
-//  (later, boards/) and SimulatedNorFlash (tests, the fuzzer).
+//  (boards/stm32f405/flash_controller.h) and SimulatedNorFlash (tests, the
+//  fuzzer).
 //
 //  Contract:
 //   * Offsets are bytes from the start of the device (F405: 0x08000000).

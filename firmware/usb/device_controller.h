@@ -2,7 +2,8 @@
 //  THE DEVICE-CONTROLLER SEAM: everything the portable USB stack needs from a
 //  USB device controller, and everything it hears from one.
 //
-//  Backends: the STM32F405 OTG FS register driver (boards/, later) and the
+//  Backends: the STM32F405 OTG FS register driver
+//  (boards/stm32f405/otg_fs_controller.h) and the
 //  host fake (firmware/usb/host/fake_controller.h) that tests, the fuzzer and
 //  a umockdev fixture drive. The stack above the seam is portable.
 //

@@ -1,5 +1,5 @@
 // A closed-loop grasp session: the plant side of the grasp stabiliser's
-// tests (DESIGN.md section 4, "Control"; seed paper sections III-F, IV-E).
+// tests (docs/method.md, "Grasp stabiliser"; seed paper sections III-F, IV-E).
 //
 // The session builds the hand of one dynamics state exactly as
 // run_experiment would (hand_spec_for, ExperimentLoop), settles it, performs
@@ -122,7 +122,7 @@ double grasp_error(const std::vector<double>& y, const std::vector<double>& y_re
 std::vector<std::size_t> force_channels(const std::vector<std::string>& names, bool tensions = true,
                                         bool loadcells = true);
 
-// E over all of F = (f, f_contact) as DESIGN.md defines it, beta = 3.
+// E over all of F = (f, f_contact) as docs/method.md, "Grasp stabiliser", defines it, beta = 3.
 double grasp_error(const std::vector<double>& y, const std::vector<double>& y_ref,
                    const std::vector<std::string>& names, double beta = 3.0);
 

@@ -16,7 +16,7 @@ struct mjData_;
 
 namespace hadynet::plant {
 
-// One sample of every signal the robot measures (y of DESIGN.md).
+// One sample of every signal the robot measures (y of docs/architecture.md §2).
 struct Measurement {
   std::array<double, kMuscles> muscle_length_mm{};  // l: encoder, incl. offsets
   std::array<double, kMuscles> tension_N{};         // f

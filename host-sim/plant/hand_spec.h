@@ -16,7 +16,7 @@ inline constexpr int kMuscles = 8;    // l, f, u dimension
 inline constexpr int kLoadcells = 9;  // f_contact dimension
 inline constexpr int kWristJoints = 2;
 
-// Muscle order in logs (l0..l7, f0..f7, u0..u7). DESIGN.md numbers the finger
+// Muscle order in logs (l0..l7, f0..f7, u0..u7). docs/architecture.md §2 numbers the finger
 // muscles #1..#5; they are columns 3..7 here.
 enum Muscle : int {
   kWristFlexRadial = 0,  // wrist flexion + radial deviation

@@ -16,7 +16,7 @@ std::vector<std::size_t> range(std::size_t first, std::size_t count) {
 }
 
 // The hand's header gives y = (l 8, f 8, fc 9, th 2) = 27 observed channels
-// in header order and u = 8 commands (DESIGN.md section 2).
+// in header order and u = 8 commands (docs/architecture.md §2).
 TEST(ChannelLayout, MusashiHand) {
   std::string row = "0";  // t plus 35 channels
   for (int i = 0; i < 35; ++i) row += ",0";

@@ -16,7 +16,7 @@ inline const std::string kRequiredMetadata =
     "# format_version: 1\n"
     "# dt_s: 0.2\n";
 
-// The Musashi hand's header (DESIGN.md section 2): 27 observed channels, 8 commands.
+// The Musashi hand's header (docs/architecture.md §2): 27 observed channels, 8 commands.
 inline std::string hand_header() {
   std::string header = "t";
   const auto group = [&](const std::string& prefix, int n) {

@@ -107,7 +107,7 @@ TEST(ChannelLayout, LoadcellIndexParsesOnlyTheBoardGroup) {
 
 // The layout against the model's names, read here with std::string: every
 // "fc<k>" is loadcell k, everything else is the muscle state in y order.
-// The hand's model (DESIGN.md §2) has 9 loadcells and 18 other channels.
+// The hand's model (docs/architecture.md §2) has 9 loadcells and 18 other channels.
 TEST(ChannelLayout, FollowsTheGeneratedModelsChannelNames) {
   using L = app::ChannelLayout<Q>;
   EXPECT_EQ(L::kLoadcells, 9);

@@ -1,4 +1,4 @@
-// Malformed input on the link (DESIGN.md §6, issue 5): every bad frame gets
+// Malformed input on the link (docs/architecture.md §6, issue 5): every bad frame gets
 // the right error reply and changes nothing. Proof by twins: device A gets
 // the bad frame, device B never sees it; afterwards A's runtime is byte for
 // byte B's (history, network state, plan, PB, mode), the link's sequence

@@ -1,4 +1,4 @@
-// Matrix and activation kernels of the q15 core (STYLE.md item 3): the hot
+// Matrix and activation kernels of the q15 core (docs/architecture.md §6): the hot
 // loops of HadynetNet's forward step (the LSTM gates, encoder, decoder, the
 // gate activations) and of the stabiliser's backward pass, behind one
 // interface whose implementation the build chooses:

@@ -1,7 +1,7 @@
 // Reference implementation of kernels/dot_q15.h: the plain exact sums, the
 // requantisation of fixed_point.h and the activations of activation.h, in
 // the obvious order. What optimised kernels are tested against; do not
-// optimise it in place (STYLE.md item 3).
+// optimise it in place (docs/architecture.md §6).
 #include "firmware/core/kernels/dot_q15.h"
 
 #include <cstdint>
