@@ -1,17 +1,18 @@
-// hadynet codegen and hadynet measure-ranges (docs/codegen.md). The commands
-// live in codegen/ (codegen_command.h), shared with the standalone
-// hadynet-codegen the build runs.
+// hadynet codegen and hadynet measure-ranges (docs/codegen.md): the command
+// lines of codegen_command_line.h, with the trainer's network serving
+// `codegen --logs`.
+#include "cli/codegen_command_line.h"
 #include "cli/commands.h"
-#include "codegen/codegen_command.h"
+#include "trainer/deploy_prep.h"
 
 namespace hadynet::cli {
 
 int run_codegen(int argc, char** argv) {
-  return codegen::run_codegen_command("hadynet", "codegen", argc, argv);
+  return run_codegen_command("hadynet", "codegen", argc, argv, trainer::measure_log_ranges);
 }
 
 int run_measure_ranges(int argc, char** argv) {
-  return codegen::run_measure_ranges_command("hadynet", argc, argv);
+  return run_measure_ranges_command("hadynet", "measure-ranges", argc, argv);
 }
 
 }  // namespace hadynet::cli

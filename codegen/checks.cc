@@ -94,7 +94,7 @@ void check_model(const HadynetModel& model) {
   }
   if (!model.ranges) {
     reject("the model file holds no measured value ranges: store them with `hadynet measure-ranges "
-           "MODEL LOGS` (or `hadynet-codegen measure-ranges MODEL LOGS`), or give codegen --logs");
+           "MODEL LOGS` (or `hadynet-measure-ranges MODEL LOGS`), or give `hadynet codegen` --logs");
   }
   if (model.detection) {
     const trainer::DetectionCalibration& c = *model.detection;

@@ -4,19 +4,25 @@
 # boards (the core and its runtime with the generated q15 and f32 models; it
 # must compile without warnings, link no heap or exceptions and fit each
 # board's memory), then the release suite under CTest, which also runs the
-# images under QEMU (test/boards/), then the same host suite under
-# ASan + UBSan (debug preset), without the tests labelled `slow` (model
+# images under QEMU (test/boards/), then the libFuzzer targets (fuzz preset:
+# clang, ASan + UBSan, 10 s each from their seeds), then the same host suite
+# under ASan + UBSan (debug preset), without the tests labelled `slow` (model
 # fine-tuning; they ran in release already).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 scripts/setup.sh
 # The presets chain the builds: the cross build generates its model headers
-# with build/release's codegen, and the release suite runs
-# build/cortex-m4/images under QEMU (CMakePresets.json).
+# with build/release's codegen, the release suite runs
+# build/cortex-m4/images under QEMU, and the fuzz build runs build/release's
+# codegen and fuzz tools (CMakePresets.json).
 scripts/build.sh release
 scripts/build.sh cortex-m4
 echo "cross build (cortex-m4): ok"
 ctest --preset release
+# Fails (no skip) when clang or its libFuzzer runtime (libclang-rt-dev) is
+# missing.
+scripts/build.sh fuzz
+ctest --preset fuzz
 scripts/build.sh debug
 ctest --preset debug

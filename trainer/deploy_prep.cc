@@ -17,21 +17,6 @@ double max_abs(const M& m) {
 
 }  // namespace
 
-FoldedEncoder fold_batch_norm(const HadynetParams<float>& params) {
-  params.check_shapes();
-  const Eigen::ArrayXd scale =
-      params.enc_bn_weight.cast<double>().array() /
-      (params.enc_bn_running_var.cast<double>().array() + kBnEps).sqrt();
-  FoldedEncoder folded;
-  folded.weight = (scale.matrix().asDiagonal() * params.enc_weight.cast<double>()).cast<float>();
-  folded.bias = (scale * (params.enc_bias.cast<double>() - params.enc_bn_running_mean.cast<double>())
-                              .array() +
-                 params.enc_bn_bias.cast<double>().array())
-                    .matrix()
-                    .cast<float>();
-  return folded;
-}
-
 ValueRanges measure_ranges(const HadynetModel& model, const WindowDataset& data,
                            std::span<const int> ids) {
   const HadynetParams<float>& p = model.params;

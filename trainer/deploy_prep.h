@@ -1,6 +1,6 @@
-// Preparing a trained model for codegen (issue 4): batch norm folded into the
-// encoder, and the value ranges of every tensor the firmware computes, from
-// which codegen picks per-tensor fixed-point formats.
+// Preparing a trained model for codegen (issue 4): the value ranges of every
+// tensor the firmware computes, from which codegen picks per-tensor
+// fixed-point formats (the batch norm fold is in batch_norm_fold.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -8,21 +8,12 @@
 #include <string>
 #include <vector>
 
+#include "trainer/batch_norm_fold.h"
 #include "trainer/hadynet_model.h"
 #include "trainer/window_dataset.h"
 
 namespace hadynet::trainer {
 
-// Encoder with eval-mode batch norm folded in:
-//   BN(W z + b) = s .* (W z + b - mean) + beta,  s = gamma / sqrt(running_var + eps)
-//             = (diag(s) W) z + s .* (b - mean) + beta
-// so h_0 = ReLU(weight [x ; p] + bias). Exact in real arithmetic; in float the
-// folded forward differs from the BN forward by rounding only.
-struct FoldedEncoder {
-  RowMatrix<float> weight;  // hidden x (x + pb)
-  Vector<float> bias;       // hidden
-};
-FoldedEncoder fold_batch_norm(const HadynetParams<float>& params);
 
 // Largest absolute value of each quantity the firmware's forward computes,
 // over the windows `ids` of `data` with their states' PBs (BN eval), in

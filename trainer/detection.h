@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "trainer/hadynet_model.h"
+#include "trainer/whitening.h"
 
 namespace hadynet::trainer {
 
@@ -32,15 +33,6 @@ DetectionCalibration calibrate_detection(const HadynetModel& model,
                                          std::string source);
 
 // d of one error vector (standardised units).
-// The whitening of the detection distance, as the firmware computes it: for
-// the regularised inverse covariance S (symmetric positive definite),
-// S = V diag(lambda) V^T and W = diag(sqrt(lambda)) V^T, so W^T W = S and
-// d^2 = |W (e - mu)|^2. Eigenvalues ascending; each eigenvector's
-// largest-magnitude entry is made positive (deterministic signs). Throws
-// std::invalid_argument if S is empty, not square, not finite, not symmetric
-// (relative 1e-9) or not positive definite.
-Eigen::MatrixXd whitening_matrix(const Eigen::MatrixXd& inverse);
-
 double mahalanobis(const DetectionCalibration& calibration, const Eigen::VectorXd& error);
 
 // d over a log: element j belongs to t = j + 1 + calibration.steps (see

@@ -23,8 +23,7 @@ namespace hadynet::trainer {
 // variance (needs B >= 2); kEval: running statistics. eps = 1e-5 in both.
 enum class BnMode { kTrain, kEval };
 
-inline constexpr double kBnEps = 1e-5;
-inline constexpr double kBnMomentum = 0.1;
+inline constexpr double kBnMomentum = 0.1;  // (kBnEps: hadynet_params.h)
 
 // Truncation depth meaning "full BPTT" (any value >= N does the same).
 inline constexpr int kFullBptt = std::numeric_limits<int>::max();

@@ -14,6 +14,10 @@
 
 namespace hadynet::trainer {
 
+// The encoder batch norm's epsilon (PyTorch BatchNorm1d's default), in the
+// network (hadynet_network.h) and in the fold (batch_norm_fold.h).
+inline constexpr double kBnEps = 1e-5;
+
 // Sizes of one model. All come from the data (column counts of the logs);
 // nothing in the trainer assumes the paper's 37/8/27.
 struct HadynetDims {

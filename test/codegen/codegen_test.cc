@@ -448,11 +448,22 @@ TEST_F(CodegenTool, RejectedModelsWriteNothing) {
   EXPECT_FALSE(fs::exists(dir_ / "new"));
 }
 
-TEST_F(CodegenTool, HelpOfBothCommands) {
-  EXPECT_EQ(run("measure-ranges --help"), 0);
-  EXPECT_TRUE(contains(read(dir_ / "stdout"), "usage: hadynet-codegen measure-ranges"));
+TEST_F(CodegenTool, HelpOfBothTools) {
   EXPECT_EQ(run("--help"), 0);
   EXPECT_TRUE(contains(read(dir_ / "stdout"), "usage: hadynet-codegen MODEL"));
+  const std::string measure = "'" + std::string(HADYNET_MEASURE_RANGES_TOOL) + "' --help > " +
+                              (dir_ / "stdout").string() + " 2> " + (dir_ / "stderr").string();
+  EXPECT_EQ(WEXITSTATUS(std::system(measure.c_str())), 0);
+  EXPECT_TRUE(contains(read(dir_ / "stdout"), "usage: hadynet-measure-ranges MODEL"));
+}
+
+// hadynet-codegen links no trainer network (its output must not depend on
+// the machine): --logs is a usage error that says where it is.
+TEST_F(CodegenTool, LogsAreForTheToolsThatMeasure) {
+  EXPECT_EQ(run("model.safetensors --numeric q15 --out " + (dir_ / "gen").string() + " --logs a.log"), 2);
+  EXPECT_TRUE(contains(read(dir_ / "stderr"), "hadynet-measure-ranges")) << read(dir_ / "stderr");
+  EXPECT_TRUE(contains(read(dir_ / "stderr"), "hadynet codegen --logs")) << read(dir_ / "stderr");
+  EXPECT_FALSE(fs::exists(dir_ / "gen"));
 }
 
 // The numbers of a generated `static constexpr ... name[...] = {a, b, ...};`.

@@ -6,6 +6,11 @@
 //   HADYNET_UPDATE_GOLDEN=1 build/release/test/codegen/codegen_golden_tests
 // and commit the new files with the change that explains them.
 //
+// This test links portable code only (codegen, the model-file and
+// deploy-math libraries; no -march=native), as hadynet-codegen does: the
+// golden bytes are what every x86-64 machine must write, so a run on another
+// machine checks that codegen's output does not depend on the CPU.
+//
 // The same golden headers are compiled into this test (they must satisfy
 // firmware/core/model_contract.h: each ends in a static_assert of it) and
 // their dimensions are checked against the model they came from.

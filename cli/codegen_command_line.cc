@@ -1,6 +1,4 @@
-#include "codegen/codegen_command.h"
-
-#include "datalog/robot_profile.h"
+#include "cli/codegen_command_line.h"
 
 #include <charconv>
 #include <cstdio>
@@ -9,9 +7,11 @@
 
 #include "cli/options.h"
 #include "codegen/codegen.h"
-#include "trainer/deploy_prep.h"
+#include "datalog/robot_profile.h"
 
-namespace hadynet::codegen {
+namespace hadynet::cli {
+
+using namespace codegen;
 
 namespace {
 
@@ -47,8 +47,8 @@ void print_formats(const Formats& f) {
 
 }  // namespace
 
-int run_codegen_command(const std::string& program, const std::string& command, int argc,
-                        char** argv) {
+int run_codegen_command(const std::string& program, const std::string& command, int argc, char** argv,
+                        const RangeMeasure& measure) {
   cli::Options opt(
       command,
       "Generates one allocation-free C++ header from a trained model file: every constant and\n"
@@ -57,7 +57,8 @@ int run_codegen_command(const std::string& program, const std::string& command, 
       "model's measured value ranges, int32 biases) or float32 (f32). Writes\n"
       "DIR/hadynet_model_<numeric>.h atomically; an unsupported model is rejected before anything\n"
       "is written (docs/codegen.md). --logs: measure the value ranges on the logs given after MODEL\n"
-      "instead of using those stored in the model.",
+      "instead of using those stored in the model (hadynet codegen only; hadynet-codegen uses the\n"
+      "stored ranges, so that its output is the same on every machine).",
       "MODEL --numeric q15|f32 --out DIR [options] [--logs LOG|DIR...]", program);
   opt.value("numeric", "q15|f32", "number format of the generated model");
   opt.value("out", "DIR", "directory to write hadynet_model_<numeric>.h into (created if needed)");
@@ -98,6 +99,14 @@ int run_codegen_command(const std::string& program, const std::string& command, 
     std::fprintf(stderr, "%s: %s\n", who.c_str(),
                  with_logs ? "--logs needs logs or folders after MODEL"
                            : "give one MODEL (logs after it only with --logs)");
+    return 2;
+  }
+  if (with_logs && !measure) {
+    std::fprintf(stderr,
+                 "%s: --logs runs the trainer's network, which this tool does not link (its output must be\n"
+                 "the same bytes on every machine): store the ranges with hadynet-measure-ranges or\n"
+                 "`hadynet measure-ranges` first, or use `hadynet codegen --logs`\n",
+                 who.c_str());
     return 2;
   }
   CodegenOptions options;
@@ -171,7 +180,7 @@ int run_codegen_command(const std::string& program, const std::string& command, 
     LoadedModel loaded = load_model_file(model_path);
     if (with_logs) {
       const std::vector<std::string> logs(opt.positional().begin() + 1, opt.positional().end());
-      loaded.model.ranges = trainer::measure_log_ranges(loaded.model, logs);
+      loaded.model.ranges = measure(loaded.model, logs);
       std::printf("value ranges measured on %s\n", loaded.model.ranges->source.c_str());
     }
     GeneratedHeader header;
@@ -191,4 +200,4 @@ int run_codegen_command(const std::string& program, const std::string& command, 
   return 0;
 }
 
-}  // namespace hadynet::codegen
+}  // namespace hadynet::cli

@@ -1,4 +1,4 @@
-// measure-ranges (`hadynet measure-ranges`, `hadynet-codegen measure-ranges`): the value ranges of every tensor the firmware
+// measure-ranges (`hadynet measure-ranges`, `hadynet-measure-ranges`): the value ranges of every tensor the firmware
 // computes (trainer/deploy_prep.h), measured over every window of the given
 // logs and stored in the model file, from which codegen picks the fixed-point
 // formats (docs/codegen.md). `hadynet train` stores them already; this
@@ -6,15 +6,15 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "cli/codegen_command_line.h"
 #include "cli/options.h"
-#include "codegen/codegen_command.h"
 #include "trainer/deploy_prep.h"
 #include "trainer/model_file.h"
 
-namespace hadynet::codegen {
+namespace hadynet::cli {
 
-int run_measure_ranges_command(const std::string& program, int argc, char** argv) {
-  cli::Options opt("measure-ranges",
+int run_measure_ranges_command(const std::string& program, const std::string& command, int argc, char** argv) {
+  Options opt(command,
               "Measures the largest absolute value of the inputs, encoder, LSTM gates, cell and hidden\n"
               "states and outputs (standardised units, BN in eval mode) over every N_train-step window of\n"
               "the logs, each log with its state's PB (its metadata 'state' must be in the model's PB\n"
@@ -24,9 +24,9 @@ int run_measure_ranges_command(const std::string& program, int argc, char** argv
   opt.value("out", "MODEL", "model file to write instead of rewriting MODEL");
   if (!opt.parse(argc, argv)) return 2;
   if (opt.help_requested()) return 0;
+  const std::string who = command.empty() ? program : program + " " + command;
   if (opt.positional().size() < 2) {
-    std::fprintf(stderr, "%s measure-ranges: give MODEL and logs or folders (see --help)\n",
-                 program.c_str());
+    std::fprintf(stderr, "%s: give MODEL and logs or folders (see --help)\n", who.c_str());
     return 2;
   }
   const std::string model_path = opt.positional().front();
@@ -43,10 +43,10 @@ int run_measure_ranges_command(const std::string& program, int argc, char** argv
     trainer::save_model(out, model);
     std::printf("wrote %s\n", out.c_str());
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s measure-ranges: %s\n", program.c_str(), e.what());
+    std::fprintf(stderr, "%s: %s\n", who.c_str(), e.what());
     return 1;
   }
   return 0;
 }
 
-}  // namespace hadynet::codegen
+}  // namespace hadynet::cli
