@@ -13,6 +13,7 @@ set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
 
 set(mcu_flags "-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16")
 set(CMAKE_C_FLAGS_INIT "${mcu_flags} -ffunction-sections -fdata-sections")
+set(CMAKE_ASM_FLAGS_INIT "${mcu_flags}")
 set(CMAKE_CXX_FLAGS_INIT "${mcu_flags} -ffunction-sections -fdata-sections -fno-exceptions -fno-rtti -fno-threadsafe-statics")
 set(CMAKE_EXE_LINKER_FLAGS_INIT "${mcu_flags} -Wl,--gc-sections --specs=nano.specs")
 

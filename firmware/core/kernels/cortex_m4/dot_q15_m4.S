@@ -1,0 +1,313 @@
+@ Cortex-M4 (ARMv7E-M, DSP extension) kernels of firmware/core/kernels/dot_q15.h;
+@ their C++ side, with the contracts, is dot_q15.cc next to this file. The
+@ job layouts and block sizes are single-sourced in kernel_layout.h, which
+@ dot_q15.cc checks against its structs with offsetof; each unrolled loop
+@ checks here that its blocks have the size the entry arithmetic assumes.
+#include "firmware/core/kernels/cortex_m4/kernel_layout.h"
+
+@ Fails the assembly unless the code from `start` to `end` is `blocks`
+@ blocks of `bytes` bytes each (the C++ side enters a loop at end - k * bytes).
+        .macro  HADYNET_CHECK_BLOCKS start, end, blocks, bytes
+        .if     (\end - \start) != (\blocks * \bytes)
+        .error  "an unrolled block is not the size kernel_layout.h says"
+        .endif
+        .endm
+        .syntax unified
+        .thumb
+        .text
+
+@ ---------------------------------------------------------------------------
+@ hadynet_matvec_pairs(const HadynetMatvecJob* job)
+@ One block = eight columns of two rows, eleven 32-bit instructions (44 bytes):
+@   r0 x pointer, r1 W pointer (packed), r2-r5 x words, r6-r9 W words,
+@   r10:r11 first row's accumulator (low:high), r12:lr the second row's.
+
+        .macro  HADYNET_MVP_BLOCK
+        ldmia.w r0!, {r2-r5}
+        ldmia.w r1!, {r6-r9}
+        smlald  r10, r11, r6, r2
+        smlald  r10, r11, r7, r3
+        smlald  r10, r11, r8, r4
+        smlald  r10, r11, r9, r5
+        ldmia.w r1!, {r6-r9}
+        smlald  r12, lr, r6, r2
+        smlald  r12, lr, r7, r3
+        smlald  r12, lr, r8, r4
+        smlald  r12, lr, r9, r5
+        .endm
+
+@ One row's rounding: acc (lo:hi) + half - (acc < 0), >> out_shift,
+@ saturated to int16 into lo. r2 = half, r3 = out_shift, r4 = 32 - out_shift;
+@ clobbers r5.
+        .macro  HADYNET_MVP_ROUND lo, hi
+        asr     r5, \hi, #31
+        adds    \lo, \lo, r2
+        adc     \hi, \hi, #0
+        adds    \lo, \lo, r5
+        adc     \hi, \hi, r5
+        lsr     \lo, \lo, r3
+        lsl     r5, \hi, r4
+        orr     \lo, \lo, r5
+        asr     \hi, \hi, r3
+        cmp     \hi, \lo, asr #31               @ fits int32?
+        itee    eq
+        ssateq  \lo, #16, \lo                   @ yes: saturate to int16
+        movwne  \lo, #0x7fff                    @ no: the rail of its sign
+        eorne   \lo, \lo, \hi, asr #31
+        .endm
+
+        .global hadynet_matvec_pairs
+        .type   hadynet_matvec_pairs, %function
+        .thumb_func
+        .p2align 2
+hadynet_matvec_pairs:
+        push    {r4-r11, lr}
+        sub     sp, sp, #HADYNET_MVP_JOB_BYTES
+        ldmia   r0!, {r1-r8}                    @ the job (16 words) onto the stack
+        stmia   sp, {r1-r8}
+        ldmia   r0, {r1-r8}
+        add     r9, sp, #32
+        stmia   r9, {r1-r8}
+.Lmvp_pair:
+        ldr     r1, [sp, #HADYNET_MVP_A_PAIR]
+        ldr     r0, [sp, #HADYNET_MVP_A_X]
+        mov     r10, #0
+        mov     r11, #0
+        mov     r12, #0
+        mov     lr, #0
+        ldr     pc, [sp, #HADYNET_MVP_A_ENTRY]  @ into the A loop
+.Lmvp_a_start:
+        .rept   HADYNET_MVP_BLOCKS
+        HADYNET_MVP_BLOCK
+        .endr
+        .global hadynet_mvp_end_a
+hadynet_mvp_end_a:
+        HADYNET_CHECK_BLOCKS .Lmvp_a_start, hadynet_mvp_end_a, HADYNET_MVP_BLOCKS, HADYNET_MVP_BLOCK_BYTES
+        ldrd    r8, r9, [sp, #HADYNET_MVP_A_SHIFT]  @ both accumulators <<= a_shift (a_shift, a_shift_rest)
+        lsl     r11, r11, r8
+        lsr     r2, r10, r9
+        orr     r11, r11, r2
+        lsl     r10, r10, r8
+        lsl     lr, lr, r8
+        lsr     r2, r12, r9
+        orr     lr, lr, r2
+        lsl     r12, r12, r8
+        ldr     r1, [sp, #HADYNET_MVP_B_PAIR]
+        ldr     r0, [sp, #HADYNET_MVP_B_X]
+        ldr     pc, [sp, #HADYNET_MVP_B_ENTRY]  @ into the B loop
+.Lmvp_b_start:
+        .rept   HADYNET_MVP_BLOCKS
+        HADYNET_MVP_BLOCK
+        .endr
+        .global hadynet_mvp_end_b
+hadynet_mvp_end_b:
+        HADYNET_CHECK_BLOCKS .Lmvp_b_start, hadynet_mvp_end_b, HADYNET_MVP_BLOCKS, HADYNET_MVP_BLOCK_BYTES
+        ldmia   sp, {r0-r4}                     @ bias, out, half, out_shift, 32 - out_shift (offsets 0..16)
+        ldrd    r6, r7, [r0], #8                @ the pair's biases, sign-extended in
+        adds    r10, r10, r6
+        adc     r11, r11, r6, asr #31
+        adds    r12, r12, r7
+        adc     lr, lr, r7, asr #31
+        HADYNET_MVP_ROUND r10, r11
+        HADYNET_MVP_ROUND r12, lr
+        strh    r10, [r1], #2
+        strh    r12, [r1], #2
+        stmia   sp, {r0-r1}
+        add     r5, sp, #HADYNET_MVP_A_PAIR     @ next row pair
+        ldmia   r5, {r6-r10}                    @ A pair, B pair, pairs, A/B pair bytes (consecutive)
+        add     r6, r6, r9
+        add     r7, r7, r10
+        subs    r8, r8, #1
+        stmia   r5, {r6-r8}
+        bne     .Lmvp_pair
+        add     sp, sp, #HADYNET_MVP_JOB_BYTES
+        pop     {r4-r11, pc}
+        .size   hadynet_matvec_pairs, . - hadynet_matvec_pairs
+
+@ ---------------------------------------------------------------------------
+@ hadynet_tanh_block(v, n, table) / hadynet_sigmoid_block(v, n, table)
+@ activation.h: m = |x|; tanh(m / 2^(shift + 5)) = T[i] + ((T[i+1] - T[i]) f
+@ + 2^(shift - 1)) >> shift with i = m >> shift, f = m mod 2^shift (f = 0
+@ gives T[i]); negated for x < 0. tanh: shift 7. sigmoid: shift 8, then
+@ (32768 + t + 1) >> 1, at most 32767.
+@   r0 v, r1 n, r2 table, r3 x, r4 m / f, r5 i / d, r6 T[i] | T[i+1] << 16,
+@   r7 y, r8 32769 (sigmoid).
+        .global hadynet_tanh_block
+        .type   hadynet_tanh_block, %function
+        .thumb_func
+        .p2align 2
+hadynet_tanh_block:
+        push    {r4-r7}
+1:
+        ldrsh   r3, [r0]
+        eor     r4, r3, r3, asr #31
+        sub     r4, r4, r3, asr #31
+        usat    r4, #15, r4                     @ m = min(|x|, 32767): i <= 255
+        lsr     r5, r4, #7
+        and     r4, r4, #127
+        ldr     r6, [r2, r5, lsl #1]
+        sxth    r7, r6
+        rsb     r5, r7, r6, asr #16
+        mul     r5, r5, r4
+        add     r5, r5, #64
+        add     r7, r7, r5, asr #7
+        eor     r7, r7, r3, asr #31
+        sub     r7, r7, r3, asr #31
+        strh    r7, [r0], #2
+        subs    r1, r1, #1
+        bne     1b
+        pop     {r4-r7}
+        bx      lr
+        .size   hadynet_tanh_block, . - hadynet_tanh_block
+
+        .global hadynet_sigmoid_block
+        .type   hadynet_sigmoid_block, %function
+        .thumb_func
+        .p2align 2
+hadynet_sigmoid_block:
+        push    {r4-r8}
+        movw    r8, #32769
+1:
+        ldrsh   r3, [r0]
+        eor     r4, r3, r3, asr #31
+        sub     r4, r4, r3, asr #31             @ m = |x| <= 32768: i <= 128
+        lsr     r5, r4, #8
+        and     r4, r4, #255
+        ldr     r6, [r2, r5, lsl #1]
+        sxth    r7, r6
+        rsb     r5, r7, r6, asr #16
+        mul     r5, r5, r4
+        add     r5, r5, #128
+        add     r7, r7, r5, asr #8
+        eor     r7, r7, r3, asr #31
+        sub     r7, r7, r3, asr #31
+        add     r7, r7, r8
+        asr     r7, r7, #1
+        ssat    r7, #16, r7
+        strh    r7, [r0], #2
+        subs    r1, r1, #1
+        bne     1b
+        pop     {r4-r8}
+        bx      lr
+        .size   hadynet_sigmoid_block, . - hadynet_sigmoid_block
+
+@ ---------------------------------------------------------------------------
+@ hadynet_dot_rows_split(const HadynetSplitJob* job)
+@ One block = eight columns, eleven 32-bit instructions (44 bytes):
+@   r0 split-g pointer, r1 W pointer, r2-r5 g words, r6-r9 W words,
+@   r10:r11 sum of W gh, r12:lr sum of W gl.
+
+        .macro  HADYNET_SPLIT_BLOCK
+        ldmia.w r1!, {r6-r9}
+        ldmia.w r0!, {r2-r5}
+        smlald  r10, r11, r6, r2
+        smlald  r10, r11, r7, r3
+        smlald  r10, r11, r8, r4
+        smlald  r10, r11, r9, r5
+        ldmia.w r0!, {r2-r5}
+        smlald  r12, lr, r6, r2
+        smlald  r12, lr, r7, r3
+        smlald  r12, lr, r8, r4
+        smlald  r12, lr, r9, r5
+        .endm
+
+        .global hadynet_dot_rows_split
+        .type   hadynet_dot_rows_split, %function
+        .thumb_func
+        .p2align 2
+hadynet_dot_rows_split:
+        push    {r4-r11, lr}
+        sub     sp, sp, #HADYNET_SPLIT_JOB_BYTES
+        ldmia   r0, {r1-r6}                     @ the job (6 words) onto the stack
+        stmia   sp, {r1-r6}
+.Lsplit_row:
+        ldr     r1, [sp, #HADYNET_SPLIT_ROW]
+        ldr     r0, [sp, #HADYNET_SPLIT_G]
+        mov     r10, #0
+        mov     r11, #0
+        mov     r12, #0
+        mov     lr, #0
+        ldr     pc, [sp, #HADYNET_SPLIT_ENTRY]
+.Lsplit_start:
+        .rept   HADYNET_SPLIT_BLOCKS
+        HADYNET_SPLIT_BLOCK
+        .endr
+        .global hadynet_split_end
+hadynet_split_end:
+        HADYNET_CHECK_BLOCKS .Lsplit_start, hadynet_split_end, HADYNET_SPLIT_BLOCKS, HADYNET_SPLIT_BLOCK_BYTES
+        lsl     r11, r11, #16                   @ 2^16 sum_h + sum_l
+        orr     r11, r11, r10, lsr #16
+        lsl     r10, r10, #16
+        adds    r10, r10, r12
+        adc     r11, r11, lr
+        ldmia   sp, {r2-r5}                     @ r2 row, r3 rows, r4 out, r5 stride (offsets 0..12)
+        strd    r10, r11, [r4], #8
+        add     r2, r2, r5
+        subs    r3, r3, #1
+        stmia   sp, {r2-r4}
+        bne     .Lsplit_row
+        add     sp, sp, #HADYNET_SPLIT_JOB_BYTES
+        pop     {r4-r11, pc}
+        .size   hadynet_dot_rows_split, . - hadynet_dot_rows_split
+
+@ ---------------------------------------------------------------------------
+@ hadynet_dot_cols4(w, stride_bytes, g, rows, out)
+@ One row of W^T g: four columns (r0 points at W[r][c]), g[r] shared.
+@ Ten 32-bit instructions (40 bytes):
+@   r0 W pointer, r1 stride in bytes, r2 g pointer, r3 passes of 8 rows,
+@   r4 g[r], r5 W value, r6:r7, r8:r9, r10:r11, r12:lr accumulators.
+        .macro  HADYNET_COLS_ROW
+        ldr.w   r4, [r2], #4
+        ldrsh.w r5, [r0, #0]
+        smlal   r6, r7, r5, r4
+        ldrsh.w r5, [r0, #2]
+        smlal   r8, r9, r5, r4
+        ldrsh.w r5, [r0, #4]
+        smlal   r10, r11, r5, r4
+        ldrsh.w r5, [r0, #6]
+        smlal   r12, lr, r5, r4
+        add.w   r0, r0, r1
+        .endm
+
+        .global hadynet_dot_cols4
+        .type   hadynet_dot_cols4, %function
+        .thumb_func
+        .p2align 2
+hadynet_dot_cols4:
+        push    {r4-r11, lr}
+        mov     r6, #0
+        mov     r7, #0
+        mov     r8, #0
+        mov     r9, #0
+        mov     r10, #0
+        mov     r11, #0
+        mov     r12, #0
+        mov     lr, #0
+        @ Enter the 8-row body so that the first pass does rows % 8 rows
+        @ (8 if rows % 8 == 0); r3 becomes the number of passes.
+        and     r4, r3, #7
+        adds    r3, r3, #7
+        lsrs    r3, r3, #3
+        cbz     r4, 3f
+        rsb     r4, r4, #8
+        mov     r5, #HADYNET_COLS_ROW_BYTES
+        mul     r4, r4, r5
+        adr.w   r5, 1f
+        add     r4, r4, r5
+        orr     r4, r4, #1
+        bx      r4
+3:
+1:
+        .rept   8
+        HADYNET_COLS_ROW
+        .endr
+        HADYNET_CHECK_BLOCKS 1b, ., 8, HADYNET_COLS_ROW_BYTES
+        subs    r3, r3, #1
+        bne     1b
+        ldr     r4, [sp, #36]
+        strd    r6, r7, [r4]
+        strd    r8, r9, [r4, #8]
+        strd    r10, r11, [r4, #16]
+        strd    r12, lr, [r4, #24]
+        pop     {r4-r11, pc}
+        .size   hadynet_dot_cols4, . - hadynet_dot_cols4

@@ -1,0 +1,50 @@
+/* The layout the Cortex-M4 assembly (dot_q15_m4.S) and its C++ side
+ * (dot_q15.cc) share: byte offsets of the job blocks' fields and the sizes of
+ * the unrolled loops. Plain #defines, so that the assembler's preprocessor
+ * reads the same numbers as the compiler; dot_q15.cc checks every offset
+ * against its structs with offsetof, and the assembly checks every loop's
+ * block size (HADYNET_CHECK_BLOCKS). Change a struct, a loop or these numbers
+ * together: the build fails otherwise. */
+#ifndef HADYNET_FIRMWARE_CORE_KERNELS_CORTEX_M4_KERNEL_LAYOUT_H_
+#define HADYNET_FIRMWARE_CORE_KERNELS_CORTEX_M4_KERNEL_LAYOUT_H_
+
+/* hadynet_matvec_pairs: one block = 8 columns of a row pair, 11 32-bit
+ * instructions; up to 32 blocks (256 columns) per term. */
+#define HADYNET_MVP_BLOCKS 32
+#define HADYNET_MVP_BLOCK_BYTES 44
+/* HadynetMatvecJob (16 words, copied onto the assembly's stack). */
+#define HADYNET_MVP_JOB_BYTES 64
+#define HADYNET_MVP_BIAS 0
+#define HADYNET_MVP_OUT 4
+#define HADYNET_MVP_HALF 8
+#define HADYNET_MVP_OUT_SHIFT 12
+#define HADYNET_MVP_OUT_SHIFT_REST 16
+#define HADYNET_MVP_A_PAIR 20
+#define HADYNET_MVP_B_PAIR 24
+#define HADYNET_MVP_PAIRS 28
+#define HADYNET_MVP_A_PAIR_BYTES 32
+#define HADYNET_MVP_B_PAIR_BYTES 36
+#define HADYNET_MVP_A_X 40
+#define HADYNET_MVP_A_ENTRY 44
+#define HADYNET_MVP_B_X 48
+#define HADYNET_MVP_B_ENTRY 52
+#define HADYNET_MVP_A_SHIFT 56
+#define HADYNET_MVP_A_SHIFT_REST 60
+
+/* hadynet_dot_rows_split: one block = 8 columns, 11 32-bit instructions; up
+ * to 64 blocks (512 columns). */
+#define HADYNET_SPLIT_BLOCKS 64
+#define HADYNET_SPLIT_BLOCK_BYTES 44
+/* HadynetSplitJob (6 words, copied onto the assembly's stack). */
+#define HADYNET_SPLIT_JOB_BYTES 24
+#define HADYNET_SPLIT_ROW 0
+#define HADYNET_SPLIT_ROWS 4
+#define HADYNET_SPLIT_OUT 8
+#define HADYNET_SPLIT_STRIDE 12
+#define HADYNET_SPLIT_G 16
+#define HADYNET_SPLIT_ENTRY 20
+
+/* hadynet_dot_cols4: one row of four columns, 10 32-bit instructions. */
+#define HADYNET_COLS_ROW_BYTES 40
+
+#endif /* HADYNET_FIRMWARE_CORE_KERNELS_CORTEX_M4_KERNEL_LAYOUT_H_ */
