@@ -7,30 +7,22 @@
 #include "firmware/core/hadynet_runtime.h"
 #include "hadynet_model_f32.h"
 #include "hadynet_model_q15.h"
+#include "host-sim/channel_binding.h"
 #include "host-sim/plant/grasp_session.h"
 
 namespace hadynet::hostsim {
 
 namespace {
 
-// Position of `name` in `names`; throws std::invalid_argument naming it.
-std::size_t index_of(const std::vector<std::string>& names, const char* name, const char* what) {
-  for (std::size_t k = 0; k < names.size(); ++k)
-    if (names[k] == name) return k;
-  throw std::invalid_argument(std::string("the plant has no ") + what + " '" + name + "'");
-}
-
 template <class M>
 ClosedLoopRun run_with(const ClosedLoopOptions& opt) {
   plant::GraspSession session(opt.object, opt.init_id, opt.wear_level, opt.seed, opt.disturbance);
   // The model's channels in the plant's order; a derived input is computed
   // by the firmware from its base command, not sent to the plant (kNoCommand).
-  constexpr std::size_t kNoCommand = static_cast<std::size_t>(-1);
+  constexpr std::size_t kNoCommand = ChannelBinding::kComputed;
   const auto derived = [](int i) { return M::kUDerived[i] != firmware::DerivedKind::kNone; };
-  std::vector<std::size_t> y_index, u_index;
-  for (int i = 0; i < M::kY; ++i) y_index.push_back(index_of(session.y_names(), M::kYNames[i], "channel"));
-  for (int i = 0; i < M::kU; ++i)
-    u_index.push_back(derived(i) ? kNoCommand : index_of(session.u_names(), M::kUNames[i], "command"));
+  const ChannelBinding binding = bind_channels<M>(session.y_names(), session.u_names(), "the plant", "channel", "command");
+  const std::vector<std::size_t>& u_index = binding.u;
 
   auto rt = std::make_unique<firmware::HadynetRuntime<M>>();
   if (!opt.pb_state.empty()) {
@@ -56,11 +48,8 @@ ClosedLoopRun run_with(const ClosedLoopOptions& opt) {
   std::vector<double> u(session.u_names().size(), 0.0);
   for (int t = 0; t <= opt.steps; ++t) {
     const std::vector<double>& y = session.y();
-    for (int i = 0; i < M::kY; ++i) frame.y[i] = static_cast<float>(y[y_index[static_cast<std::size_t>(i)]]);
-    for (int i = 0; i < M::kU; ++i) {
-      const std::size_t k = u_index[static_cast<std::size_t>(i)];
-      frame.u_prev[i] = k == kNoCommand ? 0.0f : static_cast<float>(session.last_u()[k]);
-    }
+    fill_frame<M>(
+        binding, [&](std::size_t k) { return y[k]; }, [&](std::size_t k) { return session.last_u()[k]; }, frame);
     const firmware::StepResult<M> r = rt->step(frame);
     ClosedLoopStep s;
     s.step = t;

@@ -51,8 +51,9 @@ struct ClosedLoopRun {
   double mean_error(std::size_t begin, std::size_t end) const;
 };
 
-// Runs one closed loop. Throws std::invalid_argument for an unknown PB state
-// or a plant whose channels the compiled model does not read.
+// Runs one closed loop. Throws std::invalid_argument for an unknown PB state,
+// std::runtime_error for a plant without a channel the compiled model reads
+// (host-sim/channel_binding.h).
 ClosedLoopRun run_closed_loop(const ClosedLoopOptions& options);
 
 }  // namespace hadynet::hostsim

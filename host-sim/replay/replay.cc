@@ -8,6 +8,7 @@
 #include "datalog/log_reader.h"
 #include "hadynet_model_f32.h"
 #include "hadynet_model_q15.h"
+#include "host-sim/channel_binding.h"
 #include "tools/link/link_session.h"
 #include "tools/link/qemu_process.h"
 
@@ -36,27 +37,6 @@ CompiledModelInfo info_of() {
   for (int i = 0; i < M::kU; ++i) info.u_names.emplace_back(M::kUNames[i]);
   for (int i = 0; i < M::kStates; ++i) info.state_names.emplace_back(M::kStateNames[i]);
   return info;
-}
-
-// A model channel the log need not have (map_columns): the frame carries 0.
-constexpr std::size_t kNotLogged = static_cast<std::size_t>(-1);
-
-// Column index of every model channel in the log, in model order. A channel
-// with `computed[i]` (a derived input: the firmware computes it from its base
-// command) may be absent and maps to kNotLogged.
-std::vector<std::size_t> map_columns(const datalog::LogTable& log, const std::string& file,
-                                     const std::vector<std::string>& names, const std::vector<bool>& computed = {}) {
-  std::vector<std::size_t> cols;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    const auto c = log.column_index(names[i]);
-    if (!c && i < computed.size() && computed[i]) {
-      cols.push_back(kNotLogged);
-      continue;
-    }
-    if (!c) throw std::runtime_error(file + ": no column '" + names[i] + "', which the compiled model reads");
-    cols.push_back(*c);
-  }
-  return cols;
 }
 
 // The firmware compiled into this program.
@@ -114,14 +94,11 @@ template <class M, class Device>
 ReplayResult replay_on(Device& device, const datalog::LogTable& log, const std::string& file,
                        const ReplayOptions& opt) {
   const CompiledModelInfo info = info_of<M>();
-  const auto y_cols = map_columns(log, file, info.y_names);
-  std::vector<bool> derived;
-  for (int i = 0; i < M::kU; ++i) derived.push_back(M::kUDerived[i] != firmware::DerivedKind::kNone);
-  const auto u_cols = map_columns(log, file, info.u_names, derived);
+  const ChannelBinding binding = bind_channels<M>(log.columns, log.columns, file, "column", "column");
   const auto t_col = log.column_index("t");
-  std::vector<std::size_t> signal_cols = y_cols;
-  for (const std::size_t c : u_cols)
-    if (c != kNotLogged) signal_cols.push_back(c);
+  std::vector<std::size_t> signal_cols = binding.y;
+  for (const std::size_t c : binding.u)
+    if (c != ChannelBinding::kComputed) signal_cols.push_back(c);
   datalog::check_magnitudes(log, signal_cols, datalog::kMaxSignalMagnitude, file,
                             "the firmware's boundary is float32 (docs/input-limits.md)");
   if (!opt.pb.empty()) {
@@ -145,11 +122,10 @@ ReplayResult replay_on(Device& device, const datalog::LogTable& log, const std::
   for (std::size_t row = 0; row < log.rows(); ++row) {
     if (opt.control_from >= 0 && row == static_cast<std::size_t>(opt.control_from))
       device.set_mode(firmware::Mode::kControl);
-    for (int i = 0; i < M::kY; ++i) frame.y[i] = static_cast<float>(log.at(row, y_cols[static_cast<std::size_t>(i)]));
-    for (int i = 0; i < M::kU; ++i)
-      frame.u_prev[i] = row == 0 || u_cols[static_cast<std::size_t>(i)] == kNotLogged
-                            ? 0.0f
-                            : static_cast<float>(log.at(row - 1, u_cols[static_cast<std::size_t>(i)]));
+    // u_{t-1}: none before the first row.
+    fill_frame<M>(
+        binding, [&](std::size_t c) { return log.at(row, c); },
+        [&](std::size_t c) { return row == 0 ? 0.0 : log.at(row - 1, c); }, frame);
     ReplayStep s;
     const firmware::StepResult<M> r = device.step(frame, s);
     s.time = t_col ? log.at(row, *t_col) : static_cast<double>(row);
