@@ -94,8 +94,10 @@ int run_adapt(int argc, char** argv) {
     const trainer::HadynetModel model = trainer::load_model(opt.positional().front());
     const std::vector<std::string> log_args(opt.positional().begin() + 1, opt.positional().end());
     std::vector<trainer::LogSequence> logs = read_sequences(log_args, model);
-    const Eigen::VectorXf start = parse_pb(model, opt.get("start"));
+    const std::vector<Eigen::VectorXf> starts = parse_start_pbs(model, opt.get("start"));
     if (opt.has("online")) {
+      if (starts.size() != 1) throw std::runtime_error("--online adapts from one start PB (not 'objects')");
+      const Eigen::VectorXf& start = starts.front();
       trainer::OnlinePbAdapter::Options online;
       online.start_windows = static_cast<int>(*start_windows);
       online.max_windows = static_cast<int>(*max_windows);
@@ -104,7 +106,7 @@ int run_adapt(int argc, char** argv) {
       return run_online(model, logs, start, online, opt.get("csv"), opt.get("plot"));
     }
     const std::vector<AdaptedState> results =
-        adapt_each_state(model, group_by_state(std::move(logs)), start, *adapt);
+        adapt_each_state(model, group_by_state(std::move(logs)), starts, *adapt);
     std::printf("%-22s %-11s %7s %11s %11s %7s  PB\n", "state", "object", "windows", "loss before",
                 "loss after", "drop");
     for (const auto& r : results) {

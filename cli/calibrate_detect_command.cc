@@ -54,7 +54,7 @@ int run_calibrate_detect(int argc, char** argv) {
     std::string source = std::to_string(logs.size()) + " logs";
     if (opt.get("pb") == "adapt") {
       StateGroup all{"calibration", "", logs};
-      const auto adapted = adapt_each_state(model, {all}, parse_pb(model, opt.get("start")), *adapt);
+      const auto adapted = adapt_each_state(model, {all}, parse_start_pbs(model, opt.get("start")), *adapt);
       pb = adapted.front().result.pb;
       std::printf("PB fitted to the calibration logs: loss %.5f -> %.5f, PB %s\n",
                   adapted.front().result.loss.front(), adapted.front().result.loss.back(),

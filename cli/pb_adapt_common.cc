@@ -11,7 +11,8 @@ namespace hadynet::cli {
 
 void add_adapt_options(Options& opt) {
   const trainer::AdaptOptions d;
-  opt.value("start", "PB", "initial PB: zero, a state of the model, or comma-separated values", "zero");
+  opt.value("start", "PB", "initial PB: zero, a state of the model, comma-separated values, or objects\n"
+            "(zero and each object's mean trained PB, keeping the best fit)", "zero");
   opt.value("epochs", "N", "full-batch epochs (paper: 20)", std::to_string(d.epochs));
   opt.value("lr", "X", "MomentumSGD learning rate", "1.0");
   opt.value("momentum", "X", "MomentumSGD momentum", "0.9");
@@ -27,7 +28,7 @@ std::optional<trainer::AdaptOptions> adapt_options(const Options& opt) {
 
 std::vector<AdaptedState> adapt_each_state(const trainer::HadynetModel& model,
                                            const std::vector<StateGroup>& groups,
-                                           const Eigen::VectorXf& start,
+                                           const std::vector<Eigen::VectorXf>& starts,
                                            const trainer::AdaptOptions& options) {
   std::vector<AdaptedState> out;
   for (const StateGroup& g : groups) {
@@ -40,7 +41,7 @@ std::vector<AdaptedState> adapt_each_state(const trainer::HadynetModel& model,
     std::vector<int> ids(static_cast<std::size_t>(data.size()));
     std::iota(ids.begin(), ids.end(), 0);
     out.push_back({g.state, g.object, data.size(),
-                   trainer::adapt_pb(model, data, ids, start, options)});
+                   trainer::adapt_pb_best_of(model, data, ids, starts, options)});
     if (!out.back().result.pb.allFinite()) {
       // Never print or store a NaN PB as a result.
       throw std::runtime_error("state '" + g.state + "': PB adaptation diverged (the PB is not finite); try a "

@@ -26,9 +26,10 @@ struct AdaptedState {
 };
 
 // Adapts one PB per group on all its windows (N_train steps each).
+// With several starts (parse_start_pbs), the best fit of them.
 std::vector<AdaptedState> adapt_each_state(const trainer::HadynetModel& model,
                                            const std::vector<StateGroup>& groups,
-                                           const Eigen::VectorXf& start,
+                                           const std::vector<Eigen::VectorXf>& starts,
                                            const trainer::AdaptOptions& options);
 
 void write_adapt_json(const std::string& path, const std::vector<AdaptedState>& results);

@@ -110,7 +110,7 @@ int run_simulate(int argc, char** argv) {
     Eigen::VectorXf pb;
     if (opt.get("pb") == "adapt") {
       const trainer::AdaptResult r =
-          adapt_each_state(model, {{seq.state, seq.object, {seq}}}, parse_pb(model, opt.get("start")), *adapt)
+          adapt_each_state(model, {{seq.state, seq.object, {seq}}}, parse_start_pbs(model, opt.get("start")), *adapt)
               .front()
               .result;
       pb = r.pb;

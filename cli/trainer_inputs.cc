@@ -1,6 +1,7 @@
 #include "cli/trainer_inputs.h"
 
 #include "datalog/log_reader.h"
+#include "trainer/recognition.h"
 
 #include <cstdio>
 #include <sstream>
@@ -64,6 +65,13 @@ Eigen::VectorXf parse_pb(const trainer::HadynetModel& model, const std::string& 
                              " values, the model's PB has " + std::to_string(dim));
   }
   return Eigen::Map<const Eigen::VectorXf>(values.data(), dim);
+}
+
+std::vector<Eigen::VectorXf> parse_start_pbs(const trainer::HadynetModel& model, const std::string& text) {
+  if (text != "objects") return {parse_pb(model, text)};
+  std::vector<Eigen::VectorXf> starts = {Eigen::VectorXf::Zero(model.params.dims.pb)};
+  for (Eigen::VectorXf& pb : trainer::object_mean_pbs(model)) starts.push_back(std::move(pb));
+  return starts;
 }
 
 std::string format_pb(const Eigen::VectorXf& pb) {

@@ -37,6 +37,11 @@ std::vector<StateGroup> group_by_state(std::vector<trainer::LogSequence> sequenc
 // table, or comma-separated numbers. Throws std::runtime_error with a message.
 Eigen::VectorXf parse_pb(const trainer::HadynetModel& model, const std::string& text);
 
+// The start PBs of an adaptation (--start): "objects" is the zero PB and
+// each object's mean trained PB (the best fit of them wins:
+// trainer::adapt_pb_best_of); anything else one PB as parse_pb reads it.
+std::vector<Eigen::VectorXf> parse_start_pbs(const trainer::HadynetModel& model, const std::string& text);
+
 std::string format_pb(const Eigen::VectorXf& pb);
 
 }  // namespace hadynet::cli

@@ -70,6 +70,20 @@ WindowBatch<float> single_state(WindowBatch<float> batch) {
 
 }  // namespace
 
+AdaptResult adapt_pb_best_of(const HadynetModel& model, const WindowDataset& data, std::span<const int> ids,
+                             const std::vector<Eigen::VectorXf>& starts, const AdaptOptions& options) {
+  if (starts.empty()) throw std::invalid_argument("PB adaptation: no start PB");
+  AdaptResult best;
+  for (std::size_t i = 0; i < starts.size(); ++i) {
+    AdaptResult r = adapt_pb(model, data, ids, starts[i], options);
+    // A diverged fit (non-finite PB or loss) never wins over a finite one.
+    const bool finite = r.pb.allFinite() && std::isfinite(r.loss.back());
+    const bool best_finite = i > 0 && best.pb.allFinite() && std::isfinite(best.loss.back());
+    if (i == 0 || (finite && (!best_finite || r.loss.back() < best.loss.back()))) best = std::move(r);
+  }
+  return best;
+}
+
 AdaptResult adapt_pb(const HadynetModel& model, const WindowDataset& data, std::span<const int> ids,
                      const Eigen::VectorXf& start, const AdaptOptions& options) {
   if (ids.empty()) throw std::invalid_argument("PB adaptation: no windows");

@@ -45,6 +45,13 @@ struct AdaptResult {
 AdaptResult adapt_pb(const HadynetModel& model, const WindowDataset& data, std::span<const int> ids,
                      const Eigen::VectorXf& start, const AdaptOptions& options);
 
+// Adapts from each of `starts` (at least one) and keeps the fit whose final
+// loss is lowest (the first on ties). The PB loss has local minima: a start
+// inside the right object's cluster of trained PBs can end elsewhere than a
+// start at zero. Cost: one adaptation per start.
+AdaptResult adapt_pb_best_of(const HadynetModel& model, const WindowDataset& data, std::span<const int> ids,
+                             const std::vector<Eigen::VectorXf>& starts, const AdaptOptions& options);
+
 // Online PB update over a stream of steps (paper: start once 100 windows are
 // available, keep the newest 200, 3 full-batch epochs per new step). The
 // stream may consist of several segments (e.g. one log per grasped object):

@@ -4,6 +4,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "trainer/hadynet_model.h"
@@ -17,6 +20,33 @@ struct NearestPb {
 };
 
 NearestPb nearest_pb(const HadynetModel& model, const Eigen::VectorXf& pb);
+
+// The object an adapted PB names, and how clearly. The margin is the
+// distance to the nearest trained PB of any other object over the distance
+// to the recognised one (>= 1; infinite when the model knows one object):
+// near 1, a small change of the adapted PB would name another object.
+struct Recognition {
+  NearestPb nearest;
+  std::string object;  // model.states[nearest.state].object
+  // Every object of the model with the distance to its nearest trained PB,
+  // closest first (the first is `object`).
+  std::vector<std::pair<std::string, double>> objects_by_distance;
+  double margin = 0;
+  bool clear = false;  // margin >= the clear margin asked for
+};
+
+// The margin at and above which a recognition is called clear (below:
+// ambiguous), chosen on the validation zeroings only (inits 4-6 of dataset
+// seed 1; docs/trainer.md, "Recognition over many zeroings", where the
+// fresh zeroings' figures are).
+inline constexpr double kClearRecognitionMargin = 1.25;
+
+Recognition recognize_object(const HadynetModel& model, const Eigen::VectorXf& pb,
+                             double clear_margin = kClearRecognitionMargin);
+
+// The mean trained PB of each object (objects in the order of their first
+// state), as starts of a multi-start adaptation (adapt_pb_best_of).
+std::vector<Eigen::VectorXf> object_mean_pbs(const HadynetModel& model);
 
 
 // Principal axes of a point set (rows = points), for 2-D maps.

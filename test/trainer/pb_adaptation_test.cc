@@ -79,6 +79,23 @@ TEST_F(PbAdaptation, ZeroEpochsAndErrors) {
   EXPECT_THROW(adapt_pb(model(), data_, ids_, Eigen::VectorXf::Zero(3), {}), std::invalid_argument);
 }
 
+// Several starts: the fit with the lowest final loss wins, bit for bit the
+// single-start fit from that start (the same deterministic computation).
+TEST_F(PbAdaptation, BestOfStartsKeepsTheLowestFinalLoss) {
+  const std::vector<Eigen::VectorXf> starts = {pb_of(0), pb_of(1), Eigen::VectorXf::Zero(pb_of(0).size())};
+  const AdaptOptions few{3, 1.0, 0.9};  // few epochs: the starts end at different losses
+  std::vector<AdaptResult> single;
+  for (const Eigen::VectorXf& s : starts) single.push_back(adapt_pb(model(), data_, ids_, s, few));
+  std::size_t want = 0;
+  for (std::size_t i = 1; i < single.size(); ++i)
+    if (single[i].loss.back() < single[want].loss.back()) want = i;
+  const AdaptResult best = adapt_pb_best_of(model(), data_, ids_, starts, few);
+  EXPECT_EQ(best.pb, single[want].pb);
+  EXPECT_EQ(best.loss, single[want].loss);
+  EXPECT_EQ(adapt_pb_best_of(model(), data_, ids_, {starts[1]}, few).pb, single[1].pb) << "one start";
+  EXPECT_THROW(adapt_pb_best_of(model(), data_, ids_, {}, few), std::invalid_argument);
+}
+
 TEST_F(PbAdaptation, OnlineStartsWhenStartWindowsExistAndKeepsAtMostMax) {
   OnlinePbAdapter::Options o;
   o.start_windows = 6;

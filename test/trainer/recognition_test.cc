@@ -52,6 +52,35 @@ TEST(NearestPb, PicksTheNearestRowAndReportsEveryDistance) {
   EXPECT_THROW(nearest_pb(m, Eigen::Vector3f::Zero()), std::invalid_argument);
 }
 
+// The margin is the nearest other object's distance over the recognised
+// object's: states of one object count once, at their nearest PB.
+TEST(RecognizeObject, MarginOverTheNearestOtherObject) {
+  RowMatrix<float> pbs(4, 2);
+  pbs << 0.0f, 0.0f,  // Ball
+      1.0f, 0.0f,     // Ball (a second zeroing)
+      0.0f, 2.0f,     // Hammer
+      -4.0f, 0.0f;    // None
+  HadynetModel m = model_with_pbs(pbs);
+  m.states = {{"Ball/i0", "Ball"}, {"Ball/i1", "Ball"}, {"Hammer/i0", "Hammer"}, {"None/i0", "None"}};
+  // Near the second Ball PB: 0.25 from it, sqrt(0.75^2 + 2^2) from Hammer.
+  const Recognition r = recognize_object(m, Eigen::Vector2f(0.75f, 0.0f));
+  EXPECT_EQ(r.object, "Ball");
+  EXPECT_EQ(r.nearest.state, 1);
+  ASSERT_EQ(r.objects_by_distance.size(), 3u);
+  EXPECT_EQ(r.objects_by_distance[0].first, "Ball");
+  EXPECT_EQ(r.objects_by_distance[1].first, "Hammer");
+  EXPECT_EQ(r.objects_by_distance[2].first, "None");
+  // Dyadic PB values, distances in double: a sqrt and a division, so 1e-12.
+  EXPECT_NEAR(r.margin, std::hypot(0.75, 2.0) / 0.25, 1e-12);
+  EXPECT_TRUE(r.clear);
+  // Half-way between Ball and Hammer (0, 1): both at distance 1, margin 1.
+  const Recognition tie = recognize_object(m, Eigen::Vector2f(0.0f, 1.0f));
+  EXPECT_NEAR(tie.margin, 1.0, 1e-12);
+  EXPECT_FALSE(tie.clear) << "margin 1 < the clear margin";
+  EXPECT_TRUE(recognize_object(m, Eigen::Vector2f(0.0f, 1.0f), 1.0).clear) << "clear from the margin given on";
+  EXPECT_TRUE(std::isinf(recognize_object(m, Eigen::Vector2f(1.0f, 0.0f)).margin)) << "on a trained PB";
+}
+
 // Points c + s a + o b for s = -2..2 along a unit direction a, with small
 // offsets o along a unit b orthogonal to a. sum(o) = 0 and sum(s o) = 0, so
 // the covariance is 2.5 a a^T + 2.5e-4 b b^T exactly: the principal axes are
