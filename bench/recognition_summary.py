@@ -2,10 +2,14 @@
 """Summary of `hadynet recognize --json` files, one per zeroing
 (bench/recognition_zeroings.sh): accuracy per object, the confusion matrix,
 the margin of each grasp (distance to the nearest wrong object over distance
-to the right one: > 1 right, < 1 wrong) and where the objects the model never
-saw land (their two nearest known objects).
+to the right one: > 1 right, < 1 wrong), how well `hadynet recognize`'s
+confidence word separates right from wrong (a recognition is "clear" when the
+nearest other object is at least CLEAR times as far as the recognised one;
+trainer/recognition.h) and where the objects the model never saw land (their
+two nearest known objects).
 
-Usage: bench/recognition_summary.py RECOGNIZE.json...
+Usage: bench/recognition_summary.py [--clear-margin CLEAR] RECOGNIZE.json...
+  (CLEAR default 1.25, trainer::kClearRecognitionMargin)
 """
 import json
 import statistics
@@ -13,10 +17,16 @@ import sys
 from collections import Counter, defaultdict
 
 
-def main(paths):
-    if not paths or paths[0] in ("-h", "--help"):
+def main(args):
+    if not args or args[0] in ("-h", "--help"):
         print(__doc__.strip())
-        return 0 if paths else 2
+        return 0 if args else 2
+    clear_margin = 1.25
+    if args[0] == "--clear-margin":
+        clear_margin = float(args[1])
+        args = args[2:]
+    paths = args
+    flagged = {True: [0, 0], False: [0, 0]}  # right? -> [ambiguous, total]
     per_object = defaultdict(lambda: [0, 0])  # object -> [right, total]
     confusion = defaultdict(Counter)  # true -> recognised -> count
     margins = defaultdict(list)  # object -> margins
@@ -35,6 +45,10 @@ def main(paths):
                 continue
             right = r["recognised"] == r["object"]
             all_right &= right
+            d0 = by_distance[0]["distance"]
+            margin = by_distance[1]["distance"] / d0 if len(by_distance) > 1 and d0 > 0 else float("inf")
+            flagged[right][0] += margin < clear_margin
+            flagged[right][1] += 1
             per_object[r["object"]][0] += right
             per_object[r["object"]][1] += 1
             confusion[r["object"]][r["recognised"]] += 1
@@ -57,6 +71,11 @@ def main(paths):
     all_m = sorted(x for ms in margins.values() for x in ms)
     print(f"{'all':<10} {right:>4} of {total:<4} {all_m[0]:>12.2f} "
           f"{all_m[max(0, int(0.1 * len(all_m)) - 1)]:>6.2f} {statistics.median(all_m):>7.2f}")
+    print()
+    print(f"confidence word (clear from margin {clear_margin}): "
+          f"{flagged[False][0]} of {flagged[False][1]} wrong recognitions called ambiguous; "
+          f"{flagged[True][0]} of {flagged[True][1]} right ones called ambiguous "
+          f"({100.0 * flagged[True][0] / max(1, flagged[True][1]):.0f} %)")
     print()
     print("confusion (rows: true object, columns: recognised)")
     cols = sorted({c for row in confusion.values() for c in row} | set(objects))

@@ -87,7 +87,7 @@ void check_resumable(const trainer::Checkpoint& c, const trainer::HadynetModel& 
 int run_train(int argc, char** argv) {
   Options opt("train",
               "Trains HADYNET (encoder FC+BN+ReLU, LSTM with the PB as input, linear decoder) and one PB per\n"
-              "dynamics state (log metadata 'state') jointly with Adam, on windows of --steps steps, one per\n"
+              "dynamics state (log metadata 'state') jointly with Adam, on windows of --window steps, one per\n"
               "time step, shuffled. The last --held-out fraction of each log's windows is kept out of training\n"
               "and reported as the held-out loss per epoch. A checkpoint OUT.ckpt is written atomically after\n"
               "every epoch; --resume continues an interrupted run exactly. Writes OUT (safetensors, PyTorch\n"

@@ -8,6 +8,7 @@
 # the measured figures to OUT/summary.md (docs/trainer.md discusses them).
 # Usage: scripts/paper_experiments.sh [DATA_DIR] [OUT_DIR]   (defaults data/paper, out/paper)
 #        REUSE_MODELS=1 scripts/paper_experiments.sh   keeps trained models found in OUT_DIR
+#        ZEROINGS=N scripts/paper_experiments.sh       recognition over N fresh zeroings (default 10)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 data="${1:-data/paper}"
@@ -59,6 +60,14 @@ for init in 4 5 6; do
   done
   record "$hadynet" recognize "$model" "$out/more_inits/init$init" --json "$out/recognize_init$init.json"
 done
+end_section
+
+# ZEROINGS (default 10; bench/recognition_zeroings.sh runs 50): fresh
+# zeroings, inits 100.. of dataset seed 1, used for nothing else.
+zeroings="${ZEROINGS:-10}"
+section "(3c) recognition over $zeroings fresh zeroings (inits 100..; bench/recognition_zeroings.sh, docs/trainer.md)"
+bench/recognition_zeroings.sh --model "$model" --out "$out/zeroings" $(seq 100 $((99 + zeroings))) >&2  # progress
+record cat "$out/zeroings/summary.txt"
 end_section
 
 section "(5) online PB update streaming None, then Cylinder, then Cylinder-L (test/novel Random-2 logs)"
