@@ -7,6 +7,9 @@
 # seed 1, collected into OUT/data if absent) and reports the final training
 # loss and the loss on the held-out windows (the last 10 % of every training
 # log's windows, never trained on), with the mean and the range over seeds.
+# The held-out windows are new windows of the training records (the same
+# zeroings, inits 0-2): they measure the fit of unseen stretches of known
+# states, not a new zeroing (bench/recognition_zeroings.sh does that).
 #
 # Usage: bench/variable_pb_seeds.sh [--out DIR] [--epochs N] [SEED...]
 #   defaults: build/variable-pb-seeds, 200 epochs (the paper preset's), 1 2 3

@@ -16,6 +16,7 @@
 #include "cli/pb_adapt_common.h"
 #include "cli/pb_map_plot.h"
 #include "cli/trainer_inputs.h"
+#include "datalog/log_rules.h"
 #include "trainer/model_file.h"
 #include "trainer/recognition.h"
 
@@ -37,7 +38,7 @@ int run_recognize(int argc, char** argv) {
   opt.value("clear-margin", "M",
             "margin (distance to the nearest other object / to the recognised one) from which a\n"
             "recognition is called clear, below it ambiguous (chosen on validation zeroings; docs/trainer.md)",
-            "1.25");
+            datalog::rules::format_number(trainer::kClearRecognitionMargin));
   if (!opt.parse(argc, argv)) return 2;
   if (opt.help_requested()) return 0;
   if (opt.positional().size() < 2) {

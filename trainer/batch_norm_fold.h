@@ -1,6 +1,6 @@
 // The encoder's batch norm folded into its weights, as the firmware runs it
-// (codegen writes the folded weights). Part of the model-file library
-// (hadynet_model_file): portable code, the same bits on every x86-64.
+// (codegen writes the folded weights). Part of the portable deploy-math
+// library (hadynet_deploy_math): the same bits on every x86-64.
 #pragma once
 
 #include "trainer/hadynet_params.h"

@@ -365,7 +365,6 @@ HadynetModel model_from_safetensors(const st::File& file, const std::string& ori
       // One network step, s (the training logs' dt_s); a JSON number.
       const json period = json{{"period_s", parse_metadata_json(file, "period_s", origin)}};
       model.period_s = json_number(period, "period_s", "metadata", origin, 1e-9, 1e6);
-      if (!(model.period_s > 0)) fail(origin, "metadata 'period_s' must be a positive number of seconds");
     }
 
     const json states = parse_metadata_json(file, "states", origin);

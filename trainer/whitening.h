@@ -1,6 +1,6 @@
 // The whitening of the detection distance (docs/method.md, "Detection"), as
-// codegen writes it for the firmware. Part of the portable model library
-// (hadynet_model_file): the same bits on every x86-64.
+// codegen writes it for the firmware. Part of the portable deploy-math
+// library (hadynet_deploy_math): the same bits on every x86-64.
 #pragma once
 
 #include <Eigen/Core>
