@@ -47,22 +47,7 @@ void print_formats(const Formats& f) {
 
 }  // namespace
 
-int run_codegen_command(const std::string& program, const std::string& command, int argc, char** argv,
-                        const RangeMeasure& measure) {
-  cli::Options opt(
-      command,
-      "Generates one allocation-free C++ header from a trained model file: every constant and\n"
-      "array of the firmware contract (firmware/core/model_contract.h) as static constexpr members\n"
-      "of `struct Model`, in fixed point (q15: int16 values in per-tensor Q formats chosen from the\n"
-      "model's measured value ranges, int32 biases) or float32 (f32). Writes\n"
-      "DIR/hadynet_model_<numeric>.h atomically; an unsupported model is rejected before anything\n"
-      "is written (docs/codegen.md). --logs: measure the value ranges on the logs given after MODEL\n"
-      "instead of using those stored in the model (hadynet codegen only; hadynet-codegen uses the\n"
-      "stored ranges, so that its output is the same on every machine).",
-      "MODEL --numeric q15|f32 --out DIR [options] [--logs LOG|DIR...]", program);
-  opt.value("numeric", "q15|f32", "number format of the generated model");
-  opt.value("out", "DIR", "directory to write hadynet_model_<numeric>.h into (created if needed)");
-  opt.value("namespace", "NS", "C++ namespace (default: hadynet::model_q15 / hadynet::model_f32)");
+void add_model_options(cli::Options& opt) {
   opt.value("headroom", "H", "factor on the measured activation ranges before choosing formats", "1.5");
   opt.value("control-horizon", "N", "grasp stabiliser horizon N_control (<= the model's N_train)", "8");
   opt.value("control-epochs", "N", "gradient steps per control period (N_epoch)", "3");
@@ -86,6 +71,88 @@ int run_codegen_command(const std::string& program, const std::string& command, 
   opt.value("period-s", "S",
             "the control period (s) for a model file that does not record it (trained before model files\n"
             "stored the logs' dt_s); a model that records its period must not be given another");
+}
+
+bool read_model_options(const cli::Options& opt, const std::string& who, CodegenOptions& options) {
+  const auto headroom = opt.get_double("headroom", 1.0, 1e6);
+  const auto horizon = opt.get_int("control-horizon", 1, 100000);
+  const auto epochs = opt.get_int("control-epochs", 1, 100000);
+  const auto alphas = parse_alphas(opt.get("control-alphas"), who);
+  std::optional<long long> truncation;
+  if (opt.has("control-truncation")) {
+    truncation = opt.get_int("control-truncation", 1, 100000);
+    if (!truncation) return false;
+  }
+  const auto beta = opt.get_double("beta", 0.0, 1e6);
+  const auto w2 = opt.get_double("w2", 0.0, 1e6);
+  const auto w3 = opt.get_double("w3", 0.0, 1e6);
+  if (!headroom || !horizon || !epochs || !alphas || !beta || !w2 || !w3) return false;
+  if (opt.has("period-s")) {
+    const auto period = opt.get_double("period-s", 1e-6, 4294.0);
+    if (!period) return false;
+    options.period_s = *period;
+  }
+  options.headroom = *headroom;
+  options.control.horizon = static_cast<int>(*horizon);
+  options.control.epochs = static_cast<int>(*epochs);
+  options.control.alphas = *alphas;
+  if (truncation) options.control.truncation = static_cast<int>(*truncation);
+  options.control.loss.beta = *beta;
+  options.control.loss.w2 = *w2;
+  options.control.loss.w3 = *w3;
+  if (opt.get("loss-units") == "physical") {
+    options.control.loss.physical_units = true;
+  } else if (opt.get("loss-units") == "standardised") {
+    options.control.loss.physical_units = false;
+  } else {
+    std::fprintf(stderr, "%s: --loss-units must be physical or standardised, got '%s'\n", who.c_str(),
+                 opt.get("loss-units").c_str());
+    return false;
+  }
+  // Lists that default to the model's robot profile (datalog/robot_profile.h).
+  const auto profile_list = [&](const char* name, const char* all_word,
+                                std::optional<std::vector<std::string>>& out) {
+    const std::string text = opt.get(name);
+    if (text == "profile") return true;
+    if (text == all_word) {
+      out.emplace();
+      return true;
+    }
+    try {
+      out = datalog::split_list(text);
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "%s: --%s: %s\n", who.c_str(), name, e.what());
+      return false;
+    }
+    return true;
+  };
+  if (!profile_list("control-commands", "all", options.control.commands) ||
+      !profile_list("force-groups", "none", options.control.force_groups) ||
+      !profile_list("angle-groups", "none", options.control.angle_groups) ||
+      !profile_list("length-groups", "none", options.control.length_groups)) {
+    return false;
+  }
+
+  return true;
+}
+
+int run_codegen_command(const std::string& program, const std::string& command, int argc, char** argv,
+                        const RangeMeasure& measure) {
+  cli::Options opt(
+      command,
+      "Generates one allocation-free C++ header from a trained model file: every constant and\n"
+      "array of the firmware contract (firmware/core/model_contract.h) as static constexpr members\n"
+      "of `struct Model`, in fixed point (q15: int16 values in per-tensor Q formats chosen from the\n"
+      "model's measured value ranges, int32 biases) or float32 (f32). Writes\n"
+      "DIR/hadynet_model_<numeric>.h atomically; an unsupported model is rejected before anything\n"
+      "is written (docs/codegen.md). --logs: measure the value ranges on the logs given after MODEL\n"
+      "instead of using those stored in the model (hadynet codegen only; hadynet-codegen uses the\n"
+      "stored ranges, so that its output is the same on every machine).",
+      "MODEL --numeric q15|f32 --out DIR [options] [--logs LOG|DIR...]", program);
+  opt.value("numeric", "q15|f32", "number format of the generated model");
+  opt.value("out", "DIR", "directory to write hadynet_model_<numeric>.h into (created if needed)");
+  opt.value("namespace", "NS", "C++ namespace (default: hadynet::model_q15 / hadynet::model_f32)");
+  add_model_options(opt);
   opt.flag("logs", "measure the value ranges on the logs/folders given after MODEL");
   if (!opt.parse(argc, argv)) return 2;
   if (opt.help_requested()) return 0;
@@ -116,64 +183,7 @@ int run_codegen_command(const std::string& program, const std::string& command, 
     return 2;
   }
   options.ns = opt.get("namespace");
-  const auto headroom = opt.get_double("headroom", 1.0, 1e6);
-  const auto horizon = opt.get_int("control-horizon", 1, 100000);
-  const auto epochs = opt.get_int("control-epochs", 1, 100000);
-  const auto alphas = parse_alphas(opt.get("control-alphas"), who);
-  std::optional<long long> truncation;
-  if (opt.has("control-truncation")) {
-    truncation = opt.get_int("control-truncation", 1, 100000);
-    if (!truncation) return 2;
-  }
-  const auto beta = opt.get_double("beta", 0.0, 1e6);
-  const auto w2 = opt.get_double("w2", 0.0, 1e6);
-  const auto w3 = opt.get_double("w3", 0.0, 1e6);
-  if (!headroom || !horizon || !epochs || !alphas || !beta || !w2 || !w3) return 2;
-  if (opt.has("period-s")) {
-    const auto period = opt.get_double("period-s", 1e-6, 4294.0);
-    if (!period) return 2;
-    options.period_s = *period;
-  }
-  options.headroom = *headroom;
-  options.control.horizon = static_cast<int>(*horizon);
-  options.control.epochs = static_cast<int>(*epochs);
-  options.control.alphas = *alphas;
-  if (truncation) options.control.truncation = static_cast<int>(*truncation);
-  options.control.loss.beta = *beta;
-  options.control.loss.w2 = *w2;
-  options.control.loss.w3 = *w3;
-  if (opt.get("loss-units") == "physical") {
-    options.control.loss.physical_units = true;
-  } else if (opt.get("loss-units") == "standardised") {
-    options.control.loss.physical_units = false;
-  } else {
-    std::fprintf(stderr, "%s: --loss-units must be physical or standardised, got '%s'\n", who.c_str(),
-                 opt.get("loss-units").c_str());
-    return 2;
-  }
-  // Lists that default to the model's robot profile (datalog/robot_profile.h).
-  const auto profile_list = [&](const char* name, const char* all_word,
-                                std::optional<std::vector<std::string>>& out) {
-    const std::string text = opt.get(name);
-    if (text == "profile") return true;
-    if (text == all_word) {
-      out.emplace();
-      return true;
-    }
-    try {
-      out = datalog::split_list(text);
-    } catch (const std::invalid_argument& e) {
-      std::fprintf(stderr, "%s: --%s: %s\n", who.c_str(), name, e.what());
-      return false;
-    }
-    return true;
-  };
-  if (!profile_list("control-commands", "all", options.control.commands) ||
-      !profile_list("force-groups", "none", options.control.force_groups) ||
-      !profile_list("angle-groups", "none", options.control.angle_groups) ||
-      !profile_list("length-groups", "none", options.control.length_groups)) {
-    return 2;
-  }
+  if (!read_model_options(opt, who, options)) return 2;
 
   const std::string model_path = opt.positional().front();
   try {

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "cli/options.h"
+#include "codegen/codegen_options.h"
 #include "trainer/hadynet_model.h"
 
 namespace hadynet::cli {
@@ -29,6 +31,15 @@ using RangeMeasure =
 // nothing written), 2 usage error.
 int run_codegen_command(const std::string& program, const std::string& command, int argc, char** argv,
                         const RangeMeasure& measure);
+
+// The options that shape a generated header beyond its numeric and namespace
+// (headroom, the stabiliser's constants and loss, its commands and loss
+// groups, the period), declared on `opt` and read back into `options`:
+// codegen and model-image (an image must be generated with the options its
+// firmware's header was). read_model_options prints what is wrong and
+// returns false on a usage error.
+void add_model_options(cli::Options& opt);
+bool read_model_options(const cli::Options& opt, const std::string& who, codegen::CodegenOptions& options);
 
 // Measures the value ranges of MODEL on logs and stores them in the model
 // file (trainer::measure_log_ranges); the options after "measure-ranges"

@@ -23,5 +23,7 @@ int run_stabilize(int argc, char** argv);
 int run_measure_ranges(int argc, char** argv);
 int run_codegen(int argc, char** argv);
 int run_residual(int argc, char** argv);
+int run_keygen(int argc, char** argv);
+int run_model_image(int argc, char** argv);
 
 }  // namespace hadynet::cli

@@ -9,6 +9,7 @@
 #include "codegen/header_text.h"
 #include "codegen/prepared_model.h"
 #include "codegen/sensor_arrays.h"
+#include "codegen/shape_id.h"
 #include "codegen/tensor_writer.h"
 #include "trainer/model_file.h"
 
@@ -132,8 +133,11 @@ std::vector<std::string> option_words(const CodegenOptions& o) {
   return words;
 }
 
-// The header's text.
-std::string emit(const PreparedModel& p, const Formats& f, const HeaderValues& v, const ModelIdentity& identity) {
+// Stands for kShapeId's value until every member is known.
+constexpr const char* kShapeIdPlaceholder = "@SHAPE_ID@";
+
+// The header's text and every member's literals.
+Emitter emit(const PreparedModel& p, const Formats& f, const HeaderValues& v, const ModelIdentity& identity) {
   const HadynetModel& model = p.model;
   const CodegenOptions& options = p.options;
   const bool q15 = options.numeric == Numeric::kQ15;
@@ -266,6 +270,7 @@ std::string emit(const PreparedModel& p, const Formats& f, const HeaderValues& v
   e.member("int", "kContractVersion", std::to_string(firmware::kModelContractVersion));
   e.member("const char*", "kGeneratorVersion", string_literal(generator));
   e.member("std::uint64_t", "kModelHash", hash_hex + "ULL", "FNV-1a 64 of the model file");
+  e.member("std::uint64_t", "kShapeId", kShapeIdPlaceholder, "model images must match it");
   e.member("hadynet::firmware::Numeric", "kNumeric",
            q15 ? "hadynet::firmware::Numeric::kQ15" : "hadynet::firmware::Numeric::kF32");
   e.line();
@@ -397,7 +402,13 @@ std::string emit(const PreparedModel& p, const Formats& f, const HeaderValues& v
   e.line("}  // namespace " + ns);
   e.line();
   e.line("#endif  // " + guard);
-  return std::move(e.out);
+
+  char id_buf[32];
+  std::snprintf(id_buf, sizeof id_buf, "0x%016llxULL", static_cast<unsigned long long>(shape_id(e.literals)));
+  const std::size_t at = e.out.find(kShapeIdPlaceholder);
+  e.out.replace(at, std::string(kShapeIdPlaceholder).size(), id_buf);
+  e.literals["kShapeId"] = {id_buf};
+  return e;
 }
 
 
@@ -420,7 +431,9 @@ GeneratedHeader generate(const HadynetModel& model, const ModelIdentity& identit
   const PreparedModel prepared = prepare(model, options);
   const Formats formats = choose_formats(prepared);
   const HeaderValues values = quantise(prepared, formats);
-  return {header_file_name(options.numeric), emit(prepared, formats, values, identity), formats};
+  Emitter e = emit(prepared, formats, values, identity);
+  const std::uint64_t id = shape_id(e.literals);
+  return {header_file_name(options.numeric), std::move(e.out), formats, id, std::move(e.literals)};
 }
 
 }  // namespace hadynet::codegen

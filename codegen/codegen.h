@@ -16,7 +16,9 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
+#include <vector>
 
 #include "codegen/codegen_options.h"
 #include "codegen/formats.h"
@@ -48,6 +50,10 @@ struct GeneratedHeader {
   std::string file_name;  // header_file_name(options.numeric)
   std::string text;       // the whole header
   Formats formats;        // as chosen (all frac 0 in an f32 header's constants)
+  std::uint64_t shape_id = 0;  // kShapeId (codegen/shape_id.h)
+  // Every member's literals by name, arrays flattened row by row, as in the
+  // text (header_text.h's Emitter::literals): the model image writer's input.
+  std::map<std::string, std::vector<std::string>> literals;
 };
 
 // The header for `model` (throws UnsupportedModel before producing anything).

@@ -3,6 +3,7 @@
 // from the model's robot profile (datalog/robot_profile.h).
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,6 +48,13 @@ struct CodegenOptions {
   // that records one must not be given another.
   std::optional<double> period_s;
   ControlOptions control;
+  // q15: the formats of an existing firmware, frac bits in the contract's
+  // order (kFracIn, H, C, Y, Gate, EncW, LstmW, LstmAcc, DecW, Whiten, Z,
+  // LossW). Set, the header takes them instead of choosing its own, so its
+  // data can run in that firmware (a model image, docs/model-update.md); a
+  // model that needs more range than one of them gives (fewer frac bits) is
+  // refused, naming the format.
+  std::optional<std::array<int, 12>> target_formats;
 };
 
 }  // namespace hadynet::codegen

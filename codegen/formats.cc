@@ -51,6 +51,32 @@ int frac_bits_for(double max_abs, const std::string& what) {
   return frac;
 }
 
+void apply_target_formats(const std::array<int, 12>& target, Formats& f) {
+  static constexpr const char* kNames[12] = {"kFracIn",    "kFracH",     "kFracC",       "kFracY",
+                                             "kFracGate",  "kFracEncW",  "kFracLstmW",   "kFracLstmAcc",
+                                             "kFracDecW",  "kFracWhiten", "kFracZ",      "kFracLossW"};
+  FormatChoice* choices[12] = {&f.in,     &f.h,        &f.c,        &f.y,      &f.gate,   &f.enc_w,
+                               &f.lstm_w, &f.lstm_acc, &f.dec_w,    &f.whiten, &f.z,      &f.loss_w};
+  for (int i = 0; i < 12; ++i) {
+    FormatChoice& c = *choices[i];
+    const int want = target[static_cast<std::size_t>(i)];
+    if (want < 0 || want > 62) reject(std::string("target ") + kNames[i] + " " + std::to_string(want) + " is not a format");
+    // The gate input is fixed (the activation tables' Q3.12) and the LSTM
+    // accumulator derived from the other targets; any other target may hold
+    // more range than the model needs (fewer frac bits), never less.
+    bool ok = want <= c.frac;
+    if (i == 4) ok = want == c.frac;
+    if (i == 7) ok = want == target[6] + std::max(target[0], target[1]);
+    if (!ok) {
+      reject(std::string(kNames[i]) + ": this model needs Q" + std::to_string(c.frac) + " (" + c.from +
+             "), the target firmware has Q" + std::to_string(want) +
+             ": build a firmware for this model instead of a model image");
+    }
+    if (want != c.frac) c.from = "the target firmware's format (this model needs Q" + std::to_string(c.frac) + ")";
+    c.frac = want;
+  }
+}
+
 Formats choose_formats(const PreparedModel& prepared) {
   const trainer::HadynetModel& model = prepared.model;
   const CodegenOptions& options = prepared.options;
@@ -115,6 +141,7 @@ Formats choose_formats(const PreparedModel& prepared) {
   } else {
     f.loss_w = {kFracLossW, 0.0, "fixed: loss weights up to 7.99 (standardised units)"};
   }
+  if (options.target_formats) apply_target_formats(*options.target_formats, f);
   return f;
 }
 

@@ -5,6 +5,7 @@
 // constants.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 
@@ -41,7 +42,14 @@ struct Formats {
   FormatChoice in, h, c, y, gate, enc_w, lstm_w, lstm_acc, dec_w, whiten, z, loss_w;
 };
 
-// The formats of a prepared model (all "unused" for f32).
+// The formats of a prepared model (all "unused" for f32); its
+// options.target_formats when set (apply_target_formats).
 Formats choose_formats(const PreparedModel& prepared);
+
+// Replaces the chosen formats `f` by `target` (CodegenOptions::target_formats'
+// order). Throws UnsupportedModel when a target format holds less than the
+// model needs (fewer frac bits than chosen), or differs from a fixed or
+// derived one (kFracGate, kFracLstmAcc, fixed kFracLossW).
+void apply_target_formats(const std::array<int, 12>& target, Formats& f);
 
 }  // namespace hadynet::codegen

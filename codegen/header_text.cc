@@ -134,18 +134,27 @@ void Emitter::line(const std::string& s) {
   out += '\n';
 }
 
+namespace {
+std::string member_name(const std::string& decl) { return decl.substr(0, decl.find('[')); }
+}  // namespace
+
 void Emitter::member(const std::string& type, const std::string& name, const std::string& value,
                      const std::string& comment) {
+  literals[member_name(name)] = {value};
   line("  static constexpr " + type + " " + name + " = " + value + ";" + (comment.empty() ? "" : "  // " + comment));
 }
 
 void Emitter::array1(const std::string& type, const std::string& decl, const std::vector<std::string>& items) {
+  literals[member_name(decl)] = items;
   line("  static constexpr " + type + " " + decl + " = {");
   line("      " + wrapped(items, 6, 6) + "};");
 }
 
 void Emitter::array2(const std::string& type, const std::string& decl,
                      const std::vector<std::vector<std::string>>& rows) {
+  std::vector<std::string>& flat = literals[member_name(decl)];
+  flat.clear();
+  for (const auto& row : rows) flat.insert(flat.end(), row.begin(), row.end());
   line("  static constexpr " + type + " " + decl + " = {");
   for (const auto& row : rows) line("      {" + wrapped(row, 7, 7) + "},");
   line("  };");

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -41,8 +42,12 @@ std::vector<std::string> inv_items(const Eigen::VectorXd& stds);
 std::vector<std::string> string_items(const std::vector<std::string>& v);
 
 // Appends lines of the header; members are written inside `struct Model`.
+// Every member's literals are also kept by name ("kXMean", without the
+// declarator's bounds; arrays flattened row by row): what the model image
+// writer reads (codegen/model_image.h) and the shape id hashes.
 struct Emitter {
   std::string out;
+  std::map<std::string, std::vector<std::string>> literals;
 
   void line(const std::string& s = "");
   // static constexpr TYPE NAME = VALUE;  // COMMENT

@@ -122,12 +122,12 @@ class Bench {
     frames.next(f0);
     frames.next(f1);
     Value x[M::kX];
-    firmware::Boundary<M>::x_from_frames(f1.y, f0.y, x);
+    firmware::Boundary<M>{}.x_from_frames(f1.y, f0.y, x);
     Value pb[M::kPb] = {};
     net.encode(x, pb);
     Value u[M::kU];
     Value y[M::kY];
-    firmware::Boundary<M>::u_to_model(f1.u_prev, u);
+    firmware::Boundary<M>{}.u_to_model(f1.u_prev, u);
     for (int k = 0; k < 4; ++k) net.step(u, y);
     constexpr int kSteps = 32;
     const std::uint32_t t0 = board::ticks();

@@ -63,46 +63,49 @@ class Detector {
   // the N recorded commands. Uses (and overwrites) `net`'s state.
   static void estimate(const History& history, const Value (&pb)[M::kPb], HadynetNet<M>& net,
                        Value (&y_est)[M::kY]) noexcept {
+    const B boundary(net.tensors());
     Value x[M::kX];
-    B::x_from_frames(history.y(kSteps), history.y(kSteps + 1), x);
+    boundary.x_from_frames(history.y(kSteps), history.y(kSteps + 1), x);
     net.encode(x, pb);
     for (int k = 0; k < kSteps; ++k) {
       Value u[M::kU];
       // u_{t-N+k} was applied before frame t-N+k+1, i.e. the frame of age N-k-1.
-      B::u_to_model(history.u_prev(kSteps - k - 1), u);
+      boundary.u_to_model(history.u_prev(kSteps - k - 1), u);
       net.step(u, y_est);
     }
   }
 
-  // |W (e - mu)|^2 for e = y_est - y (both Q(kFracY)).
-  static Distance2 distance2(const Value (&y_est)[M::kY], const Value (&y)[M::kY]) noexcept {
+  // |W (e - mu)|^2 for e = y_est - y (both Q(kFracY)), with the detection
+  // statistics of `t`.
+  static Distance2 distance2(const ModelTensors<M>& t, const Value (&y_est)[M::kY],
+                             const Value (&y)[M::kY]) noexcept {
     if constexpr (N::kFixed) {
       std::int32_t centred[M::kY];
       for (int i = 0; i < M::kY; ++i) {
-        centred[i] = std::int32_t{y_est[i]} - y[i] - M::kDetectMean[i];
+        centred[i] = std::int32_t{y_est[i]} - y[i] - t.detect_mean[i];
       }
       std::int64_t d2 = 0;
       for (int r = 0; r < M::kY; ++r) {
         std::int64_t acc = 0;
-        for (int c = 0; c < M::kY; ++c) acc += std::int64_t{M::kDetectWhiten[r][c]} * centred[c];
+        for (int c = 0; c < M::kY; ++c) acc += std::int64_t{t.detect_whiten[r][c]} * centred[c];
         const std::int16_t z = fixed::requantize_i16<M::kFracWhiten + M::kFracY, M::kFracZ>(acc);
         d2 += std::int64_t{z} * z;
       }
       return d2;
     } else {
       float centred[M::kY];
-      for (int i = 0; i < M::kY; ++i) centred[i] = y_est[i] - y[i] - M::kDetectMean[i];
+      for (int i = 0; i < M::kY; ++i) centred[i] = y_est[i] - y[i] - t.detect_mean[i];
       float d2 = 0.0f;
       for (int r = 0; r < M::kY; ++r) {
         float z = 0.0f;
-        for (int c = 0; c < M::kY; ++c) z += M::kDetectWhiten[r][c] * centred[c];
+        for (int c = 0; c < M::kY; ++c) z += t.detect_whiten[r][c] * centred[c];
         d2 += z * z;
       }
       return d2;
     }
   }
 
-  static bool is_contact(Distance2 d2) noexcept { return d2 > M::kDetectThresholdSq; }
+  static bool is_contact(const ModelTensors<M>& t, Distance2 d2) noexcept { return d2 > t.detect_threshold_sq; }
 
   // d in standardised units (q15: integer square root, then one scaling).
   static float distance(Distance2 d2) noexcept {

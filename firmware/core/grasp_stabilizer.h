@@ -109,6 +109,7 @@ class GraspStabilizer {
   // the next period's warm start.
   void plan(HadynetNet<M>& net, const Value (&x)[M::kX], const Value (&y_now)[kY],
             const Value (&pb)[M::kPb], Value (&command)[kU]) noexcept {
+    t_ = &net.tensors();  // step sizes and loss weights of the net's model
     net.encode(x, pb);
     net.save(start_);
     set_step_references(net, y_now);
@@ -132,7 +133,7 @@ class GraspStabilizer {
       copy(seq_, best_seq);
       for (int a = 0; a < kAlphas; ++a) {
         Value cand[kHorizon][kU];
-        step_along(M::kControlAlpha[a], cand);
+        step_along(t_->control_alpha[a], cand);
         const Loss l = rollout(net, cand, 1 - best_slot_);
         if (!have_best || l < best) {
           have_best = true;
@@ -215,7 +216,7 @@ class GraspStabilizer {
   Loss loss_step(const Value (&y)[kY], const Value (&ref)[kY]) const noexcept {
     Loss l = 0;
     for (int i = 0; i < kY; ++i) {
-      const Value w = y[i] >= ref[i] ? M::kLossWeightUp[i] : M::kLossWeightDown[i];
+      const Value w = y[i] >= ref[i] ? t_->loss_weight_up[i] : t_->loss_weight_down[i];
       if constexpr (N::kFixed) {
         const std::int64_t e = std::int64_t{y[i]} - ref[i];
         l += e * e * w;  // Q(2 kFracY + kFracLossW); < 2^47 per term
@@ -246,7 +247,7 @@ class GraspStabilizer {
       for (int k = 0; k < kHorizon; ++k) {
         for (int i = 0; i < kY; ++i) {
           const Value y = y_est_[slot][k][i];
-          const std::int64_t w = y >= ref_[k][i] ? M::kLossWeightUp[i] : M::kLossWeightDown[i];
+          const std::int64_t w = y >= ref_[k][i] ? t_->loss_weight_up[i] : t_->loss_weight_down[i];
           raw[k][i] = w * (std::int64_t{y} - ref_[k][i]);
           const std::int64_t a = raw[k][i] < 0 ? -raw[k][i] : raw[k][i];
           if (a > max_abs) max_abs = a;
@@ -263,7 +264,7 @@ class GraspStabilizer {
       for (int k = 0; k < kHorizon; ++k) {
         for (int i = 0; i < kY; ++i) {
           const float y = y_est_[slot][k][i];
-          const float w = y >= ref_[k][i] ? M::kLossWeightUp[i] : M::kLossWeightDown[i];
+          const float w = y >= ref_[k][i] ? t_->loss_weight_up[i] : t_->loss_weight_down[i];
           dy_[k][i] = 2.0f * w * (y - ref_[k][i]);
           any = any || dy_[k][i] != 0.0f;
         }
@@ -380,6 +381,7 @@ class GraspStabilizer {
   Value hold_[kU] = {};
   Value ref_[kHorizon][kY] = {};  // per-step reference of this period
   typename HadynetNet<M>::State start_{};
+  const ModelTensors<M>* t_ = &kCompiledTensors<M>;  // the model of the last plan()'s net
   StepTrace<M> trace_[2][kHorizon] = {};
   Value y_est_[2][kHorizon][kY] = {};
   int best_slot_ = 0;

@@ -16,6 +16,7 @@
 
 #include "firmware/core/kernels/dot_q15.h"
 #include "firmware/core/model_contract.h"
+#include "firmware/core/model_tensors.h"
 #include "firmware/core/numerics.h"
 
 namespace hadynet::firmware {
@@ -29,39 +30,6 @@ struct StepTrace {
   Value tanh_c[M::kHidden];     // tanh(c after the step) (Q15)
 };
 
-// q15: the network's matrices in the orders the build's kernels read
-// (kernels/dot_q15.h), built at compile time into read-only memory (flash
-// on the MCU); of the generated row-major arrays the q15 code then reads only
-// W_dec (W_dec^T dy, backward_decoder). Forward: packed (rows in pairs,
-// columns in chunks of eight). Backward: W^T of the u columns of W_ih and of
-// W_hh, so dL/du and dL/dh are dot products along contiguous rows. Only q15
-// code refers to them.
-template <GeneratedModel M>
-struct KernelWeights {
-  static constexpr int kGates = 4 * M::kHidden;
-  kernels::PackedMatrix<M::kHidden, M::kX + M::kPb> enc;  // [W_enc | x ; p]
-  kernels::PackedMatrix<kGates, M::kU + M::kPb> ih;       // W_ih, input [u ; p]
-  kernels::PackedMatrix<kGates, M::kHidden> hh;           // W_hh
-  kernels::PackedMatrix<M::kY, M::kHidden> dec;           // W_dec
-  typename M::Value ih_u_t[M::kU][kGates];                // W_ih[:, :kU]^T
-  typename M::Value hh_t[M::kHidden][kGates];             // W_hh^T
-};
-template <GeneratedModel M>
-constexpr KernelWeights<M> make_kernel_weights() noexcept {
-  KernelWeights<M> k{};
-  k.enc = kernels::pack_matrix(M::kEncWeight);
-  k.ih = kernels::pack_matrix(M::kLstmWeightIh);
-  k.hh = kernels::pack_matrix(M::kLstmWeightHh);
-  k.dec = kernels::pack_matrix(M::kDecWeight);
-  for (int r = 0; r < KernelWeights<M>::kGates; ++r) {
-    for (int c = 0; c < M::kU; ++c) k.ih_u_t[c][r] = M::kLstmWeightIh[r][c];
-    for (int c = 0; c < M::kHidden; ++c) k.hh_t[c][r] = M::kLstmWeightHh[r][c];
-  }
-  return k;
-}
-template <GeneratedModel M>
-inline constexpr KernelWeights<M> kKernelWeights = make_kernel_weights<M>();
-
 template <GeneratedModel M>
 class HadynetNet {
  public:
@@ -73,6 +41,13 @@ class HadynetNet {
   static constexpr int kX = M::kX, kU = M::kU, kY = M::kY, kPb = M::kPb, kH = M::kHidden;
   static constexpr int kGates = 4 * kH;
   static constexpr int kFracOut = N::kFixed ? 15 : 0;  // activation outputs
+  static_assert(sizeof(ModelTensors<M>) == unpadded_tensor_bytes<M>(),
+                "ModelTensors has interior padding: its bytes would differ between targets");
+
+  // Runs on `tensors` (the compiled-in model by default, or a model slot's
+  // payload in flash), which must outlive the net.
+  explicit constexpr HadynetNet(const ModelTensors<M>& tensors = kCompiledTensors<M>) noexcept : t_(&tensors) {}
+  const ModelTensors<M>& tensors() const noexcept { return *t_; }
 
   // h_0 from the standardised initial state x (Q(kFracIn)) and PB p
   // (Q(kFracIn)); c_0 = 0. p is kept for the following steps.
@@ -81,21 +56,21 @@ class HadynetNet {
     if constexpr (N::kFixed) {
       // [x ; p] as one vector (zero-padded to the packed matrix's columns):
       // one exact dot product per row, requantised by the build's kernel.
-      const auto& enc = kKernelWeights<M>.enc;
+      const auto& enc = t_->weights.enc;
       alignas(8) Value xp[enc.kCols] = {};
       for (int i = 0; i < kX; ++i) xp[i] = x[i];
       for (int i = 0; i < kPb; ++i) xp[kX + i] = pb_[i];
       constexpr int kFrom = M::kFracEncW + M::kFracIn;
       static_assert(kFrom >= M::kFracH, "the encoder output has more fractional bits than its sum");
-      kernels::matvec_requantize_q15({enc.data, enc.kCols, xp, 0}, {}, M::kEncBias, kH, kFrom - M::kFracH, h_);
+      kernels::matvec_requantize_q15({enc.data, enc.kCols, xp, 0}, {}, t_->enc_bias, kH, kFrom - M::kFracH, h_);
       for (int r = 0; r < kH; ++r) {
         h_[r] = h_[r] > 0 ? h_[r] : Value{0};
         c_[r] = 0;
       }
     } else {
       for (int r = 0; r < kH; ++r) {
-        const auto acc = typename N::Acc{M::kEncBias[r]} + N::dot(M::kEncWeight[r], x, kX) +
-                         N::dot(M::kEncWeight[r] + kX, pb_, kPb);
+        const auto acc = typename N::Acc{t_->enc_bias[r]} + N::dot(t_->weights.enc[r], x, kX) +
+                         N::dot(t_->weights.enc[r] + kX, pb_, kPb);
         const Value v = N::template narrow<M::kFracEncW + M::kFracIn, M::kFracH>(acc);
         h_[r] = v > 0 ? v : Value{0};
         c_[r] = 0;
@@ -117,22 +92,22 @@ class HadynetNet {
       // Q(kFracLstmAcc) by left shifts (|sum| < 2^46 before the shift of at
       // most 15 bits), then one rounding to Q(kFracGate).
       static_assert(kAccFrac >= M::kFracGate, "gate sums have fewer fractional bits than the gates");
-      const KernelWeights<M>& kw = kKernelWeights<M>;
+      const NetworkWeights<M>& kw = t_->weights;
       alignas(8) Value up[kw.ih.kCols] = {};  // [u ; p]: one dot product per row of W_ih
       for (int i = 0; i < kU; ++i) up[i] = u[i];
       for (int i = 0; i < kPb; ++i) up[kU + i] = pb_[i];
       alignas(8) Value h_buffer[kHPadded];
       kernels::matvec_requantize_q15({kw.ih.data, kw.ih.kCols, up, kInShift},
-                                     {kw.hh.data, kw.hh.kCols, hidden_padded(h_buffer), kHShift}, M::kLstmBias,
+                                     {kw.hh.data, kw.hh.kCols, hidden_padded(h_buffer), kHShift}, t_->lstm_bias,
                                      kGates, kAccFrac - M::kFracGate, gates);
       kernels::sigmoid_q15_block(gates, 2 * kH);       // i, f
       kernels::tanh_q15_block(gates + 2 * kH, kH);     // g
       kernels::sigmoid_q15_block(gates + 3 * kH, kH);  // o
     } else {
       for (int r = 0; r < kGates; ++r) {
-        const auto in = N::dot(M::kLstmWeightIh[r], u, kU) + N::dot(M::kLstmWeightIh[r] + kU, pb_, kPb);
-        const auto rec = N::dot(M::kLstmWeightHh[r], h_, kH);
-        const Value pre = N::template narrow<kAccFrac, M::kFracGate>(M::kLstmBias[r] + in + rec);
+        const auto in = N::dot(t_->weights.ih[r], u, kU) + N::dot(t_->weights.ih[r] + kU, pb_, kPb);
+        const auto rec = N::dot(t_->weights.hh[r], h_, kH);
+        const Value pre = N::template narrow<kAccFrac, M::kFracGate>(t_->lstm_bias[r] + in + rec);
         gates[r] = (r >= 2 * kH && r < 3 * kH) ? N::tanh(pre) : N::sigmoid(pre);
       }
     }
@@ -173,13 +148,13 @@ class HadynetNet {
     if constexpr (N::kFixed) {
       constexpr int kFrom = M::kFracDecW + M::kFracH;
       static_assert(kFrom >= M::kFracY, "the decoder output has more fractional bits than its sum");
-      const auto& dec = kKernelWeights<M>.dec;
+      const auto& dec = t_->weights.dec;
       alignas(8) Value h_buffer[kHPadded];
-      kernels::matvec_requantize_q15({dec.data, dec.kCols, hidden_padded(h_buffer), 0}, {}, M::kDecBias, kY,
+      kernels::matvec_requantize_q15({dec.data, dec.kCols, hidden_padded(h_buffer), 0}, {}, t_->dec_bias, kY,
                                      kFrom - M::kFracY, y);
     } else {
       for (int r = 0; r < kY; ++r) {
-        const auto acc = typename N::Acc{M::kDecBias[r]} + N::dot(M::kDecWeight[r], h_, kH);
+        const auto acc = typename N::Acc{t_->dec_bias[r]} + N::dot(t_->weights.dec[r], h_, kH);
         y[r] = N::template narrow<M::kFracDecW + M::kFracH, M::kFracY>(acc);
       }
     }
@@ -216,19 +191,19 @@ class HadynetNet {
     if constexpr (N::kFixed) {
       // W^T dgates along the rows of the transposed copies (exact int64 sums,
       // one rounding per output, as transposed_matvec).
-      const KernelWeights<M>& kw = kKernelWeights<M>;
+      const NetworkWeights<M>& kw = t_->weights;
       kernels::dot_rows_q15_i32(kw.ih_u_t[0], kGates, kU, dgates, kGates, scratch_);
       for (int k = 0; k < kU; ++k) du[k] = N::grad_add(du[k], fixed::requantize_i32<M::kFracLstmW, 0>(scratch_[k]));
       if (dh_prev != nullptr) {
-        kernels::dot_rows_q15_i32(kw.hh_t[0], kGates, kH, dgates, kGates, scratch_);
+        kernels::dot_cols_packed_q15_i32(kw.hh.data, kw.hh.kCols, kGates, dgates, kH, scratch_);
         for (int j = 0; j < kH; ++j) dh_prev[j] = fixed::requantize_i32<M::kFracLstmW, 0>(scratch_[j]);
       }
     } else {
       Grad du_step[kU];
-      N::template transposed_matvec<M::kFracLstmW>(M::kLstmWeightIh, dgates, kU, du_step, scratch_);
+      N::template transposed_matvec<M::kFracLstmW>(t_->weights.ih, dgates, kU, du_step, scratch_);
       for (int k = 0; k < kU; ++k) du[k] = N::grad_add(du[k], du_step[k]);
       if (dh_prev != nullptr) {
-        N::template transposed_matvec<M::kFracLstmW>(M::kLstmWeightHh, dgates, kH, dh_prev, scratch_);
+        N::template transposed_matvec<M::kFracLstmW>(t_->weights.hh, dgates, kH, dh_prev, scratch_);
       }
     }
   }
@@ -236,7 +211,13 @@ class HadynetNet {
   // dh += W_dec^T dy (dy: dL/dy of the current output, kY entries).
   void backward_decoder(const Grad (&dy)[kY], Grad (&dh)[kH]) noexcept {
     Grad d[kH];
-    N::template transposed_matvec<M::kFracDecW>(M::kDecWeight, dy, kH, d, scratch_);
+    if constexpr (N::kFixed) {
+      const auto& dec = t_->weights.dec;
+      kernels::dot_cols_packed_q15_i32(dec.data, dec.kCols, kY, dy, kH, scratch_);
+      for (int j = 0; j < kH; ++j) d[j] = fixed::requantize_i32<M::kFracDecW, 0>(scratch_[j]);
+    } else {
+      N::template transposed_matvec<M::kFracDecW>(t_->weights.dec, dy, kH, d, scratch_);
+    }
     for (int j = 0; j < kH; ++j) dh[j] = N::grad_add(dh[j], d[j]);
   }
 
@@ -274,6 +255,7 @@ class HadynetNet {
     }
   }
 
+  const ModelTensors<M>* t_;
   Value pb_[kPb] = {};
   Value h_[kH] = {};
   Value c_[kH] = {};

@@ -56,7 +56,24 @@ class HadynetRuntime {
   using B = Boundary<M>;
   using Det = Detector<M>;
 
-  HadynetRuntime() noexcept {
+  // Runs the model `tensors` (the compiled-in model by default; a model
+  // slot's payload after a model update, docs/model-update.md), which must
+  // outlive the runtime.
+  explicit HadynetRuntime(const ModelTensors<M>& tensors = kCompiledTensors<M>) noexcept
+      : t_(&tensors), boundary_(tensors), sensor_(tensors), net_(tensors) {
+    init_pb();
+    reset();
+  }
+  const ModelTensors<M>& tensors() const noexcept { return *t_; }
+
+  // Runs `tensors` from now on (e.g. the model a boot chose from a flash
+  // slot): as a runtime constructed with them, except that the mode and the
+  // control settings are kept. `tensors` must outlive the runtime.
+  void use_model(const ModelTensors<M>& tensors) noexcept {
+    t_ = &tensors;
+    boundary_ = B(tensors);
+    sensor_ = SensorStage<M>(tensors);
+    net_ = HadynetNet<M>(tensors);
     init_pb();
     reset();
   }
@@ -68,7 +85,7 @@ class HadynetRuntime {
     sensor_.reset();
     reference_pending_ = true;
     const float zero_u[M::kU] = {};
-    B::u_to_model(zero_u, hold_);
+    boundary_.u_to_model(zero_u, hold_);
     stabilizer_.reset(hold_);
   }
 
@@ -84,7 +101,7 @@ class HadynetRuntime {
   // Active PB from the PB table; false (and unchanged) if out of range.
   bool set_pb_state(int state) noexcept {
     if (state < 0 || state >= M::kStates) return false;
-    for (int i = 0; i < M::kPb; ++i) pb_[i] = M::kPbTable[state][i];
+    for (int i = 0; i < M::kPb; ++i) pb_[i] = t_->pb_table[state][i];
     return true;
   }
   // Active PB from standardised real values (saturated into the format).
@@ -103,20 +120,20 @@ class HadynetRuntime {
     sensor_.to_model(frame.y, frame.u_prev, y_frame, u_frame);
     history_.push(y_frame, u_frame);
     Value y_now[M::kY];
-    B::y_to_model(y_frame, y_now);
+    boundary_.y_to_model(y_frame, y_now);
 
     if (Det::ready(history_)) {
       Value y_est[M::kY];
       Det::estimate(history_, pb_, net_, y_est);
-      SensorStage<M>::clip(y_est);
+      sensor_.clip(y_est);
       float predicted[M::kY];
-      B::y_to_physical(y_est, predicted);
+      boundary_.y_to_physical(y_est, predicted);
       sensor_.to_measured(predicted, out.prediction);
       out.prediction_valid = true;
       if (M::kHasDetection && mode_ != Mode::kObserve) {
-        const auto d2 = Det::distance2(y_est, y_now);
+        const auto d2 = Det::distance2(*t_, y_est, y_now);
         out.d = Det::distance(d2);
-        out.contact = Det::is_contact(d2);
+        out.contact = Det::is_contact(*t_, d2);
         out.distance_valid = true;
       }
     }
@@ -128,16 +145,16 @@ class HadynetRuntime {
       }
       if (history_.count() >= 2) {
         Value x[M::kX];
-        B::x_from_frames(history_.y(0), history_.y(1), x);
+        boundary_.x_from_frames(history_.y(0), history_.y(1), x);
         Value u[M::kU];
         if constexpr (SensorStage<M>::has_derived_inputs()) {
           // Derived inputs keep their value of the newest frame over the horizon.
-          B::u_to_model(u_frame, u);
+          boundary_.u_to_model(u_frame, u);
           for (int i = 0; i < M::kU; ++i)
             if (M::kUDerived[i] != DerivedKind::kNone) stabilizer_.hold_input(i, u[i]);
         }
         stabilizer_.plan(net_, x, y_now, pb_, u);
-        B::u_to_physical(u, out.command);
+        boundary_.u_to_physical(u, out.command);
         out.command_valid = true;
       }
     }
@@ -147,19 +164,21 @@ class HadynetRuntime {
  private:
   void init_pb() noexcept {
     if constexpr (M::kHasDetection) {
-      for (int i = 0; i < M::kPb; ++i) pb_[i] = M::kDetectPb[i];
+      for (int i = 0; i < M::kPb; ++i) pb_[i] = t_->detect_pb[i];
     } else if constexpr (M::kStates > 0) {
-      for (int i = 0; i < M::kPb; ++i) pb_[i] = M::kPbTable[0][i];
+      for (int i = 0; i < M::kPb; ++i) pb_[i] = t_->pb_table[0][i];
     }
   }
 
+  const ModelTensors<M>* t_;
+  B boundary_;
   Mode mode_ = Mode::kDetect;
   Value pb_[M::kPb] = {};
   Value hold_[M::kU] = {};
   bool reference_pending_ = true;
-  SensorStage<M> sensor_{};
+  SensorStage<M> sensor_;
   typename Det::History history_{};
-  HadynetNet<M> net_{};
+  HadynetNet<M> net_;
   GraspStabilizer<M> stabilizer_{};
 };
 

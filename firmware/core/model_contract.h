@@ -59,8 +59,9 @@ constexpr bool parse_numeric(std::string_view text, Numeric& out) noexcept {
 // The version of this contract; codegen writes the same number into
 // kContractVersion (kGeneratorVersion names the generator, not the contract)
 // and the core rejects other versions at compile time (a stale generated
-// header fails the build, not the robot). 3 added kPeriodUs and kBoardGroup.
-inline constexpr int kModelContractVersion = 3;
+// header fails the build, not the robot). 3 added kPeriodUs and kBoardGroup,
+// 4 kShapeId.
+inline constexpr int kModelContractVersion = 4;
 
 // Loss class of each observed channel for the grasp stabiliser.
 enum class LossClass : std::uint8_t {
@@ -86,6 +87,9 @@ concept GeneratedModel = requires {
   { M::kContractVersion } -> std::convertible_to<int>;        // == kModelContractVersion
   { M::kGeneratorVersion } -> std::convertible_to<const char*>; // e.g. "hadynet-codegen 0.1.0"
   { M::kModelHash } -> std::convertible_to<std::uint64_t>;     // FNV-1a 64 of the model file bytes
+  // FNV-1a 64 of every member that is not model data (codegen/shape_id.h):
+  // a model image (docs/model-update.md) runs only in a firmware of its shape.
+  { M::kShapeId } -> std::convertible_to<std::uint64_t>;
   { M::kNumeric } -> std::convertible_to<Numeric>;
   typename M::Value;                                           // int16_t (q15) or float (f32)
   typename M::Bias;                                            // int32_t (q15) or float (f32)

@@ -19,6 +19,7 @@
 #define HADYNET_FIRMWARE_CORE_SENSOR_STAGE_H_
 
 #include "firmware/core/model_contract.h"
+#include "firmware/core/model_tensors.h"
 
 namespace hadynet::firmware {
 
@@ -27,6 +28,10 @@ class SensorStage {
  public:
   using Value = typename M::Value;
   static constexpr int kY = M::kY, kU = M::kU;
+
+  // With the sensor model values of `tensors` (the compiled-in model by
+  // default), which must outlive the stage.
+  explicit constexpr SensorStage(const ModelTensors<M>& tensors = kCompiledTensors<M>) noexcept : t_(&tensors) {}
 
   // Forgets the drift integrals and the hysteresis states (a new log starts).
   void reset() noexcept {
@@ -56,31 +61,31 @@ class SensorStage {
       const float magnitude = y[c] < 0.0f ? -y[c] : y[c];
       driver_[k] += M::kDriftIsLoad[k] ? magnitude * M::kSensorPeriod : M::kSensorPeriod;
       // The time driver is t dt with t counted from 0 at the first frame.
-      drifted[c] -= M::kDriftRate[k] * drift_driver(k);
+      drifted[c] -= t_->drift_rate[k] * drift_driver(k);
     }
     for (int i = 0; i < kY; ++i) y_model[i] = drifted[i];
     for (int k = 0; k < M::kCrosstalkCount; ++k)
-      y_model[M::kCrosstalkTarget[k]] -= M::kCrosstalkGain[k] * drifted[M::kCrosstalkSource[k]];
+      y_model[M::kCrosstalkTarget[k]] -= t_->crosstalk_gain[k] * drifted[M::kCrosstalkSource[k]];
   }
 
   // A model-frame prediction (physical) as the sensors would report it.
   void to_measured(const float (&y_model)[kY], float (&y)[kY]) const noexcept {
     for (int i = 0; i < kY; ++i) y[i] = y_model[i];
     for (int k = 0; k < M::kCrosstalkCount; ++k)
-      y[M::kCrosstalkTarget[k]] += M::kCrosstalkGain[k] * y_model[M::kCrosstalkSource[k]];
-    for (int k = 0; k < M::kDriftCount; ++k) y[M::kDriftChannel[k]] += M::kDriftRate[k] * drift_driver(k);
+      y[M::kCrosstalkTarget[k]] += t_->crosstalk_gain[k] * y_model[M::kCrosstalkSource[k]];
+    for (int k = 0; k < M::kDriftCount; ++k) y[M::kDriftChannel[k]] += t_->drift_rate[k] * drift_driver(k);
     for (int k = 0; k < M::kClipCount; ++k) {
       float& v = y[M::kClipChannel[k]];
-      if (M::kClipSide[k] > 0 ? v > M::kClipRail[k] : v < M::kClipRail[k]) v = M::kClipRail[k];
+      if (M::kClipSide[k] > 0 ? v > t_->clip_rail[k] : v < t_->clip_rail[k]) v = t_->clip_rail[k];
     }
   }
 
   // The clips on a standardised model-frame estimate (Q(kFracY)), so that
   // detection compares what a saturating sensor can show.
-  static void clip(Value (&y)[kY]) noexcept {
+  void clip(Value (&y)[kY]) const noexcept {
     for (int k = 0; k < M::kClipCount; ++k) {
       Value& v = y[M::kClipChannel[k]];
-      if (M::kClipSide[k] > 0 ? v > M::kClipRailModel[k] : v < M::kClipRailModel[k]) v = M::kClipRailModel[k];
+      if (M::kClipSide[k] > 0 ? v > t_->clip_rail_model[k] : v < t_->clip_rail_model[k]) v = t_->clip_rail_model[k];
     }
   }
 
@@ -97,6 +102,7 @@ class SensorStage {
   }
 
   static constexpr int kDrifts = M::kDriftCount > 0 ? M::kDriftCount : 1;
+  const ModelTensors<M>* t_;
   float driver_[kDrifts] = {};
   float hysteresis_[kU] = {};
 };

@@ -3,9 +3,11 @@
 // parallelism, 2.7..3.6 V: 16 KiB 800 ms, 64 KiB 2400 ms, 128 KiB 4000 ms
 // worst case; word programming 100 µs worst case = 25 µs/byte).
 //
-// Model slots (PROVISIONAL: the model-image issue owns the layout): sectors
-// 8..9 and 10..11, 256 KiB each; the firmware image keeps sectors 0..7
-// (512 KiB; today's image is ~350 KB).
+// Model slots A and B (firmware/model_update/: signed model images, boot
+// rule, updates; the layout inside a slot is firmware/model_update/
+// slot_layout.h): sectors 8..9 and 10..11, 256 KiB each, two 128 KiB
+// sectors per slot; the firmware image keeps sectors 0..7 (512 KiB; today's
+// image is ~350 KB).
 #ifndef HADYNET_FIRMWARE_FLASH_STM32F405_FLASH_LAYOUT_H_
 #define HADYNET_FIRMWARE_FLASH_STM32F405_FLASH_LAYOUT_H_
 
@@ -29,7 +31,7 @@ inline constexpr std::array<FlashSector, 12> kSectors = {{
 inline constexpr std::uint32_t kFlashSize = 0x100000;  // 1 MiB
 static_assert(kSectors.back().offset + kSectors.back().size == kFlashSize);
 
-// Provisional model slots (offset, size in bytes).
+// The model slots (offset, size in bytes).
 inline constexpr std::uint32_t kModelSlotAOffset = 0x80000;
 inline constexpr std::uint32_t kModelSlotBOffset = 0xC0000;
 inline constexpr std::uint32_t kModelSlotSize = 256 * 1024;

@@ -44,10 +44,10 @@ std::vector<float> direction(const hadynet::datalog::LogTable& log, const std::v
     yr[i] = static_cast<float>(log.at(static_cast<std::size_t>(t - 6), y_cols[static_cast<std::size_t>(i)]));
   }
   F::Value x[F::kX], y_now[F::kY], y_ref[F::kY], hold[F::kU], u[F::kU];
-  B::x_from_frames(yt, yp, x);
-  B::y_to_model(yt, y_now);
-  B::y_to_model(yr, y_ref);
-  B::u_to_model(hold_phys, hold);
+  B{}.x_from_frames(yt, yp, x);
+  B{}.y_to_model(yt, y_now);
+  B{}.y_to_model(yr, y_ref);
+  B{}.u_to_model(hold_phys, hold);
   stab.reset(hold);
   stab.set_reference(y_ref);
   stab.settings().epochs = 1;

@@ -298,6 +298,38 @@ void test_cols_i32() noexcept {
   }
 }
 
+// W^T g on packed matrices (rows in pairs, columns in chunks of eight):
+// against the plain sum over packed_index. Row counts odd and even, column
+// counts that are and are not multiples of 4 and 8.
+void test_cols_packed_i32() noexcept {
+  static constexpr int kRows[] = {1, 2, 3, 27, 28, 512};
+  static constexpr int kCols[] = {0, 1, 4, 5, 8, 12, 128};
+  for (const int rows : kRows) {
+    for (const int cols : kCols) {
+      const int padded = (cols + 7) / 8 * 8;
+      const int size = (rows + 1) / 2 * 2 * padded;
+      if (size > kWtRows * kWtCols) continue;
+      for (int p = 0; p < kPatterns; ++p) {
+        if (p != 0 && rows == 512 && cols > 8) continue;  // keep the run short
+        const Pattern pattern = static_cast<Pattern>(p);
+        for (int i = 0; i < size; ++i) g_wt[i] = value(pattern, i, false);
+        for (int r = 0; r < rows; ++r) g_g[r] = value32(pattern);
+        for (int c = 0; c <= cols; ++c) g_acc[c] = 0x5A5A5A5A5A5A5A5All;
+        kernels::dot_cols_packed_q15_i32(g_wt, padded, rows, g_g, cols, g_acc);
+        ++g_cases;
+        for (int c = 0; c < cols; ++c) {
+          std::int64_t want = 0;
+          for (int r = 0; r < rows; ++r)
+            want += static_cast<std::int64_t>(g_wt[kernels::packed_index(padded, r, c)]) * g_g[r];
+          if (g_acc[c] != want) report_failure("dot_cols_packed_i32", rows, cols, padded, p, c, g_acc[c], want);
+        }
+        if (g_acc[cols] != 0x5A5A5A5A5A5A5A5All)
+          report_failure("dot_cols_packed_i32(overrun)", rows, cols, padded, p, cols, g_acc[cols], 0);
+      }
+    }
+  }
+}
+
 // Runs every case; each failure (the first 20) and the summary line go to
 // `emit`. Returns the number of failures.
 int run_kernel_exactness(void (*emit)(std::string_view)) noexcept {
@@ -308,6 +340,7 @@ int run_kernel_exactness(void (*emit)(std::string_view)) noexcept {
   test_activations();
   test_rows_i32();
   test_cols_i32();
+  test_cols_packed_i32();
   Text<96> line;
   line << "kernel exactness: " << g_cases << " cases, " << g_failures << " failures\n";
   emit(line.view());

@@ -45,14 +45,14 @@ Eigen::MatrixXd firmware_rollout(const LogSequence& s, int t, int steps, const E
   frame<M>(s, t - 1, yp);
   for (int i = 0; i < M::kPb; ++i) pbf[i] = static_cast<float>(pb(i));
   Value x[M::kX], pbv[M::kPb], u[M::kU], y[M::kY];
-  B::x_from_frames(yt, yp, x);
+  B{}.x_from_frames(yt, yp, x);
   B::real_to_in(pbf, pbv);
   net.encode(x, pbv);
   Eigen::MatrixXd out(M::kY, steps);
   for (int k = 0; k < steps; ++k) {
     float uf[M::kU];
     for (int i = 0; i < M::kU; ++i) uf[i] = static_cast<float>(s.u(i, t + k));
-    B::u_to_model(uf, u);
+    B{}.u_to_model(uf, u);
     net.step(u, y);
     for (int i = 0; i < M::kY; ++i) out(i, k) = firmware::Numerics<M>::template to_real<M::kFracY>(y[i]);
   }
@@ -151,10 +151,10 @@ Plan firmware_plan(const LogSequence& s, int t, int t_ref, int epochs, int trunc
   frame<M>(s, t_ref, yr);
   frame<M>(s, t, yt);
   frame<M>(s, t - 1, yp);
-  B::y_to_model(yr, y_ref);
+  B{}.y_to_model(yr, y_ref);
   stab.set_reference(y_ref);
-  B::x_from_frames(yt, yp, x);
-  B::y_to_model(yt, y_now);
+  B{}.x_from_frames(yt, yp, x);
+  B{}.y_to_model(yt, y_now);
   const Eigen::VectorXd pb = detection_pb();
   for (int i = 0; i < M::kPb; ++i) pbf[i] = static_cast<float>(pb(i));
   B::real_to_in(pbf, pbv);

@@ -45,7 +45,7 @@ TEST(FirmwareEdgeCases, BoundaryConversionSaturatesAndMapsNaNToTheMean) {
   for (float extreme : {1e30f, -1e30f, std::numeric_limits<float>::infinity(),
                         -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN()}) {
     for (float& e : y) e = extreme;
-    Boundary<Q>::y_to_model(y, v);
+    Boundary<Q>{}.y_to_model(y, v);
     for (int i = 0; i < Q::kY; ++i) {
       if (std::isnan(extreme)) {
         EXPECT_EQ(v[i], 0);  // NaN -> 0 standardised = the channel mean

@@ -94,6 +94,13 @@ void dot_rows_q15_i32(const std::int16_t* w, int stride, int rows, const std::in
 void dot_cols_q15_i32(const std::int16_t* w, int stride, int rows, const std::int32_t* g, int cols,
                       std::int64_t* acc) noexcept;
 
+// acc[c] = sum_{r < rows} W(r, c) * g[r] for c < cols, W a packed matrix
+// (`w` = PackedMatrix::data, `padded_cols` = its kCols): W^T g from the
+// forward kernel's own storage, so a model keeps one copy of each matrix
+// (the model image's flash budget, docs/model-update.md).
+void dot_cols_packed_q15_i32(const std::int16_t* w, int padded_cols, int rows, const std::int32_t* g, int cols,
+                             std::int64_t* acc) noexcept;
+
 }  // namespace hadynet::kernels
 
 #endif  // HADYNET_FIRMWARE_CORE_KERNELS_DOT_Q15_H_

@@ -157,6 +157,11 @@ bool fast_term(const MatvecTerm& t) noexcept {
          t.shift <= 31;
 }
 
+// g's even and odd rows for dot_cols_packed_q15_i32 (static, as g_split).
+inline constexpr int kPackedColsMaxRows = 1024;
+alignas(8) std::int32_t g_even[kPackedColsMaxRows / 2];
+alignas(8) std::int32_t g_odd[kPackedColsMaxRows / 2];
+
 // The split of g for hadynet_dot_rows_split (static: the firmware is
 // single-threaded and nothing here is reentrant).
 alignas(8) std::int16_t g_split[2 * kSplitMaxCols];
@@ -256,6 +261,29 @@ void dot_cols_q15_i32(const std::int16_t* w, int stride, int rows, const std::in
     for (; c + 4 <= cols; c += 4) hadynet_dot_cols4(w + c, 2 * stride, g, rows, acc + c);
   }
   if (c < cols) reference::dot_cols_q15_i32(w + c, stride, rows, g, cols - c, acc + c);  // the last cols % 4
+}
+
+// W^T g on a packed matrix: a pair's two rows sit 8 elements apart and
+// pairs 2 * padded_cols apart, so the even rows and the odd rows are each a
+// row-major matrix with that stride; hadynet_dot_cols4 runs over each with
+// g's even or odd entries, four columns (inside one chunk of eight) at a time.
+void dot_cols_packed_q15_i32(const std::int16_t* w, int padded_cols, int rows, const std::int32_t* g, int cols,
+                             std::int64_t* acc) noexcept {
+  if (rows <= 1 || rows > kPackedColsMaxRows || cols % 4 != 0 || !word_aligned(w)) {
+    reference::dot_cols_packed_q15_i32(w, padded_cols, rows, g, cols, acc);
+    return;
+  }
+  const int even_rows = (rows + 1) / 2, odd_rows = rows / 2;
+  for (int i = 0; i < even_rows; ++i) g_even[i] = g[2 * i];
+  for (int i = 0; i < odd_rows; ++i) g_odd[i] = g[2 * i + 1];
+  const int stride_bytes = 2 * 2 * padded_cols;
+  for (int c = 0; c < cols; c += 4) {
+    const std::int16_t* first = w + packed_index(padded_cols, 0, c);
+    std::int64_t odd[4];
+    hadynet_dot_cols4(first, stride_bytes, g_even, even_rows, acc + c);
+    hadynet_dot_cols4(first + 8, stride_bytes, g_odd, odd_rows, odd);
+    for (int j = 0; j < 4; ++j) acc[c + j] += odd[j];
+  }
 }
 
 }  // namespace hadynet::kernels
