@@ -13,6 +13,9 @@
 #include <cstdint>
 #include <span>
 
+#include "firmware/flash/flash_device.h"
+#include "firmware/flash/flash_region_writer.h"
+
 namespace hadynet::board {
 
 // The control period: period_elapsed() turns true every 1 / kPeriodHz s.
@@ -62,6 +65,20 @@ void uart_write(const std::uint8_t* data, std::size_t size) noexcept;
 // readings or no complete scan has arrived yet. mps2-an386 has no ADC and
 // returns synthetic readings.
 bool read_loadcells(std::span<float> newtons) noexcept;
+
+// The flash that holds the two model slots (docs/model-update.md): the
+// device behind the flash seam, the two equal sector-aligned slot regions,
+// and the device's memory-mapped view (offset 0 = its first byte), from
+// which the runtime reads the booted model in place. nullptr on a board
+// without one (mps2-an386: its "flash" is RAM in QEMU; it runs the
+// compiled-in model). Everything lives in static storage.
+struct ModelFlash {
+  flash::FlashDevice& device;
+  flash::FlashRegion slot_a;
+  flash::FlashRegion slot_b;
+  std::span<const std::uint8_t> mapped;
+};
+const ModelFlash* model_flash() noexcept;
 
 // Bytes of stack the firmware has used so far (high-water mark of a pattern
 // painted at reset), and the stack's size.

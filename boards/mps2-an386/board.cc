@@ -98,4 +98,6 @@ __attribute__((section(".isr_vector.irq"), used)) constexpr auto g_irq_vectors =
     make_irq_vectors<config::kIrqCount>({{kUart0RxIrq, Uart0Rx_Handler}});
 
 }  // namespace
+const ModelFlash* model_flash() noexcept { return nullptr; }
+
 }  // namespace hadynet::board

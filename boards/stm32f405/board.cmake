@@ -30,7 +30,7 @@ set(BOARD_REGION_STACK SRAM)
 # tendon loadcells fc0..fc8, board_config.h kLoadcells).
 set(BOARD_LOADCELLS 9)
 set(BOARD_STACK_BYTES 32768)
-set(BOARD_SOURCES board.cc clock_tree.cc loadcells.cc
+set(BOARD_SOURCES board.cc clock_tree.cc loadcells.cc model_flash.cc
   # The USB device port (boards/board_usb.h): OTG FS driver, embedded flash
   # behind the DFU model slots, DFU_DETACH into the ROM bootloader.
   usb_port.cc otg_fs_controller.cc flash_controller.cc system_bootloader.cc)

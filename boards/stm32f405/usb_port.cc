@@ -15,8 +15,8 @@
 #include <cstdint>
 
 #include "board_config.h"
+#include "boards/board.h"
 #include "boards/board_usb.h"
-#include "boards/stm32f405/flash_controller.h"
 #include "boards/stm32f405/otg_fs_controller.h"
 #include "boards/stm32f405/system_bootloader.h"
 #include "firmware/flash/stm32f405_flash_layout.h"
@@ -26,9 +26,7 @@ namespace {
 
 namespace layout = flash::stm32f405;
 
-static_assert(config::kFLASHOrigin + config::kFLASHBytes <=
-                  layout::kFlashBase + std::min(layout::kModelSlotAOffset, layout::kModelSlotBOffset),
-              "the firmware's flash region (board.cmake) overlaps a model slot");
+
 
 // RM0090 §39.1: the 96-bit unique device ID, read-only, 12 bytes.
 constexpr std::uintptr_t kUniqueIdAddress = 0x1FFF7A10;
@@ -38,8 +36,6 @@ stm32::Stm32f405OtgFsHooks g_otg_hooks;
 stm32::OtgFsController<stm32::otg::OtgFsMmio> g_otg(g_otg_registers, g_otg_hooks,
                                                      stm32::OtgFsOptions{.vbus_sensing = false,
                                                                          .ahb_clock_hz = config::kCoreClockHz});
-stm32::FlashController g_flash(stm32::flash_interface_registers(), stm32::flash_memory_window(),
-                               config::kCoreClockHz);
 stm32::SystemBootloaderDetach g_detach;
 
 // Alt 0 receives a model into slot B; alt 1 reads slot A (the provisional
@@ -51,7 +47,7 @@ constexpr usb::DfuTarget kModelSlots[usb::composite::kDfuAlternates] = {
 
 std::uint8_t g_unique_id[usb::kUniqueIdBytes];
 
-constexpr UsbPort kPort{g_otg, g_flash, std::span<const usb::DfuTarget, usb::composite::kDfuAlternates>(kModelSlots),
+const UsbPort kPort{g_otg, model_flash()->device, std::span<const usb::DfuTarget, usb::composite::kDfuAlternates>(kModelSlots),
                         g_detach, std::span<const std::uint8_t, usb::kUniqueIdBytes>(g_unique_id)};
 
 // True once the core, clocked, reports its AHB master idle (GRSTCTL.AHBIDL,

@@ -13,15 +13,23 @@
 //       step -> the period record (period_record.h), which the link sends
 //       on request (0x08) and usb_publish() sends as HID telemetry.
 //
+// At start-up the model is chosen (docs/model-update.md): on a board with
+// model flash, the boot rule of firmware/model_update/model_slots.h picks
+// a signed model image from the two slots (a new one passes its self-test
+// first) or the compiled-in model, and the runtime reads the chosen one in
+// place.
+//
 // All state is static (no heap); the runtime is constructed before main()
 // by the start-up code's static constructors.
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <type_traits>
 
 #include "boards/board.h"
 #include "firmware/app/channel_layout.h"
 #include "firmware/app/image_checks.h"
+#include "firmware/app/model_store.h"
 #include "firmware/app/period_loop.h"
 #include "firmware/app/uart_endpoint.h"
 #include "firmware/app/usb_link.h"
@@ -39,6 +47,17 @@ static_assert(hadynet::app::model_fits_board<Model>());
 
 hadynet::firmware::HadynetRuntime<Model> g_runtime;
 hadynet::app::UartEndpoint<Model> g_endpoint(g_runtime);
+std::optional<hadynet::model_update::ModelSlots> g_model_slots;  // on a board with model flash
+
+// Chooses the model (the boot rule). On a board without model flash the
+// compiled-in model runs.
+void boot_model() noexcept {
+  if (const hadynet::board::ModelFlash* flash = hadynet::board::model_flash()) {
+    g_model_slots.emplace(flash->device, flash->slot_a, flash->slot_b, hadynet::app::model_identity<Model>(),
+                          hadynet::board::config::kModelPublicKey, flash->mapped);
+    hadynet::app::boot_model(*g_model_slots, g_runtime);
+  }
+}
 
 // The 5 Hz job: one period of the autonomous loop, its work timed against
 // the period (overruns are counted in the records).
@@ -57,6 +76,7 @@ void periodic() noexcept {
 
 int main() {
   hadynet::board::init();
+  boot_model();
   hadynet::app::usb_start(g_endpoint.dispatcher());
   for (;;) {
     std::uint8_t byte;

@@ -33,14 +33,14 @@ bool ed25519_verify(std::span<const std::uint8_t, kEd25519SignatureBytes> signat
   if (edwards25519::has_small_order_y(r)) return false;
   // Rule 3: A canonical, not of small order, a curve point.
   if (!gf25519::is_canonical(public_key) || edwards25519::has_small_order_y(public_key)) return false;
-  // (k before A is decoded: the hash state and the point never share the stack.)
   const scalar25519::Scalar k = challenge(r, public_key, message);
   edwards25519::Extended a;
   if (!edwards25519::decode(a, public_key)) return false;
 
   // Rule 4: encode([S]B + [k](-A)) == R.
-  a = edwards25519::negate(a);
-  const edwards25519::Projective check = edwards25519::double_scalar_mul_base(s, k, a);
+  edwards25519::PointMultiples minus_a_multiples;
+  edwards25519::fill_odd_multiples(minus_a_multiples, edwards25519::negate(a));
+  const edwards25519::Projective check = edwards25519::double_scalar_mul_base(s, k, minus_a_multiples);
   const std::array<std::uint8_t, 32> encoded = edwards25519::encode(check);
   for (std::size_t i = 0; i < 32; ++i) {
     if (encoded[i] != r[i]) return false;

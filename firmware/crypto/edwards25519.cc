@@ -14,7 +14,6 @@ constexpr std::array<Cached, kBaseTableSize> kBaseOddMultiples = [] {
   fill_odd_multiples(table, kBasePoint);
   return table;
 }();
-constexpr std::size_t kPointTableSize = std::size_t{1} << (kPointWindow - 2);
 
 // The y of the four points of order 8 is +-y8: 2P has order 4, so
 // y(2P) = (x^2 + y^2) / (2 + x^2 - y^2) = 0, and with the curve equation
@@ -74,13 +73,11 @@ bool has_small_order_y(std::span<const std::uint8_t, 32> bytes) noexcept {
   return equal(y, kOne) || equal(y, neg(kOne)) || is_zero(y) || equal(y, kOrder8Y) || equal(y, neg(kOrder8Y));
 }
 
-Projective double_scalar_mul_base(const Scalar& s, const Scalar& k, const Extended& p) noexcept {
+Projective double_scalar_mul_base(const Scalar& s, const Scalar& k, const PointMultiples& p_multiples) noexcept {
   std::int8_t s_digits[kNafDigits];
   std::int8_t k_digits[kNafDigits];
   scalar25519::naf(s_digits, s, kBaseWindow);
   scalar25519::naf(k_digits, k, kPointWindow);
-  std::array<Cached, kPointTableSize> p_multiples;
-  fill_odd_multiples(p_multiples, p);
 
   int top = static_cast<int>(kNafDigits) - 1;
   while (top >= 0 && s_digits[top] == 0 && k_digits[top] == 0) --top;

@@ -108,8 +108,8 @@ constexpr Extended negate(const Extended& p) noexcept {
   return {gf25519::neg(p.x), p.y, p.z, gf25519::neg(p.t)};
 }
 
-// P, 3P, 5P, ...: table[i] = (2i + 1)P for every i of the table, the odd
-// multiples a NAF digit of width w selects (2^(w-2) entries).
+// P, 3P, 5P, ...: table[i] = (2i + 1)P for every entry, the odd multiples
+// the NAF digits of width w select (a table of 2^(w-2) entries, >= 1).
 constexpr void fill_odd_multiples(std::span<Cached> table, const Extended& p) noexcept {
   const Cached two_p = to_cached(to_extended(dbl(p)));
   Extended multiple = p;
@@ -139,12 +139,15 @@ bool has_small_order_y(std::span<const std::uint8_t, 32> bytes) noexcept;
 
 // [s]B + [k]P for s, k < L: one shared chain of doublings, s as a width-6
 // NAF over a compile-time table of B's odd multiples (16 entries, flash),
-// k as a width-4 NAF over P's odd multiples (4 entries, stack). P may be any
-// point (of small or mixed order too).
+// k as a width-4 NAF over P's odd multiples (4 entries), which the caller
+// fills with fill_odd_multiples(): kept in the caller's frame, the table
+// and the filling's temporaries are never on the stack together with the
+// NAF digits. P may be any point (of small or mixed order too).
 inline constexpr int kBaseWindow = 6;
 inline constexpr int kPointWindow = 4;
+using PointMultiples = std::array<Cached, std::size_t{1} << (kPointWindow - 2)>;
 Projective double_scalar_mul_base(const scalar25519::Scalar& s, const scalar25519::Scalar& k,
-                                  const Extended& p) noexcept;
+                                  const PointMultiples& p_multiples) noexcept;
 
 }  // namespace hadynet::crypto::edwards25519
 

@@ -8,11 +8,13 @@
 // back with 2^256 = 38 (mod p). Only canonical() and to_bytes() produce the
 // unique residue in [0, p); compare elements with equal(), never limb by limb.
 //
-// Everything is constexpr (edwards25519.cc builds the base point's table at
-// compile time) and variable time: verification handles only public data,
-// so nothing here needs to be constant time, and nothing here is.
+// Everything is constexpr: edwards25519.cc has the compiler build the base
+// point's table. At run time add, sub, mul and square go to out-of-line
+// copies (field25519.cc) rather than being inlined at every use.
+// Variable time: verification handles only public data, so nothing here
+// needs to be constant time, and nothing here is.
 //
-// Stack: at most ~0.2 KiB per call (a 512-bit product and a few elements).
+// Stack: at most ~0.1 KiB per call (a 512-bit product and a few limbs).
 #ifndef HADYNET_FIRMWARE_CRYPTO_FIELD25519_H_
 #define HADYNET_FIRMWARE_CRYPTO_FIELD25519_H_
 
@@ -172,7 +174,8 @@ constexpr Element square_impl(const Element& a) noexcept {
 }
 
 // Out-of-line copies of the above (field25519.cc), which run-time calls go
-// to: inlined at every use they would triple the code size on the MCU.
+// to: inlined at every use they doubled the code size on the MCU and made
+// verification slower.
 Element add_out_of_line(const Element& a, const Element& b) noexcept;
 Element sub_out_of_line(const Element& a, const Element& b) noexcept;
 Element mul_out_of_line(const Element& a, const Element& b) noexcept;

@@ -7,7 +7,7 @@
 // longer input is not detected. Not constant time in the message length
 // (irrelevant here: it hashes public data).
 //
-// Stack: about 0.3 KiB in update()/finish() (the 16-word message schedule and
+// Stack: about 0.35 KiB in update()/finish() (the 16-word message schedule and
 // the working variables) besides the object itself (~208 bytes).
 #ifndef HADYNET_FIRMWARE_CRYPTO_SHA512_H_
 #define HADYNET_FIRMWARE_CRYPTO_SHA512_H_

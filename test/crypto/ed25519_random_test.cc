@@ -8,8 +8,8 @@
 // signature is accepted.
 //
 // 4 shards x 500 keys = 2000 key pairs, 10 000 verdicts of each verifier;
-// sharded so ctest runs them in parallel (the Debug ASan+UBSan build is
-// several times slower).
+// sharded so ctest runs them in parallel. About 0.6 s a shard in the
+// release build, 6-10 s in the Debug ASan+UBSan build.
 #include <sodium.h>
 
 #include <cstdio>
