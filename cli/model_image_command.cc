@@ -26,7 +26,7 @@ host::ModelImage image_for(const codegen::LoadedModel& loaded, codegen::CodegenO
   options.numeric = M::kNumeric;
   if (M::kNumeric == firmware::Numeric::kQ15) options.target_formats = host::firmware_formats<M>();
   const codegen::GeneratedHeader header = codegen::generate(loaded.model, loaded.identity, options);
-  return host::make_model_image<M>(header, loaded.identity.hash, key, request);
+  return host::make_model_image<M>(header, key, request);
 }
 
 }  // namespace

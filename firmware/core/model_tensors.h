@@ -69,6 +69,8 @@ struct ModelTensors {
   static constexpr int kDrifts = M::kDriftCount > 0 ? M::kDriftCount : 1;
   static constexpr int kClips = M::kClipCount > 0 ? M::kClipCount : 1;
 
+  // ---- 8 bytes
+  std::uint64_t model_hash;  // FNV-1a 64 of the model file these tensors came from (kModelHash)
   // ---- 8 bytes (q15) or 4 (f32)
   ThresholdSq detect_threshold_sq;  // C_detect^2 (model_contract.h)
   // ---- float32, physical units (model_contract.h)
@@ -103,6 +105,7 @@ struct ModelTensors {
 // Counts and shapes are M's.
 template <GeneratedModel M, class Source>
 constexpr void build_tensors(const Source& s, ModelTensors<M>& t) noexcept {
+  t.model_hash = s.kModelHash;
   t.detect_threshold_sq = s.kDetectThresholdSq;
   for (int i = 0; i < M::kX; ++i) {
     t.x_mean[i] = s.kXMean[i];
@@ -178,7 +181,7 @@ template <GeneratedModel M>
 constexpr std::size_t unpadded_tensor_bytes() noexcept {
   using T = ModelTensors<M>;
   constexpr std::size_t members =
-      sizeof(T::detect_threshold_sq) + sizeof(T::x_mean) + sizeof(T::x_inv_std) + sizeof(T::u_mean) +
+      sizeof(T::model_hash) + sizeof(T::detect_threshold_sq) + sizeof(T::x_mean) + sizeof(T::x_inv_std) + sizeof(T::u_mean) +
       sizeof(T::u_std) + sizeof(T::u_inv_std) + sizeof(T::y_mean) + sizeof(T::y_std) + sizeof(T::y_inv_std) +
       sizeof(T::detect_threshold) + sizeof(T::crosstalk_gain) + sizeof(T::drift_rate) + sizeof(T::clip_rail) +
       sizeof(T::enc_bias) + sizeof(T::lstm_bias) + sizeof(T::dec_bias) + sizeof(T::weights) +

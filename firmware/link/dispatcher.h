@@ -65,7 +65,7 @@ class LinkDispatcher {
     switch (type) {
       case MessageType::kInfoRequest: {
         if (const Status s = decode_empty(f.payload); !s.ok()) return refuse(s);
-        payload_size = encode_info(kInfo, payload);
+        payload_size = encode_info(info_of<M>(runtime_.tensors()), payload);
         break;
       }
       case MessageType::kSensorFrame: {
@@ -149,8 +149,6 @@ class LinkDispatcher {
   const app::PeriodLoop<M>& loop() const noexcept { return loop_; }
 
  private:
-  static constexpr InfoReply kInfo = info_of<M>();
-
   static std::size_t error_reply(ErrorCode code, std::uint16_t sequence, const char* reason,
                                  std::span<std::uint8_t, kMaxFrame> reply) noexcept {
     FrameBuilder builder(reply);

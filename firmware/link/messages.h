@@ -87,11 +87,13 @@ struct InfoReply {
   char generator_version[kMaxGeneratorVersion + 1] = {};  // NUL-terminated
 };
 
-// The info of model M (generator string cut at kMaxGeneratorVersion bytes).
+// The info of a firmware of shape M running `tensors` (the compiled-in
+// model by default; model hash and threshold are the running model's), the
+// generator string cut at kMaxGeneratorVersion bytes.
 template <firmware::GeneratedModel M>
-constexpr InfoReply info_of() noexcept {
+constexpr InfoReply info_of(const firmware::ModelTensors<M>& tensors = firmware::kCompiledTensors<M>) noexcept {
   InfoReply r;
-  r.model_hash = M::kModelHash;
+  r.model_hash = tensors.model_hash;
   r.contract_version = static_cast<std::uint16_t>(M::kContractVersion);
   r.protocol_version = kProtocolVersion;
   r.numeric = static_cast<std::uint8_t>(to_wire(M::kNumeric));
@@ -104,7 +106,7 @@ constexpr InfoReply info_of() noexcept {
   r.detect_steps = static_cast<std::uint16_t>(M::kDetectSteps);
   r.control_horizon = static_cast<std::uint16_t>(M::kControlHorizon);
   r.has_detection = M::kHasDetection ? 1 : 0;
-  r.detect_threshold = static_cast<float>(M::kDetectThreshold);
+  r.detect_threshold = tensors.detect_threshold;
   const char* g = M::kGeneratorVersion;
   std::size_t n = 0;
   while (n < kMaxGeneratorVersion && g[n] != '\0') {

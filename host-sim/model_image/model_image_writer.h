@@ -98,8 +98,8 @@ std::uint64_t self_test_checksum(const firmware::ModelTensors<M>& tensors) {
 
 // The signed image of `header` for a firmware of shape M.
 template <firmware::GeneratedModel M>
-ModelImage make_model_image(const codegen::GeneratedHeader& header, std::uint64_t model_hash,
-                            const SigningKey& key, const ModelImageRequest& request) {
+ModelImage make_model_image(const codegen::GeneratedHeader& header, const SigningKey& key,
+                            const ModelImageRequest& request) {
   if (request.sequence == 0) throw ModelImageError("model image: the sequence number must be at least 1");
   const auto tensors = tensors_of<M>(header);
   ModelImage image;
@@ -121,7 +121,7 @@ ModelImage make_model_image(const codegen::GeneratedHeader& header, std::uint64_
             static_cast<std::uint16_t>(M::kTrainSteps), static_cast<std::uint16_t>(M::kDetectSteps)};
   const std::array<int, 12> fracs = firmware_formats<M>();
   for (std::size_t i = 0; i < fracs.size(); ++i) h.frac_bits[i] = static_cast<std::uint8_t>(fracs[i]);
-  h.model_hash = model_hash;
+  h.model_hash = tensors->model_hash;
   h.public_key = key.public_key;
   h.payload_sha256 = sha256({payload, n});
 

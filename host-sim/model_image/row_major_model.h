@@ -55,13 +55,23 @@ T parse_literal(const std::string& name, const std::string& text) {
     return v;
   } else {
     static_assert(std::is_integral_v<T>);
-    std::int64_t v = 0;
-    const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-    if (ec != std::errc() || ptr != text.data() + text.size() || v < std::numeric_limits<T>::min() ||
-        v > std::numeric_limits<T>::max()) {
-      throw ModelLiteralError("model image: " + name + ": bad integer " + text);
+    if constexpr (std::is_same_v<T, std::uint64_t>) {  // a hash: "0x0123456789abcdefULL"
+      std::uint64_t v = 0;
+      const bool hex = text.size() == 21 && text.rfind("0x", 0) == 0 && text.compare(18, 3, "ULL") == 0;
+      const auto [ptr, ec] = hex ? std::from_chars(text.data() + 2, text.data() + 18, v, 16)
+                                 : std::from_chars_result{text.data(), std::errc::invalid_argument};
+      if (!hex || ec != std::errc() || ptr != text.data() + 18)
+        throw ModelLiteralError("model image: " + name + ": bad hash " + text);
+      return v;
+    } else {
+      std::int64_t v = 0;
+      const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+      if (ec != std::errc() || ptr != text.data() + text.size() || v < std::numeric_limits<T>::min() ||
+          v > std::numeric_limits<T>::max()) {
+        throw ModelLiteralError("model image: " + name + ": bad integer " + text);
+      }
+      return static_cast<T>(v);
     }
-    return static_cast<T>(v);
   }
 }
 
@@ -116,6 +126,7 @@ struct RowMajorModel {
   static constexpr int kDrifts = M::kDriftCount > 0 ? M::kDriftCount : 1;
   static constexpr int kClips = M::kClipCount > 0 ? M::kClipCount : 1;
 
+  std::uint64_t kModelHash;
   float kXMean[M::kX], kXInvStd[M::kX];
   float kUMean[M::kU], kUStd[M::kU], kUInvStd[M::kU];
   float kYMean[M::kY], kYStd[M::kY], kYInvStd[M::kY];
@@ -150,6 +161,7 @@ struct RowMajorModel {
   // that is missing, of another size or not a number).
   void read(const Literals& l) {
     using detail::fill;
+    detail::fill_scalar(l, "kModelHash", kModelHash);
     fill(l, "kXMean", kXMean);
     fill(l, "kXInvStd", kXInvStd);
     fill(l, "kUMean", kUMean);

@@ -120,7 +120,7 @@ TEST(ModelImage, HeaderIsSignedOverWhatTheDeviceChecks) {
   const GeneratedHeader h = header_for<Q>(built_in().model, o);
   const hadynet::host::SigningKey key = hadynet::host::generate_signing_key(false);
   const hadynet::host::ModelImage image =
-      hadynet::host::make_model_image<Q>(h, built_in().identity.hash, key, {7, false});
+      hadynet::host::make_model_image<Q>(h, key, {7, false});
   namespace mu = hadynet::model_update;
   ASSERT_EQ(image.bytes.size(), mu::kImageHeaderSize + sizeof(ModelTensors<Q>));
   mu::ModelImageHeader decoded;

@@ -28,10 +28,11 @@ const hadynet::codegen::LoadedModel& built_in() {
   return m;
 }
 
-hadynet::codegen::GeneratedHeader header_of(const hadynet::trainer::HadynetModel& model) {
+hadynet::codegen::GeneratedHeader header_of(const hadynet::trainer::HadynetModel& model,
+                                            std::uint64_t model_hash = built_in().identity.hash) {
   hadynet::codegen::CodegenOptions o;
   o.target_formats = hadynet::host::firmware_formats<Q>();
-  return hadynet::codegen::generate(model, built_in().identity, o);
+  return hadynet::codegen::generate(model, {"retrained.safetensors", model_hash}, o);
 }
 
 // A device: the F405's flash (1 MiB, its sector table) and its slots.
@@ -66,7 +67,7 @@ TEST(SlotBoot, BuiltInModelFromASlotRunsBitForBitAsCompiledIn) {
   const auto key = hadynet::host::generate_signing_key(false);
   Device device(key.public_key);
   EXPECT_EQ(device.slots->choice().source, mu::ModelSource::kFactory);
-  const auto image = hadynet::host::make_model_image<Q>(header_of(built_in().model), 1, key, {1, false});
+  const auto image = hadynet::host::make_model_image<Q>(header_of(built_in().model), key, {1, false});
   ASSERT_EQ(device.send(image), mu::UpdateError::kOk);
   device.power_on(key.public_key);  // reboot: the new image's trial, self-test, confirmation
   const mu::BootChoice& choice = device.slots->choice();
@@ -84,12 +85,15 @@ TEST(SlotBoot, RetrainedModelRunsItsOwnTensorsAndSurvivesReboots) {
   hadynet::trainer::HadynetModel changed = built_in().model;
   changed.params.dec_bias.array() += 0.01f;
   changed.params.pb.row(0).swap(changed.params.pb.row(1));
-  const auto image = hadynet::host::make_model_image<Q>(header_of(changed), 2, key, {5, false});
+  constexpr std::uint64_t kRetrainedHash = 0x0123456789abcdefULL;
+  const auto image = hadynet::host::make_model_image<Q>(header_of(changed, kRetrainedHash), key, {5, false});
+  EXPECT_EQ(image.header.model_hash, kRetrainedHash);
   ASSERT_EQ(device.send(image), mu::UpdateError::kOk);
   for (int boot = 0; boot < 2; ++boot) {  // the trial boot, then a confirmed one
     device.power_on(key.public_key);
     ASSERT_NE(device.slots->choice().source, mu::ModelSource::kFactory) << "boot " << boot;
     EXPECT_EQ(device.slots->choice().trial_this_boot, boot == 0);
+    EXPECT_EQ(device.runtime->tensors().model_hash, kRetrainedHash);  // what the link's INFO reports
     EXPECT_EQ(checksum_of(*device.runtime), image.self_test_checksum) << "boot " << boot;
   }
   auto compiled = std::make_unique<hadynet::firmware::HadynetRuntime<Q>>();
@@ -99,7 +103,7 @@ TEST(SlotBoot, RetrainedModelRunsItsOwnTensorsAndSurvivesReboots) {
 TEST(SlotBoot, ImageWhoseSelfTestFailsIsRevertedToTheFactoryModel) {
   const auto key = hadynet::host::generate_signing_key(false);
   Device device(key.public_key);
-  auto image = hadynet::host::make_model_image<Q>(header_of(built_in().model), 1, key, {1, false});
+  auto image = hadynet::host::make_model_image<Q>(header_of(built_in().model), key, {1, false});
   // A validly signed header whose self-test checksum the model does not
   // reproduce (as if the host's and the device's runtimes disagreed).
   image.header.self_test_crc32 ^= 1;
