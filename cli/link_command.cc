@@ -108,6 +108,9 @@ int run_link(int argc, char** argv) {
   opt.value("tcp", "HOST:PORT", "a socket (e.g. QEMU's -serial tcp:...)");
   opt.value("qemu", "ELF", "start QEMU with this firmware image and talk to it");
   opt.value("machine", "NAME", "QEMU machine for --qemu", "mps2-an386");
+  opt.value("qemu-load", "FILE@ADDRESS",
+            "with --qemu: place FILE's bytes at ADDRESS (e.g. 0x08080000) in the guest before it starts, such\n"
+            "as a model slot's contents in the emulated flash");
   opt.value("numeric", "q15|f32", "the device's numeric (message sizes come from this build's model)", "q15");
   if (!opt.parse(argc, argv)) return 2;
   if (opt.help_requested()) return 0;
@@ -122,8 +125,16 @@ int run_link(int argc, char** argv) {
     std::unique_ptr<tools::FdStream> own;
     tools::ByteStream* stream = nullptr;
     if (opt.has("qemu")) {
-      qemu = std::make_unique<tools::QemuProcess>(
-          tools::QemuOptions{"qemu-system-arm", opt.get("machine"), opt.get("qemu"), false, ""});
+      tools::QemuOptions q{"qemu-system-arm", opt.get("machine"), opt.get("qemu"), false, "", {}};
+      if (opt.has("qemu-load")) {
+        const auto load = tools::parse_qemu_load(opt.get("qemu-load"));
+        if (!load) {
+          std::fprintf(stderr, "hadynet link: --qemu-load wants FILE@ADDRESS, got '%s'\n", opt.get("qemu-load").c_str());
+          return 2;
+        }
+        q.loads.push_back(*load);
+      }
+      qemu = std::make_unique<tools::QemuProcess>(q);
       stream = &qemu->link();
     } else if (opt.has("device")) {
       const auto baud = opt.get_int("baud", 1, 10000000);

@@ -87,6 +87,9 @@ int run_replay(int argc, char** argv) {
   opt.value("image", "ELF", "firmware image for --target qemu", HADYNET_DEFAULT_QEMU_IMAGE);
   opt.value("machine", "NAME", "QEMU machine for --target qemu (mps2-an386, netduinoplus2)", "mps2-an386");
   opt.value("qemu-log", "FILE", "QEMU's own output (--target qemu)");
+  opt.value("qemu-load", "FILE@ADDRESS",
+            "--target qemu: place FILE's bytes at ADDRESS in the guest before it starts (e.g. a model slot's\n"
+            "contents at 0x08080000 on netduinoplus2)");
   opt.value("device", "PATH", "serial device for --target serial (e.g. /dev/ttyACM0, a pty)");
   opt.value("baud", "N", "baud rate for --target serial", "115200");
   opt.value("tcp", "HOST:PORT", "socket for --target tcp (e.g. QEMU's -serial tcp:...)");
@@ -189,6 +192,15 @@ int run_replay(int argc, char** argv) {
       ro.qemu_image = opt.get("image");
       ro.qemu_machine = opt.get("machine");
       ro.qemu_log = opt.get("qemu-log");
+      if (opt.has("qemu-load")) {
+        const auto load = tools::parse_qemu_load(opt.get("qemu-load"));
+        if (!load) {
+          std::fprintf(stderr, "hadynet replay: --qemu-load wants FILE@ADDRESS, got '%s'\n",
+                       opt.get("qemu-load").c_str());
+          return 2;
+        }
+        ro.qemu_loads.push_back(*load);
+      }
     } else if (target == "serial" || target == "tcp") {
       if (target == "serial") {
         const auto baud = opt.get_int("baud", 1, 10000000);

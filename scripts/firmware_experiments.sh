@@ -70,4 +70,10 @@ section "grasp stabiliser in closed loop with the plant: Cylinder init 3, defaul
 record "$hadynet" stabilize --object Cylinder --init 3 --periods 100 --csv "$out/stabilize.csv" \
   --plot "$out/stabilize.png"
 end_section
+section "a model image of this model for the build's firmware (docs/model-update.md; development key)"
+if ! record build/release/cli/hadynet model-image "$model" --key keys/development.key --sequence 2 \
+       --out "$out/model.img"; then
+  echo "(no image: this model needs a firmware built for it; the reason is above)" | tee -a "$summary"
+fi
+end_section
 echo "summary: $summary"

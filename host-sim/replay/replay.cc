@@ -145,7 +145,7 @@ template <class M>
 ReplayResult replay_with(const datalog::LogTable& log, const std::string& file, const ReplayOptions& opt) {
   switch (opt.target) {
     case ReplayTarget::kQemu: {
-      tools::QemuProcess qemu({"qemu-system-arm", opt.qemu_machine, opt.qemu_image, false, opt.qemu_log});
+      tools::QemuProcess qemu({"qemu-system-arm", opt.qemu_machine, opt.qemu_image, false, opt.qemu_log, opt.qemu_loads});
       LinkDevice<M> device(qemu.link(), opt);
       return replay_on<M>(device, log, file, opt);
     }

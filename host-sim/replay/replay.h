@@ -12,6 +12,7 @@
 #include "datalog/log_table.h"
 #include "firmware/core/hadynet_runtime.h"
 #include "tools/link/byte_stream.h"
+#include "tools/link/qemu_process.h"
 
 namespace hadynet::hostsim {
 
@@ -33,6 +34,7 @@ struct ReplayOptions {
   std::string qemu_image;      // firmware ELF (target qemu); its model must be the compiled-in one
   std::string qemu_machine = "mps2-an386";
   std::string qemu_log;        // QEMU's output ("" : discarded)
+  std::vector<tools::QemuOptions::Load> qemu_loads;  // files placed into the guest (e.g. a model slot)
   tools::ByteStream* stream = nullptr;  // target stream: the open link (not owned)
 };
 

@@ -29,7 +29,7 @@ class QemuLink : public ::testing::Test {
  protected:
   void SetUp() override {
     qemu_ = std::make_unique<tools::QemuProcess>(
-        tools::QemuOptions{"qemu-system-arm", "mps2-an386", HADYNET_FIRMWARE_IMAGE, false, ""});
+        tools::QemuOptions{"qemu-system-arm", "mps2-an386", HADYNET_FIRMWARE_IMAGE, false, "", {}});
     tools::LinkSession<Q> session(qemu_->link());
     session.connect();  // reset: sequence numbers restart at the session's next (1)
     client_.set_next_sequence(1);

@@ -47,7 +47,7 @@ class QemuPeriodLoop : public ::testing::Test {
  protected:
   void SetUp() override {
     qemu_ = std::make_unique<tools::QemuProcess>(
-        tools::QemuOptions{"qemu-system-arm", "mps2-an386", HADYNET_FIRMWARE_IMAGE, false, ""});
+        tools::QemuOptions{"qemu-system-arm", "mps2-an386", HADYNET_FIRMWARE_IMAGE, false, "", {}});
     tools::LinkSession<Q> session(qemu_->link());
     session.connect();  // reset: the loop holds no muscle state
     client_.set_next_sequence(1);

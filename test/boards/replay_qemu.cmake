@@ -3,7 +3,10 @@
 # and through host-sim's q15 core must give bit-identical results: every
 # column of the two CSVs but the stabiliser's losses, which only host-sim
 # reports (tolerance zero: q15 is bit-identical on host and MCU).
-# Usage: cmake -DHADYNET=<hadynet> -DIMAGE=<elf> -DMACHINE=<qemu machine> -DWORK=<dir> -P replay_qemu.cmake
+# With -DSLOT=<file> the file is placed in model slot A of the emulated
+# STM32F405 flash (0x08080000) and the firmware runs the model from there
+# (docs/model-update.md): still bit-identical to host-sim's compiled-in one.
+# Usage: cmake -DHADYNET=<hadynet> -DIMAGE=<elf> -DMACHINE=<qemu machine> -DWORK=<dir> [-DSLOT=<file>] -P replay_qemu.cmake
 foreach(var HADYNET IMAGE MACHINE WORK)
   if(NOT ${var})
     message(FATAL_ERROR "replay_qemu: set ${var}")
@@ -27,8 +30,12 @@ endfunction()
 run("${HADYNET}" collect --object Cylinder --motion random2 --init 3 --rows 60 --split test --out "${WORK}" --quiet)
 set(log "${WORK}/test/Cylinder_random2_i3_w0.csv")
 run("${HADYNET}" replay "${log}" --out "${WORK}/host.csv" --control-from 20)
+set(load "")
+if(SLOT)
+  set(load --qemu-load "${SLOT}@0x08080000")
+endif()
 run("${HADYNET}" replay "${log}" --out "${WORK}/qemu.csv" --control-from 20 --target qemu --image "${IMAGE}"
-    --machine "${MACHINE}" --qemu-log "${WORK}/qemu.log")
+    --machine "${MACHINE}" --qemu-log "${WORK}/qemu.log" ${load})
 
 file(STRINGS "${WORK}/host.csv" host)
 file(STRINGS "${WORK}/qemu.csv" qemu)

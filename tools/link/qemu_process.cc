@@ -36,6 +36,16 @@ int free_port() {
 
 }  // namespace
 
+std::optional<QemuOptions::Load> parse_qemu_load(const std::string& spec) {
+  const std::size_t at = spec.rfind('@');
+  if (at == std::string::npos || at == 0 || at + 1 == spec.size()) return std::nullopt;
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long address = std::strtoull(spec.c_str() + at + 1, &end, 0);
+  if (errno != 0 || end == nullptr || *end != '\0' || address > 0xFFFFFFFFull) return std::nullopt;
+  return QemuOptions::Load{spec.substr(0, at), static_cast<std::uint32_t>(address)};
+}
+
 QemuProcess::QemuProcess(const QemuOptions& o, int connect_timeout_ms) {
   struct stat st{};
   if (::stat(o.image.c_str(), &st) != 0) throw LinkError(o.image + ": no firmware image there (build the boards)");
@@ -57,6 +67,11 @@ QemuProcess::QemuProcess(const QemuOptions& o, int connect_timeout_ms) {
   if (o.icount) {
     args.push_back("-icount");
     args.push_back("shift=0");
+  }
+  for (const QemuOptions::Load& load : o.loads) {
+    if (::stat(load.file.c_str(), &st) != 0) throw LinkError(load.file + ": no such file to load into the guest");
+    args.push_back("-device");
+    args.push_back("loader,file=" + load.file + ",addr=" + std::to_string(load.address) + ",force-raw=on");
   }
   pid_ = ::fork();
   if (pid_ < 0) throw LinkError(std::string("fork: ") + std::strerror(errno));
