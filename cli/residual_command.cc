@@ -102,9 +102,7 @@ int run_residual(int argc, char** argv) {
               "effect'. Works on any (u, y) logs the model's channels fit.",
               "MODEL LOG|DIR... [options]");
   opt.value("pb", "PB",
-            "auto (the state's trained PB if the model knows it and it predicts the state's held-out rows\n"
-            "at least as well as one adapted to its other rows, else adapted), state, adapt, zero, a state,\n"
-            "or values", "auto");
+            "auto (the state's PB if the model knows it, else adapted), state, adapt, zero, a state, or values", "auto");
   opt.value("horizon", "N", "multi-step horizon (default: the model's N_train)");
   opt.value("max-lag", "L", "correlation lags 1..L (whiteness) and -L..L (independence)",
             std::to_string(rs::kDefaultMaxLag));

@@ -16,7 +16,6 @@
 #include <set>
 
 #include "test/residual/plant_logs.h"
-#include "trainer/residual/analysis.h"
 #include "trainer/residual/attribution.h"
 
 namespace hadynet::test {
@@ -174,43 +173,6 @@ TEST(PlantEffects, UnusedAuxChannelIsNamedAndAnUnrelatedOneIsNot) {
   EXPECT_EQ(data.y_names[static_cast<std::size_t>(w.hypothesis.target)], "fc3") << w.label;
   EXPECT_GT(w.parameter, 0.1) << w.label;  // 0.5 less what the model carries over from x_t
   EXPECT_LT(w.parameter, 0.75) << w.label;
-}
-
-}  // namespace
-}  // namespace hadynet::test
-
-namespace hadynet::test {
-namespace {
-
-using trainer::residual::ResidualLog;
-
-// --pb auto checks a state's trained PB on the state's held-out rows. Logs of
-// the trained state names recorded with another dataset seed have other
-// encoder zeroings than the names' trained ones (issue 12: the 1-step fit of
-// f0..f2 fell below -180 % with the stored PBs): each state's trained PB must
-// be replaced by an adapted one, and the summary must say why.
-TEST(PbAuto, TrainedPbOfAnotherZeroingIsReplaced) {
-  const trainer::residual::ResidualData data = trainer::residual::compute_residuals(build_model(), plant_logs("", 300, 11), "auto");
-  for (const auto& log : data.logs) {
-    EXPECT_EQ(log.pb_origin, ResidualLog::PbOrigin::kAdaptedOverTrained) << log.seq.file << ": " << log.pb_source;
-  }
-  EXPECT_NE(trainer::residual::pb_summary(data, "auto").find("predicted their held-out rows worse"), std::string::npos);
-}
-
-// The training seed's own zeroings: the trained PBs were fit to exactly these
-// states, so replacing one would be a false alarm of the check. Measured: the
-// trained PB's held-out loss is below the adapted one's on all four (0.012 vs
-// 0.022, 0.069 vs 0.085, 0.020 vs 0.40, 0.010 vs 0.037): kept, every one.
-TEST(PbAuto, TrainingZeroingsKeepTheirTrainedPb) {
-  const trainer::residual::ResidualData data = trainer::residual::compute_residuals(build_model(), plant_logs("", 300, 1), "auto");
-  int kept = 0;
-  for (const auto& log : data.logs) {
-    std::printf("%s: %s\n", log.seq.file.c_str(), log.pb_source.c_str());
-    if (log.pb_origin == ResidualLog::PbOrigin::kTrained) ++kept;
-  }
-  std::printf("trained PB kept for %d of %zu logs of the training zeroings\n", kept, data.logs.size());
-  EXPECT_EQ(kept, static_cast<int>(data.logs.size()));
-  EXPECT_EQ(trainer::residual::pb_summary(data, "auto").find("worse"), std::string::npos);
 }
 
 }  // namespace

@@ -24,12 +24,9 @@ struct ResidualLog {
   Eigen::MatrixXd aux;  // aux x T: the aux_* columns named in ResidualData::aux_names
   double dt_s = 0;      // control period (metadata dt_s)
   Eigen::VectorXf pb;   // the PB the predictions used
-  std::string pb_source;  // "state Cylinder/i1/w0", "adapted to the state's logs", "zero", ... with why
-  // The state's trained PB, one adapted here (the state is unknown, or --pb
-  // adapt), one adapted because the trained one predicted the state's
-  // held-out rows worse (--pb auto), or --pb's values.
-  enum class PbOrigin { kTrained, kAdapted, kAdaptedOverTrained, kGiven };
-  PbOrigin pb_origin = PbOrigin::kGiven;
+  std::string pb_source;  // "state Cylinder/i1/w0", "adapted to the state's logs", "zero", ...
+  enum class PbOrigin { kTrained, kAdapted, kGiven };
+  PbOrigin pb_origin = PbOrigin::kGiven;  // the state's trained PB, one adapted here, or --pb's values
   Eigen::MatrixXd y_hat;  // y x n, n = T - 2: column j predicts row t = j + 2
   Eigen::MatrixXd r;      // y x n: y_t - y_hat_t
 
@@ -53,9 +50,7 @@ struct LogInput {
 };
 
 // The PB of each log: "auto" (the model's PB for the log's state when the
-// model knows it and it predicts the last 30 % of the state's windows at
-// least as well as a PB adapted to the first 70 %; else a PB adapted to the
-// logs of that state), "state"
+// model knows it, else a PB adapted to the logs of that state), "state"
 // (the state's PB; an unknown state is an error), "adapt" (adapted to the
 // logs of each state, MomentumSGD as `hadynet adapt`), "zero", a state name
 // of the model, or comma-separated values.
