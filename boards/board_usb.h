@@ -11,22 +11,18 @@
 #include <cstdint>
 #include <span>
 
-#include "firmware/flash/flash_device.h"
-#include "firmware/usb/composite_descriptors.h"
 #include "firmware/usb/device_controller.h"
-#include "firmware/usb/dfu_mode.h"
 #include "firmware/usb/dfu_runtime.h"
 #include "firmware/usb/hadynet_usb_device.h"
 
 namespace hadynet::board {
 
-// Everything lives in static storage and outlives the firmware.
+// Everything lives in static storage and outlives the firmware. The model
+// slots behind the DFU-mode interface are not the port's: they are
+// board::model_flash() (boards/board.h), which the application's ModelSlots
+// manages (firmware/app/usb_link.h).
 struct UsbPort {
   usb::DeviceController& controller;
-  flash::FlashDevice& flash;  // behind the DFU model interface
-  // The DFU-mode alternates: alt 0 the inactive model slot (download and
-  // upload), alt 1 the active one (upload only).
-  std::span<const usb::DfuTarget, usb::composite::kDfuAlternates> model_slots;
   usb::DetachHook& detach;  // DFU_DETACH: reboot into the ROM bootloader
   std::span<const std::uint8_t, usb::kUniqueIdBytes> unique_id;  // serial number string
 };

@@ -1,6 +1,7 @@
 // hadynet devices: every HADYNET forearm MCU on USB (serial number, firmware
-// version, model hash, the interfaces it offers) and every STM32 waiting in
-// its ROM DfuSe bootloader (tools/usb/usb_inventory.h).
+// version, the model it runs: hash and source, the interfaces it offers)
+// and every STM32 waiting in its ROM DfuSe bootloader
+// (tools/usb/usb_inventory.h).
 #include <libusb.h>
 
 #include <cstdio>
@@ -42,8 +43,11 @@ void print_device(const AttachedDevice& d) {
   }
   std::printf("  serial %s", d.serial.empty() ? "?" : d.serial.c_str());
   if (hand) {
-    std::printf("  firmware %s  model %s  interfaces %s", d.firmware_version.empty() ? "?" : d.firmware_version.c_str(),
-                d.model_hash.empty() ? "?" : d.model_hash.c_str(), interfaces_text(d.interfaces).c_str());
+    // The running model: its hash and where it comes from (factory / slot, sequence).
+    const std::string source = d.model_source.empty() ? std::string() : " (" + d.model_source + ")";
+    std::printf("  firmware %s  model %s%s  interfaces %s",
+                d.firmware_version.empty() ? "?" : d.firmware_version.c_str(),
+                d.model_hash.empty() ? "?" : d.model_hash.c_str(), source.c_str(), interfaces_text(d.interfaces).c_str());
   } else {
     std::printf("  (STM32 ROM DfuSe bootloader: `hadynet flash` writes firmware through it)");
   }
@@ -60,8 +64,10 @@ struct ContextCloser {
 int run_devices(int argc, char** argv) {
   Options opt("devices",
               "Lists every HADYNET forearm MCU on USB (the firmware's VID:PID, firmware/usb/usb_identity.h):\n"
-              "bus, device and port, serial number (the MCU's unique ID), firmware version, model hash and\n"
-              "the interfaces it offers; and every STM32 in its ROM DfuSe bootloader (0483:df11).\n"
+              "bus, device and port, serial number (the MCU's unique ID), firmware version, the model it runs\n"
+              "(its hash, and where it comes from: \"factory\", the compiled-in model, or \"slot A|B,\n"
+              "sequence N\", a signed model image the boot rule chose) and the interfaces it offers; and every\n"
+              "STM32 in its ROM DfuSe bootloader (0483:df11).\n"
               "Exit status: 0 if at least one device was listed, 1 if none was found or none could be\n"
               "opened (permission: udev/60-hadynet.rules, docs/usb.md), 2 on a usage error.",
               "");

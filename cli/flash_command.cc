@@ -1,14 +1,14 @@
 // hadynet flash: firmware into the forearm MCU through the STM32 ROM DfuSe
 // bootloader (a running hand is sent there by DFU_DETACH first), erased,
 // written, read back and verified (tools/usb/firmware_flasher.h); or, with
-// --model, a model file into the firmware's inactive model slot through its
-// own DFU interface, read back and compared.
+// --model, a signed model image (hadynet model-image) through the
+// firmware's own DFU model interface into the model slot not in use, read
+// back and compared; the device's refusal, if any, in its own words.
 #include <libusb.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <string>
 #include <thread>
@@ -16,15 +16,17 @@
 #include "cli/commands.h"
 #include "cli/error_text.h"
 #include "cli/options.h"
-#include "firmware/link/crc32.h"
 #include "firmware/usb/composite_descriptors.h"
-#include "firmware/usb/dfu_image.h"
+#include "firmware/usb/dfu_mode.h"
 #include "firmware/usb/usb_identity.h"
+#include "hadynet_model_q15.h"
+#include "host-sim/model_image/signing_key.h"
 #include "tools/usb/dfu_client.h"
 #include "tools/usb/dfuse_memory_layout.h"
 #include "tools/usb/firmware_flasher.h"
 #include "tools/usb/firmware_image.h"
 #include "tools/usb/libusb_dfu.h"
+#include "tools/usb/model_image_file.h"
 #include "tools/usb/usb_inventory.h"
 
 namespace hadynet::cli {
@@ -178,23 +180,36 @@ int flash_firmware(libusb_context* ctx, const Options& opt, const std::string& f
   return 0;
 }
 
-// The model file in the DFU envelope (firmware/usb/dfu_image.h).
-std::vector<std::uint8_t> model_envelope(const std::string& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw std::runtime_error(file + ": cannot open");
-  std::vector<std::uint8_t> payload((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (payload.empty()) throw std::runtime_error(file + ": empty file");
-  usb::DfuImageHeader h;
-  h.length = static_cast<std::uint32_t>(payload.size());
-  h.crc32 = link::crc32(payload);
-  std::vector<std::uint8_t> bytes(usb::kDfuImageHeaderSize + payload.size());
-  usb::encode_dfu_image_header(h, std::span<std::uint8_t, usb::kDfuImageHeaderSize>(bytes.data(), usb::kDfuImageHeaderSize));
-  std::copy(payload.begin(), payload.end(), bytes.begin() + usb::kDfuImageHeaderSize);
-  return bytes;
+// What the image says about itself, before anything is sent.
+void describe_image(const std::string& file, const tu::ModelImageFile& image) {
+  const model_update::ModelImageHeader& h = image.header;
+  const bool ours = h.shape_id == model_q15::Model::kShapeId;
+  std::printf("model image %s: sequence %u%s, %s, shape id %016llx (%s), payload %u bytes, model %016llx\n",
+              file.c_str(), h.sequence, h.downgrade_allowed ? " (downgrade allowed)" : "",
+              h.numeric == model_update::kNumericQ15 ? "q15" : "f32", static_cast<unsigned long long>(h.shape_id),
+              ours ? "this build's firmware" : "NOT this build's q15 firmware: a hand built from it refuses it",
+              h.payload_length, static_cast<unsigned long long>(h.model_hash));
+  std::printf("  signed by %s%s\n", host::hex(h.public_key).c_str(),
+              tu::is_development_key(h.public_key)
+                  ? " -- the DEVELOPMENT key (keys/): anyone can sign images a hand that trusts it accepts"
+                  : "");
+  std::fflush(stdout);
+}
+
+// The device's description of its last DFU status (GETSTATUS iString), or "".
+std::string device_text(tu::LibusbDfuInterface& dfu, std::uint8_t index) {
+  try {
+    return dfu.string_descriptor(index);
+  } catch (const std::exception&) {
+    return {};
+  }
 }
 
 int flash_model(libusb_context* ctx, const Options& opt, const std::string& file) {
-  const std::vector<std::uint8_t> bytes = model_envelope(file);
+  // Checked before any device is touched.
+  const tu::ModelImageFile image = tu::load_model_image_file(file);
+  describe_image(file, image);
+  const std::vector<std::uint8_t>& bytes = image.bytes;
   const auto devices = tu::list_attached_devices(ctx);
   const auto hand = pick(devices, tu::AttachedDevice::Kind::kHand, opt.get("serial"), "HADYNET hand");
   if (!hand) {
@@ -203,10 +218,11 @@ int flash_model(libusb_context* ctx, const Options& opt, const std::string& file
   }
   DeviceRef dev{device_at(ctx, hand->bus, hand->address)};
   if (dev.device == nullptr) throw std::runtime_error("the hand left the bus before it could be opened");
-  tu::LibusbDfuInterface dfu(dev.device, usb::composite::kDfuModeInterface, /*alternate=*/0);
+  tu::LibusbDfuInterface dfu(dev.device, usb::composite::kDfuModeInterface, usb::kDfuAltModelUpdate);
   const std::uint16_t xfer = dfu.functional().transfer_size;
   tu::DfuClient client(dfu, [](std::uint32_t ms) { std::this_thread::sleep_for(std::chrono::milliseconds(ms)); });
   ProgressBar bar(opt.has("quiet"));
+  constexpr const char* kUnchanged = "the model in use and the boot choice are unchanged";
   try {
     client.ensure_idle();
     std::uint16_t block = 0;
@@ -216,6 +232,7 @@ int flash_model(libusb_context* ctx, const Options& opt, const std::string& file
       bar({tu::FlashPhase::kWrite, at + n, bytes.size()});
     }
     client.manifest();
+    const std::string result = device_text(dfu, client.get_status().string_index);
     std::vector<std::uint8_t> back, chunk(xfer);
     for (std::uint16_t b = 0;; ++b) {
       const std::size_t n = client.upload(b, chunk);
@@ -223,23 +240,50 @@ int flash_model(libusb_context* ctx, const Options& opt, const std::string& file
       bar({tu::FlashPhase::kVerify, std::min(back.size(), bytes.size()), bytes.size()});
       if (n < xfer || back.size() > bytes.size()) break;
     }
-    client.abort();
+    client.abort();  // back to dfuIDLE whether the upload ended on a short block or not
     if (back != bytes) {
-      std::fprintf(stderr, "hadynet flash --model: the slot reads back %zu bytes that differ from the %zu sent: the "
-                   "slot does not hold this model; flash it again\n", back.size(), bytes.size());
+      std::fprintf(stderr,
+                   "hadynet flash --model: the slot reads back %zu bytes that differ from the %zu sent: the slot "
+                   "does not hold this image (the boot rule will not run it unless it verifies); send it again\n",
+                   back.size(), bytes.size());
       return 6;
     }
+    std::printf("model %s: %zu bytes sent to hand %s and read back byte for byte%s%s\n", file.c_str(), bytes.size(),
+                hand->serial.c_str(), result.empty() ? "" : ": ", result.c_str());
+    std::printf("the new model runs after the next reset or power-up: the boot rule tries it then (self-test, then "
+                "confirmed, or reverted to the model in use now)\n");
   } catch (const tu::DfuError& e) {
-    std::fprintf(stderr, "hadynet flash --model: %s; the slot holds no valid image (its header is written last), "
-                 "the active model is unchanged\n", e.what());
+    const std::string why = device_text(dfu, e.status().string_index);
+    if (why.empty()) {
+      std::fprintf(stderr, "hadynet flash --model: %s; %s\n", e.what(), kUnchanged);
+    } else {
+      std::fprintf(stderr, "hadynet flash --model: the image was not taken: %s (%s); %s\n", why.c_str(), e.what(),
+                   kUnchanged);
+    }
+    try {
+      client.clear_status();
+    } catch (const std::exception&) {
+    }
     return 5;
   } catch (const tu::UsbTransferError& e) {
-    std::fprintf(stderr, "hadynet flash --model: %s; the slot holds no valid image, the active model is unchanged\n",
-                 e.what());
+    // A request the hand STALLs (e.g. DNLOAD on a hand without model slots)
+    // leaves it in dfuERROR with its reason: ask for it.
+    if (e.kind() == tu::UsbTransferError::Kind::kStall) {
+      try {
+        const tu::DfuStatus st = client.get_status();
+        const std::string why = device_text(dfu, st.string_index);
+        if (st.state == tu::dfu::State::kError && !why.empty()) {
+          std::fprintf(stderr, "hadynet flash --model: the image was not taken: %s (%s: %s); %s\n", why.c_str(),
+                       e.what(), tu::status_name(st.status), kUnchanged);
+          client.clear_status();
+          return 5;
+        }
+      } catch (const std::exception&) {
+      }
+    }
+    std::fprintf(stderr, "hadynet flash --model: %s; %s (an interrupted image is never run)\n", e.what(), kUnchanged);
     return e.kind() == tu::UsbTransferError::Kind::kGone ? 4 : 7;
   }
-  std::printf("model %s: %zu bytes (with the 16-byte envelope) in the inactive slot of hand %s, read back byte for "
-              "byte\n", file.c_str(), bytes.size(), hand->serial.c_str());
   return 0;
 }
 
@@ -251,13 +295,20 @@ int run_flash(int argc, char** argv) {
               "bootloader (DFU_DETACH; or use one already there: BOOT0 high + reset), only the sectors the\n"
               "image covers are erased, the image is written, read back and compared byte for byte, and the\n"
               "MCU starts it. FILE: the .elf (its load segments) or the .bin (at 0x08000000) of a build.\n"
-              "--model FILE instead sends a model file (in a 16-byte envelope with its CRC-32) into the\n"
-              "inactive model slot through the firmware's own DFU interface and reads it back.\n"
+              "--model IMAGE instead sends a signed model image (hadynet model-image; docs/usb.md, \"Model\n"
+              "images\") to the running firmware's DFU model interface. The file is checked first (a model\n"
+              "image header, the right length; its sequence, shape id, payload size and signing key are\n"
+              "printed); the hand checks the header (model shape, key, signature, a sequence newer than its\n"
+              "newest image) before it erases anything, writes it into the slot not in use, and the image\n"
+              "is read back and compared. A refusal is printed in the hand's words (\"signed by another\n"
+              "key\", \"model shape does not match the firmware\", ...). The new model runs after the next\n"
+              "reset or power-up, when the boot rule tries it (self-test, then confirmed or reverted).\n"
               "Exit status: 0 done, 1 no device / bad input, 2 usage, 3 image does not fit (nothing\n"
-              "touched), 4 device vanished, 5 device reported an error, 6 verify mismatch, 7 other USB error.",
-              "FIRMWARE.elf|.bin [--serial S] | --model FILE [--serial S]");
+              "touched), 4 device vanished, 5 device reported an error (or refused the model image),\n"
+              "6 verify mismatch, 7 other USB error.",
+              "FIRMWARE.elf|.bin [--serial S] | --model IMAGE [--serial S]");
   opt.value("serial", "S", "the hand's serial number (hadynet devices), if several are attached");
-  opt.value("model", "FILE", "send a model file into the inactive model slot instead of firmware");
+  opt.value("model", "IMAGE", "send a signed model image into the hand's free model slot instead of firmware");
   opt.flag("no-leave", "stay in the bootloader after the verify (do not start the firmware)");
   opt.flag("quiet", "no progress bar");
   if (!opt.parse(argc, argv)) return 2;
@@ -278,6 +329,9 @@ int run_flash(int argc, char** argv) {
   } catch (const tu::FlashError& e) {
     std::fprintf(stderr, "\nhadynet flash: %s\n", e.what());
     return e.exit_code();
+  } catch (const tu::ModelImageFileError& e) {
+    std::fprintf(stderr, "hadynet flash --model: %s; nothing was sent\n", e.what());
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "\nhadynet flash: %s\n", error_text(e).c_str());
     return 1;

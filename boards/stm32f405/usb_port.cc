@@ -1,9 +1,10 @@
 // stm32f405's USB device port (boards/board_usb.h): the OTG FS driver on
 // PA11/PA12 without VBUS sensing (PA9 is USART1 TX on this board, and a
 // device powered by its own supply sees VBUS only when plugged: the host
-// then finds the pull-up), the embedded flash behind the DFU model slots
-// (firmware/flash/stm32f405_flash_layout.h), the ROM bootloader as the
-// DFU_DETACH target, and the 96-bit unique ID as the serial number.
+// then finds the pull-up), the ROM bootloader as the DFU_DETACH target, and
+// the 96-bit unique ID as the serial number. The model slots behind the DFU
+// model interface are model_flash.cc's, managed by the application's
+// ModelSlots (firmware/app/usb_link.h).
 //
 // The driver is polled from the main loop (usb_poll()); the OTG_FS
 // interrupt stays disabled. At most one main-loop pass (one control period's
@@ -19,14 +20,9 @@
 #include "boards/board_usb.h"
 #include "boards/stm32f405/otg_fs_controller.h"
 #include "boards/stm32f405/system_bootloader.h"
-#include "firmware/flash/stm32f405_flash_layout.h"
 
 namespace hadynet::board {
 namespace {
-
-namespace layout = flash::stm32f405;
-
-
 
 // RM0090 §39.1: the 96-bit unique device ID, read-only, 12 bytes.
 constexpr std::uintptr_t kUniqueIdAddress = 0x1FFF7A10;
@@ -38,17 +34,9 @@ stm32::OtgFsController<stm32::otg::OtgFsMmio> g_otg(g_otg_registers, g_otg_hooks
                                                                          .ahb_clock_hz = config::kCoreClockHz});
 stm32::SystemBootloaderDetach g_detach;
 
-// Alt 0 receives a model into slot B; alt 1 reads slot A (the provisional
-// active slot until the model-update issue defines the boot rule).
-constexpr usb::DfuTarget kModelSlots[usb::composite::kDfuAlternates] = {
-    {{layout::kModelSlotBOffset, layout::kModelSlotSize}, /*can_download=*/true, /*can_upload=*/true},
-    {{layout::kModelSlotAOffset, layout::kModelSlotSize}, /*can_download=*/false, /*can_upload=*/true},
-};
-
 std::uint8_t g_unique_id[usb::kUniqueIdBytes];
 
-const UsbPort kPort{g_otg, model_flash()->device, std::span<const usb::DfuTarget, usb::composite::kDfuAlternates>(kModelSlots),
-                        g_detach, std::span<const std::uint8_t, usb::kUniqueIdBytes>(g_unique_id)};
+const UsbPort kPort{g_otg, g_detach, std::span<const std::uint8_t, usb::kUniqueIdBytes>(g_unique_id)};
 
 // True once the core, clocked, reports its AHB master idle (GRSTCTL.AHBIDL,
 // 1 whenever the core is idle after a reset; RM0090 §34.16.3), within a

@@ -67,7 +67,6 @@
 #include "firmware/app/synthetic_frames.h"
 #include "firmware/app/text.h"
 #include "firmware/core/hadynet_runtime.h"
-#include "firmware/flash/simulated_nor_flash.h"
 #include "firmware/link/device_link.h"
 #include "firmware/link/frame.h"
 #include "firmware/link/link_client.h"
@@ -87,7 +86,6 @@ namespace usb = hadynet::usb;
 namespace link = hadynet::link;
 namespace app = hadynet::app;
 namespace firmware = hadynet::firmware;
-namespace flash = hadynet::flash;
 
 using Model = hadynet::model_q15::Model;
 using Runtime = firmware::HadynetRuntime<Model>;
@@ -167,14 +165,9 @@ class EventTimingController final : public usb::DeviceController, usb::Controlle
 };
 
 // ---- the device (all static: no heap) ----
-// A tiny flash for DFU mode: two 1 KiB sectors, one per model-slot
-// alternate (never written here; DFU is idle during the benchmark).
-constexpr std::array<flash::FlashSector, 2> kFlashSectors = {{{0x000, 1024, 1}, {0x400, 1024, 1}}};
-std::uint8_t g_flash_cells[2048];
-flash::SimulatedNorFlash g_flash(kFlashSectors, g_flash_cells);
-const std::array<usb::DfuTarget, usb::composite::kDfuAlternates> kTargets = {
-    usb::DfuTarget{{0x000, 1024}, true, true}, usb::DfuTarget{{0x400, 1024}, false, true}};
-
+// DFU mode without model slots (as on a board without model flash): it is
+// idle during the benchmark, and the model slots are the application's
+// (ModelSlots), not the USB stack's.
 struct NoDetach final : usb::DetachHook {
   void detach_to_bootloader(std::uint16_t) noexcept override {}
 };
@@ -186,7 +179,7 @@ Runtime g_runtime;
 DeviceLink g_link(g_runtime);
 FakeController g_fake;
 EventTimingController g_controller(g_fake);
-Usb g_usb(g_controller, g_link, g_flash, kTargets, g_detach, kUid, "bench");
+Usb g_usb(g_controller, g_link, usb::ModelSlotsAccess{}, g_detach, kUid, "bench");
 
 // ---- the twin link (the `link` job) and the host's state ----
 Runtime g_twin_runtime;

@@ -77,7 +77,7 @@ void periodic() noexcept {
 int main() {
   hadynet::board::init();
   boot_model();
-  hadynet::app::usb_start(g_endpoint.dispatcher());
+  hadynet::app::usb_start(g_endpoint.dispatcher(), g_model_slots ? &*g_model_slots : nullptr);
   for (;;) {
     std::uint8_t byte;
     while (hadynet::board::uart_read_byte(byte)) {

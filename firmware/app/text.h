@@ -1,7 +1,9 @@
 // A fixed-capacity text buffer for the firmware's human-readable output (the
-// temporary test console, the benchmark report): integers in decimal and
-// hex, no stdio (newlib's printf family may allocate), nothing allocated.
-// Text that does not fit is cut off and marked by truncated().
+// benchmark report, the USB strings the device composes: its configuration
+// string, the DFU status text): integers in decimal and hex, no stdio
+// (newlib's printf family may allocate), nothing allocated. Always
+// NUL-terminated (c_str()). Text that does not fit is cut off and marked by
+// truncated().
 #ifndef HADYNET_FIRMWARE_APP_TEXT_H_
 #define HADYNET_FIRMWARE_APP_TEXT_H_
 
@@ -45,9 +47,13 @@ class Text {
 
   void clear() noexcept {
     size_ = 0;
+    data_[0] = 0;
     truncated_ = false;
   }
   std::span<const std::uint8_t> bytes() const noexcept { return {data_, size_}; }
+  const char* c_str() const noexcept { return reinterpret_cast<const char*>(data_); }
+  std::size_t size() const noexcept { return size_; }
+  bool empty() const noexcept { return size_ == 0; }
   std::string_view view() const noexcept { return {reinterpret_cast<const char*>(data_), size_}; }
   bool truncated() const noexcept { return truncated_; }
 
@@ -65,11 +71,12 @@ class Text {
   void put(char c) noexcept {
     if (size_ < kCapacity) {
       data_[size_++] = static_cast<std::uint8_t>(c);
+      data_[size_] = 0;
     } else {
       truncated_ = true;
     }
   }
-  std::uint8_t data_[kCapacity] = {};
+  std::uint8_t data_[kCapacity + 1] = {};  // and the NUL
   std::size_t size_ = 0;
   bool truncated_ = false;
 };

@@ -6,6 +6,7 @@
 
 #include <new>
 
+#include "boards/board.h"
 #include "boards/board_usb.h"
 #include "firmware/link/frame.h"
 #include "firmware/link/link_port.h"
@@ -29,14 +30,17 @@ Usb* g_usb = nullptr;
 
 }  // namespace
 
-void usb_start(link::LinkDispatcher<FirmwareModel>& dispatcher) noexcept {
+void usb_start(link::LinkDispatcher<FirmwareModel>& dispatcher, model_update::ModelSlots* slots) noexcept {
   if (g_usb != nullptr) return;
   const board::UsbPort* port = board::usb_port();
   if (port == nullptr) return;  // no controller on the bus: the UART alone
+  // The slots live on the board's model flash; DFU uploads read them there.
+  const board::ModelFlash* model_flash = slots != nullptr ? board::model_flash() : nullptr;
+  const usb::ModelSlotsAccess model{model_flash != nullptr ? slots : nullptr,
+                                    model_flash != nullptr ? &model_flash->device : nullptr};
   Port* link_port = new (g_port_storage) Port(dispatcher);
   g_usb = new (g_usb_storage)
-      Usb(port->controller, *link_port, port->flash, port->model_slots, port->detach, port->unique_id,
-          HADYNET_FIRMWARE_VERSION);
+      Usb(port->controller, *link_port, model, port->detach, port->unique_id, HADYNET_FIRMWARE_VERSION);
   g_usb->start();
 }
 

@@ -4,7 +4,7 @@
 
 namespace hadynet::app {
 
-void usb_start(link::LinkDispatcher<FirmwareModel>&) noexcept {}
+void usb_start(link::LinkDispatcher<FirmwareModel>&, model_update::ModelSlots*) noexcept {}
 void usb_service() noexcept {}
 void usb_publish(const PeriodRecord<FirmwareModel>&) noexcept {}
 

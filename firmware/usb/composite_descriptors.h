@@ -7,7 +7,7 @@
 //   interface 1  CDC data               EP 0x02 bulk OUT, 0x82 bulk IN (64 B) }
 //   interface 2  HID telemetry          EP 0x83 interrupt IN (64 B, 10 ms)
 //   interface 3  DFU runtime            (EP0 only)
-//   interface 4  DFU mode, alt 0 / 1    (EP0 only): model slot inactive / active
+//   interface 4  DFU mode, alt 0 / 1    (EP0 only): model update / running model (read only)
 #ifndef HADYNET_FIRMWARE_USB_COMPOSITE_DESCRIPTORS_H_
 #define HADYNET_FIRMWARE_USB_COMPOSITE_DESCRIPTORS_H_
 
@@ -31,7 +31,6 @@ inline constexpr std::uint8_t kHidInterface = 2;
 inline constexpr std::uint8_t kDfuRuntimeInterface = 3;
 inline constexpr std::uint8_t kDfuModeInterface = 4;
 inline constexpr std::uint8_t kInterfaceCount = 5;
-inline constexpr std::uint8_t kDfuAlternates = 2;  // alt 0: inactive model slot, alt 1: active (read only)
 
 inline constexpr EndpointAddress kCdcNotifyIn = 0x81;
 inline constexpr EndpointAddress kCdcDataOut = 0x02;
@@ -47,10 +46,11 @@ inline constexpr std::uint8_t kCdc = 4;
 inline constexpr std::uint8_t kCdcData = 5;
 inline constexpr std::uint8_t kHid = 6;
 inline constexpr std::uint8_t kDfuRuntime = 7;
-inline constexpr std::uint8_t kDfuSlotInactive = 8;
-inline constexpr std::uint8_t kDfuSlotActive = 9;
-inline constexpr std::uint8_t kVersion = 10;  // iConfiguration: firmware version and model hash
-inline constexpr std::uint8_t kCount = 11;    // table size (index 0 is the LANGID list)
+inline constexpr std::uint8_t kDfuModelUpdate = 8;   // DFU mode alt 0
+inline constexpr std::uint8_t kDfuRunningModel = 9;  // DFU mode alt 1
+inline constexpr std::uint8_t kVersion = 10;  // iConfiguration: firmware version and the running model (running_model.h)
+inline constexpr std::uint8_t kDfuStatus = 11;  // DFU mode GETSTATUS iString: the status description (dfu_mode.h)
+inline constexpr std::uint8_t kCount = 12;    // table size (index 0 is the LANGID list)
 }  // namespace string_index
 
 inline constexpr std::uint8_t kConfigAttributes = 0xC0;  // bus-powered bit 7 (always 1) + self-powered
@@ -108,11 +108,12 @@ constexpr DescriptorBytes build_configuration() noexcept {
               string_index::kDfuRuntime);
   d.dfu_functional(kDfuRuntimeAttributes, kDfuTransferSize);
   // DFU mode (model images), one functional descriptor after each alternate.
-  d.interface(kDfuModeInterface, 0, 0, dfu::kClassApplicationSpecific, dfu::kSubclassDfu, dfu::kProtocolDfuMode,
-              string_index::kDfuSlotInactive);
+  static_assert(kDfuAlternateCount == 2 && kDfuAltModelUpdate == 0 && kDfuAltRunningModel == 1);
+  d.interface(kDfuModeInterface, kDfuAltModelUpdate, 0, dfu::kClassApplicationSpecific, dfu::kSubclassDfu,
+              dfu::kProtocolDfuMode, string_index::kDfuModelUpdate);
   d.dfu_functional(kDfuModeAttributes, kDfuTransferSize);
-  d.interface(kDfuModeInterface, 1, 0, dfu::kClassApplicationSpecific, dfu::kSubclassDfu, dfu::kProtocolDfuMode,
-              string_index::kDfuSlotActive);
+  d.interface(kDfuModeInterface, kDfuAltRunningModel, 0, dfu::kClassApplicationSpecific, dfu::kSubclassDfu,
+              dfu::kProtocolDfuMode, string_index::kDfuRunningModel);
   d.dfu_functional(kDfuModeAttributes, kDfuTransferSize);
   d.bytes[2] = static_cast<std::uint8_t>(d.size & 0xFF);
   d.bytes[3] = static_cast<std::uint8_t>(d.size >> 8);

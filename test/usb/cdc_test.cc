@@ -232,14 +232,11 @@ struct SixtyFourByteReplies {
 };
 
 TEST(UsbCdc, AFullLastPacketIsFollowedByAZeroLengthPacket) {
-  std::vector<std::uint8_t> storage(flash::stm32f405::kFlashSize);
-  flash::SimulatedNorFlash nor(flash::stm32f405::kSectors, storage);
   FakeController c;
   RecordingDetachHook hook;
   SixtyFourByteReplies endpoint;
-  const std::array<DfuTarget, 2> targets{DfuTarget{kSlotB, true, true}, DfuTarget{kSlotA, false, true}};
-  auto usb = std::make_unique<HadynetUsbDevice<Q, SixtyFourByteReplies, 64>>(c, endpoint, nor, targets, hook, kTestUid,
-                                                                            "0.1.0");
+  auto usb = std::make_unique<HadynetUsbDevice<Q, SixtyFourByteReplies, 64>>(c, endpoint, ModelSlotsAccess{}, hook,
+                                                                            kTestUid, "0.1.0");
   usb->start();
   c.bus_reset();
   ASSERT_TRUE(c.control(UsbTestDevice::setup_out_device(request::kSetAddress, 1), {}, {}).ok());

@@ -189,10 +189,11 @@ TEST(UsbControl, ZeroLengthPacketOnlyWhenTheReplyIsAMultipleOf64AndShort) {
   UsbTestDevice dev;
   dev.enumerate();
   FakeController& c = dev.controller;
-  // The version string "fw 0.1.0 model <16 hex>" is 31 characters: 64 bytes.
+  // The name of DFU alternate 1, "HADYNET model in use, read only", is 31
+  // characters: 64 bytes.
   std::uint8_t buf[64];
   std::size_t n = 0;
-  c.setup(UsbTestDevice::get_descriptor(descriptor::kString, composite::string_index::kVersion, 255));
+  c.setup(UsbTestDevice::get_descriptor(descriptor::kString, composite::string_index::kDfuRunningModel, 255));
   ASSERT_EQ(c.in_token(0x80, buf, n), Handshake::kAck);
   EXPECT_EQ(n, 64u);
   EXPECT_EQ(buf[0], 64);
@@ -203,7 +204,7 @@ TEST(UsbControl, ZeroLengthPacketOnlyWhenTheReplyIsAMultipleOf64AndShort) {
   EXPECT_EQ(dev.usb->device().control_stage(), ControlStage::kIdle);
 
   // wLength 64: the reply fills it exactly, no ZLP.
-  c.setup(UsbTestDevice::get_descriptor(descriptor::kString, composite::string_index::kVersion, 64));
+  c.setup(UsbTestDevice::get_descriptor(descriptor::kString, composite::string_index::kDfuRunningModel, 64));
   ASSERT_EQ(c.in_token(0x80, buf, n), Handshake::kAck);
   EXPECT_EQ(n, 64u);
   EXPECT_EQ(c.in_token(0x80, buf, n), Handshake::kNak);

@@ -1,9 +1,14 @@
 // The firmware's USB side (firmware/app/usb_link.cc, as linked into the
 // stm32f405 image) on a host board port: this file implements
-// boards/board_usb.h over the host backend (FakeController, a simulated NOR
-// flash laid out like the F405's, a recording detach hook). What it checks:
-// the composite device comes up on the board's port with the serial number
-// from the unique ID and the firmware version; the UART and the USB CDC-ACM
+// boards/board_usb.h and board::model_flash() over the host backend
+// (FakeController, a simulated NOR flash laid out like the F405's with its
+// two model slots, a recording detach hook), and boots a signed image in
+// slot A with the app's own boot rule and self-test (model_store.h) before
+// usb_start(), as firmware_main.cc does. What it checks: the composite
+// device comes up on the board's port with the serial number from the
+// unique ID, the firmware version and the model the boot rule chose; the
+// DFU model interface reads that image back and takes a newer one into the
+// other slot through the firmware's own usb_service(); the UART and the USB CDC-ACM
 // port serve ONE device state (one dispatcher: runtime, autonomous loop,
 // sequence numbers), with each port's frames kept apart even when their
 // bytes interleave; and a period published by the main loop reaches the host
@@ -16,7 +21,10 @@
 #include <string>
 #include <vector>
 
+#include "boards/board.h"
 #include "boards/board_usb.h"
+#include "firmware/app/model_store.h"
+#include "firmware/app/runtime_checksum.h"
 #include "firmware/app/uart_endpoint.h"
 #include "firmware/app/usb_link.h"
 #include "firmware/link/link_client.h"
@@ -37,9 +45,8 @@ struct HostPort {
   flash::SimulatedNorFlash flash{flash::stm32f405::kSectors, storage};
   usb::host::FakeController controller;
   t::RecordingDetachHook detach;
-  std::array<usb::DfuTarget, usb::composite::kDfuAlternates> slots{usb::DfuTarget{t::kSlotB, true, true},
-                                                                   usb::DfuTarget{t::kSlotA, false, true}};
-  UsbPort port{controller, flash, slots, detach, t::kTestUid};
+  UsbPort port{controller, detach, t::kTestUid};
+  ModelFlash model{flash, t::kSlotA, t::kSlotB, flash.contents()};
   int polls = 0;
 };
 
@@ -52,6 +59,7 @@ HostPort& host_port() {
 
 const UsbPort* usb_port() noexcept { return &host_port().port; }
 void usb_poll() noexcept { ++host_port().polls; }
+const ModelFlash* model_flash() noexcept { return &host_port().model; }
 
 }  // namespace hadynet::board
 
@@ -118,22 +126,81 @@ std::string string_descriptor(FakeController& c, std::uint8_t index) {
   return s;
 }
 
-TEST(FirmwareUsb, TheUartAndUsbServeOneDeviceStateAndThePeriodReachesHid) {
-  auto runtime = std::make_unique<firmware::HadynetRuntime<Q>>();
-  auto uart = std::make_unique<app::UartEndpoint<Q>>(*runtime);
-  app::usb_start(uart->dispatcher());
-  app::usb_start(uart->dispatcher());  // a second start changes nothing
-  FakeController& c = board::host_port().controller;
+namespace mu = model_update;
 
-  // Enumeration on the board's port; the serial number is the unique ID.
+constexpr std::uint64_t kSlotModelHash = 0x0123456789ABCDEFull;
+
+// The firmware's statics (firmware_main.cc): the runtime, the UART endpoint
+// and the ModelSlots over the board's model flash, booted before
+// usb_start(). Made once per process, like the firmware's; never destroyed.
+struct FirmwareUnderTest {
+  std::unique_ptr<firmware::HadynetRuntime<Q>> runtime = std::make_unique<firmware::HadynetRuntime<Q>>();
+  std::unique_ptr<app::UartEndpoint<Q>> uart = std::make_unique<app::UartEndpoint<Q>>(*runtime);
+  std::unique_ptr<mu::ModelSlots> slots;
+  Bytes installed;  // the image in slot A, which the boot rule chose
+};
+
+std::unique_ptr<mu::ModelSlots> slots_over_board_flash() {
+  const board::ModelFlash& m = *board::model_flash();
+  return std::make_unique<mu::ModelSlots>(m.device, m.slot_a, m.slot_b, app::model_identity<Q>(),
+                                          device_key().public_key, m.mapped);
+}
+
+// A signed image of the compiled-in model's tensors (so the app's self-test
+// passes: its checksum is the compiled-in runtime's) under its own model hash.
+Bytes compiled_model_image(std::uint32_t sequence) {
+  mu::ModelImageHeader h = mu::test::header_for(app::model_identity<Q>(), sequence);
+  h.model_hash = kSlotModelHash;
+  auto reference = std::make_unique<firmware::HadynetRuntime<Q>>();
+  h.self_test_crc32 = static_cast<std::uint32_t>(app::runtime_checksum(*reference));
+  const auto* bytes = reinterpret_cast<const std::uint8_t*>(&firmware::kCompiledTensors<Q>);
+  return mu::test::sign_image(h, std::span(bytes, sizeof(firmware::ModelTensors<Q>)), device_key());
+}
+
+FirmwareUnderTest* start_firmware() {
+  auto* f = new FirmwareUnderTest;
+  f->installed = compiled_model_image(1);
+  {  // an earlier power-on session wrote the image into slot A
+    const auto installer = slots_over_board_flash();
+    VerdictSelfTest pass(true);
+    installer->boot(pass);
+    EXPECT_EQ(installer->begin_update(mu::test::header_of(f->installed)), mu::UpdateError::kOk);
+    EXPECT_EQ(installer->append_update(mu::test::payload_of(f->installed)), mu::UpdateError::kOk);
+    EXPECT_EQ(installer->finish_update(), mu::UpdateError::kOk);
+  }
+  // This power-on: the boot rule (the app's self-test), then usb_start().
+  f->slots = slots_over_board_flash();
+  app::boot_model(*f->slots, *f->runtime);
+  app::usb_start(f->uart->dispatcher(), f->slots.get());
+  app::usb_start(f->uart->dispatcher(), f->slots.get());  // a second start changes nothing
+  return f;
+}
+
+FirmwareUnderTest& firmware_under_test() {
+  static FirmwareUnderTest* f = start_firmware();
+  return *f;
+}
+
+void enumerate(FakeController& c) {
   c.bus_reset();
   ASSERT_TRUE(c.control(UsbTestDevice::setup_out_device(request::kSetAddress, 7), {}, {}).ok());
   ASSERT_TRUE(c.control(UsbTestDevice::setup_out_device(request::kSetConfiguration, 1), {}, {}).ok());
+}
+
+TEST(FirmwareUsb, TheUartAndUsbServeOneDeviceStateAndThePeriodReachesHid) {
+  FirmwareUnderTest& f = firmware_under_test();
+  app::UartEndpoint<Q>* uart = f.uart.get();
+  FakeController& c = board::host_port().controller;
+
+  // Enumeration on the board's port; the serial number is the unique ID;
+  // the configuration names the model the boot rule chose.
+  enumerate(c);
   EXPECT_EQ(string_descriptor(c, composite::string_index::kSerial), kTestUidHex);
-  char hash[17];
-  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(Q::kModelHash));
   EXPECT_EQ(string_descriptor(c, composite::string_index::kVersion),
-            std::string("fw ") + HADYNET_FIRMWARE_VERSION + " model " + hash);
+            std::string("fw ") + HADYNET_FIRMWARE_VERSION + " model 0123456789abcdef (slot A, sequence 1)");
+  EXPECT_EQ(f.slots->choice().source, mu::ModelSource::kSlotA);
+  EXPECT_EQ(&f.runtime->tensors(), reinterpret_cast<const firmware::ModelTensors<Q>*>(f.slots->choice().payload.data()))
+      << "the runtime reads the slot's tensors in place";
 
   // One session over both ports: reset and a muscle state over USB, the
   // period result over the UART; one client numbers them all.
@@ -194,6 +261,70 @@ TEST(FirmwareUsb, TheUartAndUsbServeOneDeviceStateAndThePeriodReachesHid) {
   const Bytes uart_tail = uart_exchange(*uart, std::span(uart_wire + half, uart_n - half));
   EXPECT_EQ(replies(client, usb_reply), std::vector<link::MessageType>{link::MessageType::kInfo});
   EXPECT_EQ(replies(client, uart_tail), std::vector<link::MessageType>{link::MessageType::kPeriodResult});
+}
+
+// DFU through the firmware's own USB side: alt 1 reads back the running
+// image, alt 0 takes a newer image into the other slot (usb_service() does
+// the flash work), the running slot untouched; the next power-on runs it.
+TEST(FirmwareUsb, TheDfuModelInterfaceReadsTheRunningImageAndTakesANewOneIntoTheOtherSlot) {
+  FirmwareUnderTest& f = firmware_under_test();
+  FakeController& c = board::host_port().controller;
+  enumerate(c);
+  const auto dfu = [](bool in, std::uint8_t request, std::uint16_t value, std::uint16_t length) {
+    return UsbTestDevice::class_interface(in, request, value, composite::kDfuModeInterface, length);
+  };
+  const auto set_alt = [&c](std::uint16_t alt) {
+    return c.control({request_type(false, RequestKind::kStandard, Recipient::kInterface), request::kSetInterface, alt,
+                      composite::kDfuModeInterface, 0},
+                     {}, {})
+        .ok();
+  };
+  const auto state = [&]() {
+    Bytes status(6);
+    EXPECT_TRUE(c.control(dfu(true, dfu::kGetStatus, 0, 6), {}, status).ok());
+    return static_cast<dfu::State>(status[4]);
+  };
+  const auto upload = [&]() {
+    Bytes all;
+    for (std::uint16_t b = 0; b < 2000; ++b) {
+      Bytes block(256);
+      const host::ControlResult r = c.control(dfu(true, dfu::kUpload, b, 256), {}, block);
+      EXPECT_TRUE(r.ok());
+      all.insert(all.end(), block.begin(), block.begin() + static_cast<long>(r.in_bytes));
+      if (r.in_bytes < 256) break;
+    }
+    return all;
+  };
+  ASSERT_TRUE(set_alt(1));
+  EXPECT_EQ(upload(), f.installed);
+
+  ASSERT_TRUE(set_alt(0));
+  const auto& flash = board::host_port().flash;
+  const Bytes slot_a(flash.contents().begin() + kSlotA.offset, flash.contents().begin() + kSlotA.offset + kSlotA.size);
+  const Bytes next = compiled_model_image(2);
+  std::uint16_t block = 0;
+  for (std::size_t at = 0; at < next.size(); at += 256, ++block) {
+    const std::size_t n = std::min<std::size_t>(256, next.size() - at);
+    ASSERT_TRUE(c.control(dfu(false, dfu::kDnload, block, static_cast<std::uint16_t>(n)),
+                          std::span(next).subspan(at, n), {})
+                    .ok());
+    ASSERT_EQ(state(), dfu::State::kDnBusy);
+    app::usb_service();  // the main loop does the flash work
+    ASSERT_EQ(state(), dfu::State::kDnloadIdle) << "block " << block;
+  }
+  ASSERT_TRUE(c.control(dfu(false, dfu::kDnload, block, 0), {}, {}).ok());
+  ASSERT_EQ(state(), dfu::State::kManifest);
+  app::usb_service();
+  ASSERT_EQ(state(), dfu::State::kIdle);
+  EXPECT_EQ(upload(), next);
+  EXPECT_EQ(Bytes(flash.contents().begin() + kSlotA.offset, flash.contents().begin() + kSlotA.offset + kSlotA.size),
+            slot_a)
+      << "the running slot is untouched";
+  EXPECT_EQ(f.slots->slot_status(mu::SlotId::kB).state, mu::SlotState::kValid);
+  // The next power-on: the app's boot rule tries slot B (sequence 2) and runs it.
+  const auto next_boot = slots_over_board_flash();
+  auto runtime = std::make_unique<firmware::HadynetRuntime<Q>>();
+  EXPECT_EQ(app::boot_model(*next_boot, *runtime).source, mu::ModelSource::kSlotB);
 }
 
 }  // namespace

@@ -1,8 +1,10 @@
 // Test fixture for the USB stack: the composite device over the host backend
 // (FakeController), with the real link device end (DeviceLink + q15
-// runtime), a simulated NOR flash laid out like the STM32F405's 1 MiB, the
-// provisional model slots as DFU targets, and a detach hook that records.
-// Helpers build SETUP packets and run control transfers.
+// runtime), a simulated NOR flash laid out like the STM32F405's 1 MiB with
+// its two model slots managed by a ModelSlots (booted before the device is
+// built, as the firmware does), and a detach hook that records. A reboot is
+// a new device over the same flash cells. Helpers build SETUP packets and
+// run control transfers.
 #ifndef HADYNET_TEST_USB_USB_TEST_DEVICE_H_
 #define HADYNET_TEST_USB_USB_TEST_DEVICE_H_
 
@@ -12,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "firmware/core/hadynet_runtime.h"
@@ -19,14 +22,15 @@
 #include "firmware/flash/stm32f405_flash_layout.h"
 #include "firmware/link/device_link.h"
 #include "firmware/link/frame.h"
+#include "firmware/model_update/model_slots.h"
 #include "firmware/usb/hadynet_usb_device.h"
 #include "firmware/usb/host/fake_controller.h"
 #include "hadynet_model_q15.h"
+#include "test/usb/usb_test_images.h"
 
 namespace hadynet::usb::testing {
 
 using Q = model_q15::Model;
-using Bytes = std::vector<std::uint8_t>;
 using host::ControlResult;
 using host::FakeController;
 using host::Handshake;
@@ -40,6 +44,18 @@ struct RecordingDetachHook final : DetachHook {
   std::uint16_t last_timeout_ms = 0;
 };
 
+// The boot's self-test with a fixed verdict (the app's own self-test is
+// exercised by firmware_usb_test.cc and test/usb_host/ with real images).
+struct VerdictSelfTest final : model_update::SelfTest {
+  explicit VerdictSelfTest(bool verdict) : pass(verdict) {}
+  bool run(std::span<const std::uint8_t>, const model_update::ModelImageHeader&) noexcept override {
+    ++runs;
+    return pass;
+  }
+  bool pass;
+  int runs = 0;
+};
+
 // A fixed unique ID (bytes as the board reads them) and its serial string.
 inline constexpr std::array<std::uint8_t, kUniqueIdBytes> kTestUid = {0x33, 0x00, 0x2A, 0x00, 0x0E, 0x47,
                                                                       0x37, 0x36, 0x34, 0x32, 0x38, 0x39};
@@ -51,15 +67,37 @@ inline constexpr flash::FlashRegion kSlotB{flash::stm32f405::kModelSlotBOffset, 
 
 using Usb = HadynetUsbDevice<Q, link::DeviceLink<Q>, link::kMaxWireFrame>;
 
+struct DeviceSetup {
+  model_update::ModelIdentity identity = firmware_identity();
+  bool model_slots = true;         // false: a board without model flash (no ModelSlots)
+  bool boot = true;                // run the boot rule before the USB device is built
+  bool self_test_passes = true;    // the boot's self-test verdict
+  const Bytes* cells = nullptr;    // the flash's contents at power-on (a reboot); null: erased
+};
+
 struct UsbTestDevice {
-  UsbTestDevice()
+  explicit UsbTestDevice(const DeviceSetup& setup = {})
       : storage(flash::stm32f405::kFlashSize),
         flash(flash::stm32f405::kSectors, storage),
         runtime(std::make_unique<firmware::HadynetRuntime<Q>>()),
         link(std::make_unique<link::DeviceLink<Q>>(*runtime)),
-        targets{DfuTarget{kSlotB, true, true}, DfuTarget{kSlotA, false, true}},
-        usb(std::make_unique<Usb>(controller, *link, flash, targets, hook, kTestUid, kTestFirmwareVersion)) {
+        self_test(setup.self_test_passes) {
+    if (setup.cells != nullptr) std::copy(setup.cells->begin(), setup.cells->end(), storage.begin());
+    if (setup.model_slots) {
+      slots = std::make_unique<model_update::ModelSlots>(flash, kSlotA, kSlotB, setup.identity,
+                                                         device_key().public_key, flash.contents());
+      if (setup.boot) slots->boot(self_test);
+    }
+    usb = std::make_unique<Usb>(controller, *link, ModelSlotsAccess{slots.get(), slots ? &flash : nullptr}, hook,
+                                kTestUid, kTestFirmwareVersion);
     usb->start();
+  }
+
+  // A power-on reset: a new device over a copy of this one's cells.
+  std::unique_ptr<UsbTestDevice> reboot(DeviceSetup setup = {}) const {
+    const Bytes cells(flash.contents().begin(), flash.contents().end());
+    setup.cells = &cells;
+    return std::make_unique<UsbTestDevice>(setup);
   }
 
   // Bus reset, SET_ADDRESS(5), SET_CONFIGURATION(1); expects success.
@@ -79,6 +117,15 @@ struct UsbTestDevice {
       *in = buffer;
     }
     return r;
+  }
+
+  // String descriptor `index` (LANGID 0x0409) as ASCII; "<stall>" if refused.
+  std::string string_descriptor(std::uint8_t index) {
+    Bytes in;
+    if (!control(get_descriptor(descriptor::kString, index, 255, kLangIdEnglishUs), {}, &in).ok()) return "<stall>";
+    std::string s;
+    for (std::size_t i = 2; i + 1 < in.size(); i += 2) s.push_back(static_cast<char>(in[i]));
+    return s;
   }
 
   static SetupPacket setup(std::uint8_t type, std::uint8_t request, std::uint16_t value, std::uint16_t index,
@@ -104,7 +151,8 @@ struct UsbTestDevice {
   RecordingDetachHook hook;
   std::unique_ptr<firmware::HadynetRuntime<Q>> runtime;
   std::unique_ptr<link::DeviceLink<Q>> link;
-  std::array<DfuTarget, composite::kDfuAlternates> targets;
+  VerdictSelfTest self_test;
+  std::unique_ptr<model_update::ModelSlots> slots;  // null: no model flash
   std::unique_ptr<Usb> usb;
 };
 

@@ -3,14 +3,18 @@
 // from a bootloader already on the bus, through the whole DFU_DETACH flow
 // from a running hand, and the documented failures with their exit codes
 // (tools/usb/firmware_flasher.h: 3 doesn't fit, 4 vanished, 5 DFU status
-// error, 6 verify mismatch, 7 other transfer failure). Also `--model`
-// through the hand's own DFU interface, read back independently by dfu-util.
+// error, 6 verify mismatch, 7 other transfer failure). Also `--model`: a
+// signed model image of the build's model (hadynet model-image) through the
+// hand's own DFU interface, read back independently by dfu-util and run by
+// the hand after a power-on; the hand's refusal in its own words; a file
+// that is not a model image refused before any device is touched.
 // Expected flash contents are the image file's bytes; expected erases come
 // from the F405 sector table written out here (16,16,16,16,64,128.. KiB).
 #include <gtest/gtest.h>
 
 #include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -22,8 +26,10 @@
 #include "test/usb/test_bytes.h"
 #include "test/usb_host/child_process.h"
 #include "test/usb_host/hand_device.h"
+#include "test/usb_host/model_image_files.h"
 #include "test/usb_host/test_records.h"
 #include "test/usb_host/usb_testbed.h"
+#include "tools/usb/model_image_file.h"
 
 namespace hadynet::usb::host_testing {
 namespace {
@@ -41,8 +47,9 @@ constexpr std::uint8_t kRomDevnum = 3;  // where the bootloader appears (the han
 constexpr std::uint32_t kPollPercent = 1;
 // Tolerance of a child's run: a flash here takes ~0.5 s (the detach flow's
 // wait for the bootloader, up to 10 s in the CLI, ~0.2 s of it); the hang
-// test costs libusb's 5 s control time-out (tools/usb/libusb_dfu.h); the
-// --model test the hand's real 4 s sector-erase poll time. 30 s only
+// test costs libusb's 5 s control time-out (tools/usb/libusb_dfu.h); a
+// --model download ~3 s (the hand's poll times: signature check 0.25 s,
+// scaled erases and programming ~1 s, manifestation 2 s). 30 s only
 // catches a hang.
 constexpr auto kChildTimeout = 30s;
 constexpr std::size_t kImageBytes = 150 * 1024;  // sectors 0..5 (0x08000000 .. 0x0803FFFF)
@@ -276,27 +283,107 @@ TEST_F(CliFlash, HungTransferMidWayFailsWithSevenInBoundedTime) {
 }
 
 // --model through the hand's DFU-mode interface (docs/usb.md "Model
-// images"), then read back by dfu-util, a client that is not ours.
-TEST_F(CliFlash, ModelGoesIntoTheInactiveSlot) {
+// images"): what the file says, the transfer, the read-back, the slot the
+// hand names; then read back by dfu-util, a client that is not ours; then
+// the hand after a power-on runs it, and `hadynet devices` says so.
+TEST_F(CliFlash, ModelImageGoesIntoAFreeSlotAndRunsAfterAPowerOn) {
   hand_ = std::make_shared<HandDevice>();
   ASSERT_TRUE(bus_->plug(kHandDevnum, hand_)) << bus_->error();
-  const Bytes model = pseudo_random(3000, 17);
-  const ChildResult r = hadynet({"flash", "--model", write("model.bin", model).string()});
+  const fs::path image = make_model_image(*bus_, dir_, 2);
+  const Bytes file = read(image);
+  ASSERT_GT(file.size(), 256u);
+  const ChildResult r = hadynet({"flash", "--model", image.string()});
   ASSERT_TRUE(r.started && !r.timed_out) << r.describe();
   EXPECT_EQ(r.exit_code, 0) << r.describe();
-  EXPECT_NE(r.out.find("3016 bytes (with the 16-byte envelope) in the inactive slot of hand " +
-                       std::string(kFixtureSerial) + ", read back byte for byte"),
+  char shape[17];
+  std::snprintf(shape, sizeof shape, "%016llx", static_cast<unsigned long long>(Q::kShapeId));
+  EXPECT_NE(r.out.find("model image " + image.string() + ": sequence 2, q15, shape id " + shape +
+                       " (this build's firmware), payload " + std::to_string(file.size() - 256) + " bytes"),
             std::string::npos)
       << r.out;
-  if (std::string(DFU_UTIL_EXECUTABLE).empty() || !fs::exists(DFU_UTIL_EXECUTABLE)) return;
-  const fs::path back = dir_ / "readback.hdim";
-  const ChildResult up = run_child(
-      *bus_, {DFU_UTIL_EXECUTABLE, "-d", "1209:0001", "-i", "4", "-a", "0", "-U", back.string()}, kChildTimeout);
-  ASSERT_EQ(up.exit_code, 0) << up.describe();
-  const Bytes got = read(back);
-  ASSERT_EQ(got.size(), 16u + model.size());
-  EXPECT_EQ(Bytes(got.begin(), got.begin() + 4), (Bytes{'H', 'D', 'I', 'M'}));
-  EXPECT_EQ(Bytes(got.begin() + 16, got.end()), model);
+  EXPECT_NE(r.out.find("-- the DEVELOPMENT key"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(std::to_string(file.size()) + " bytes sent to hand " + std::string(kFixtureSerial) +
+                       " and read back byte for byte: image sequence 2 written to slot A: the boot rule tries it at "
+                       "the next reset"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("the new model runs after the next reset or power-up"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("verify ["), std::string::npos) << r.err;
+  bus_->locked([&] {
+    EXPECT_EQ(hand_->slot_status(model_update::SlotId::kA).state, model_update::SlotState::kValid);
+    EXPECT_EQ(hand_->boot_choice().source, model_update::ModelSource::kFactory) << "until the reset";
+  });
+  if (!std::string(DFU_UTIL_EXECUTABLE).empty() && fs::exists(DFU_UTIL_EXECUTABLE)) {
+    const fs::path back = dir_ / "readback.img";
+    const ChildResult up = run_child(
+        *bus_, {DFU_UTIL_EXECUTABLE, "-d", "1209:0001", "-i", "4", "-a", "0", "-U", back.string()}, kChildTimeout);
+    ASSERT_EQ(up.exit_code, 0) << up.describe();
+    EXPECT_EQ(read(back), file);
+  }
+  // Power-on: the same flash in a new hand; the boot rule runs the image
+  // (the app's self-test passes: hadynet model-image computed its checksum).
+  std::vector<std::uint8_t> cells;
+  bus_->locked([&] { cells = hand_->flash_cells(); });
+  bus_->unplug(kHandDevnum);
+  hand_ = std::make_shared<HandDevice>(&cells);
+  ASSERT_TRUE(bus_->plug(kHandDevnum, hand_)) << bus_->error();
+  const ChildResult d = hadynet({"devices"});
+  ASSERT_EQ(d.exit_code, 0) << d.describe();
+  char hash[17];
+  std::snprintf(hash, sizeof hash, "%016llx",
+                static_cast<unsigned long long>(
+                    tools::usb::check_model_image_bytes(file, image.string()).header.model_hash));
+  EXPECT_NE(d.out.find(std::string("  model ") + hash + " (slot A, sequence 2)  "), std::string::npos) << d.out;
+}
+
+// The hand's refusal, in its own words, exit 5; nothing else changes.
+TEST_F(CliFlash, ModelImageTheHandRefusesIsReportedInItsWords) {
+  hand_ = std::make_shared<HandDevice>();
+  ASSERT_TRUE(bus_->plug(kHandDevnum, hand_)) << bus_->error();
+  const fs::path key = make_other_key(*bus_, dir_);
+  const fs::path image = make_model_image(*bus_, dir_, 2, key);
+  const ChildResult r = hadynet({"flash", "--model", image.string()});
+  ASSERT_TRUE(r.started && !r.timed_out) << r.describe();
+  EXPECT_EQ(r.exit_code, 5) << r.describe();
+  EXPECT_EQ(r.out.find("DEVELOPMENT"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("hadynet flash --model: the image was not taken: signed by another key (block 0: the device "
+                       "reports errFILE (file failed verification) (status 0x02) in state dfuERROR (10)); the model "
+                       "in use and the boot choice are unchanged"),
+            std::string::npos)
+      << r.err;
+  bus_->locked([&] {
+    EXPECT_EQ(hand_->slot_status(model_update::SlotId::kA).state, model_update::SlotState::kEmpty);
+    EXPECT_EQ(hand_->slot_status(model_update::SlotId::kB).state, model_update::SlotState::kEmpty);
+  });
+  // The hand was left usable: the next image goes in.
+  const ChildResult again = hadynet({"flash", "--model", make_model_image(*bus_, dir_, 3).string(), "--quiet"});
+  EXPECT_EQ(again.exit_code, 0) << again.describe();
+}
+
+// A hand without model flash STALLs the first DNLOAD; the CLI asks for the
+// status and prints the hand's reason (errTARGET), exit 5.
+TEST_F(CliFlash, AHandWithoutModelSlotsSaysSo) {
+  hand_ = std::make_shared<HandDevice>(nullptr, /*model_slots=*/false);
+  ASSERT_TRUE(bus_->plug(kHandDevnum, hand_)) << bus_->error();
+  const ChildResult r = hadynet({"flash", "--model", make_model_image(*bus_, dir_, 2).string(), "--quiet"});
+  ASSERT_TRUE(r.started && !r.timed_out) << r.describe();
+  EXPECT_EQ(r.exit_code, 5) << r.describe();
+  EXPECT_NE(r.err.find("the image was not taken: this device has no model slots: it takes no model images"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("errTARGET"), std::string::npos) << r.err;
+}
+
+// A file that is not a model image: refused, with the reason, before any
+// device is looked for (no hand on the bus here).
+TEST_F(CliFlash, AFileThatIsNotAModelImageIsRefusedBeforeAnyDevice) {
+  const ChildResult r = hadynet({"flash", "--model", write("model.bin", pseudo_random(3000, 17)).string()});
+  ASSERT_TRUE(r.started && !r.timed_out) << r.describe();
+  EXPECT_EQ(r.exit_code, 1) << r.describe();
+  EXPECT_NE(r.err.find("model.bin: not a model image: not a model image (magic is not \"HYDM\")"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("nothing was sent"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("no HADYNET hand"), std::string::npos) << r.err;
 }
 
 }  // namespace

@@ -2,8 +2,18 @@
 // telemetry, DFU runtime, DFU mode) as an EmulatedDevice for the testbed
 // (usb_testbed.h): the firmware's stack over the host backend
 // FakeController, with a link::DeviceLink on a HadynetRuntime behind the
-// CDC function, the F405 flash simulated (SimulatedNorFlash) behind DFU
-// mode, and a DetachHook that records DFU_DETACH.
+// CDC function, a DetachHook that records DFU_DETACH, and the model slots
+// as the firmware has them: a ModelSlots for the build's q15 model, trusting
+// the development key (keys/development.key.pub), over a simulated F405
+// flash, booted with the app's boot rule and self-test (model_store.h)
+// before the USB device is built. A new HandDevice over another's flash
+// cells is that hand after a power-on.
+//
+// The flash has the F405's sector table but its worst-case times scaled to
+// 1 % (8/24/40 ms erases) and 1 us per programmed byte: the DFU clients
+// really sleep every bwPollTimeout, and at the datasheet's figures one
+// 181 KB image asks for 8 s of erase and 4.5 s of programming waits. The
+// exact F405 poll times are test/usb's (dfu_test.cc).
 //
 // Like every EmulatedDevice, call its methods under the bus lock
 // (UsbTestbed::locked), except in the constructor.
@@ -15,8 +25,10 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "firmware/app/period_record.h"
+#include "firmware/model_update/slot_status.h"
 #include "hadynet_model_q15.h"
 #include "test/usb_host/emulated_device.h"
 
@@ -33,8 +45,11 @@ inline constexpr const char* kFixtureFirmwareVersion = "0.1.0-umockdev";
 
 class HandDevice final : public EmulatedDevice {
  public:
-  // Started (controller initialised, pull-up on): ready to plug.
-  HandDevice();
+  // Started (controller initialised, pull-up on): ready to plug. `cells`:
+  // the flash at power-on (another hand's flash_cells()); null: erased.
+  // `model_slots` false: a board without model flash (no ModelSlots; the
+  // DFU model interface refuses images).
+  explicit HandDevice(const std::vector<std::uint8_t>* cells = nullptr, bool model_slots = true);
   ~HandDevice() override;
 
   host::FakeController& controller() noexcept override;
@@ -44,7 +59,12 @@ class HandDevice final : public EmulatedDevice {
   // HID telemetry: HadynetUsbDevice::publish.
   void publish(const app::PeriodRecord<Q>& record);
   std::string serial_number() const;
-  std::string version_string() const;  // "fw <version> model <hash>"
+  std::string version_string() const;  // "fw <version> model <hash> (<source>)"
+  // The model slots (with model_slots): what the boot rule chose, each slot's status.
+  model_update::BootChoice boot_choice() const;
+  model_update::SlotStatus slot_status(model_update::SlotId slot) const;
+  // A copy of the flash cells (for a power-on of another HandDevice).
+  std::vector<std::uint8_t> flash_cells() const;
 
   // DFU_DETACH: acknowledged by the stack, then the board hook runs (after
   // the status stage). The hand records it, calls `on_detach` (under the bus

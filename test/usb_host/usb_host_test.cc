@@ -8,11 +8,13 @@
 #include <hidapi.h>
 #include <libusb.h>
 #include <sys/time.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,6 +27,7 @@
 #include "firmware/usb/telemetry_decoder.h"
 #include "test/usb/test_bytes.h"
 #include "test/usb_host/hand_device.h"
+#include "test/usb_host/model_image_files.h"
 #include "test/usb_host/test_records.h"
 #include "test/usb_host/usb_testbed.h"
 
@@ -208,7 +211,7 @@ TEST_F(UsbHost, WireDescriptorsEqualSysfsAndStringsReadBack) {
       string_descriptor(10), std::string("fw ") + kFixtureFirmwareVersion + " model " + [] {
         char h[17];
         std::snprintf(h, sizeof h, "%016llx", static_cast<unsigned long long>(Q::kModelHash));
-        return std::string(h);
+        return std::string(h) + " (factory)";  // no image in the slots: the compiled-in model runs
       }());
   // Device qualifier: STALL (full speed only) → LIBUSB_ERROR_PIPE.
   EXPECT_EQ(libusb_get_descriptor(handle_, 0x06 /* device qualifier */, 0, buffer.data(), 10), LIBUSB_ERROR_PIPE);
@@ -414,14 +417,19 @@ bool poll_dfu_state(libusb_device_handle* h, std::uint8_t state) {
 }
 
 TEST_F(UsbHost, DfuModelImageDownloadAndUploadRoundTrip) {
+  // A signed model image of the build's model (hadynet model-image).
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("hadynet_usb_host_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path file = make_model_image(*bus_, dir, 2);
+  std::vector<std::uint8_t> image = read_file(file);  // libusb takes non-const data
+  std::filesystem::remove_all(dir);
+  ASSERT_GT(image.size(), 256u);
+
   open();
   ASSERT_EQ(libusb_claim_interface(handle_, kDfuModeInterface), 0);
   EXPECT_EQ(libusb_set_interface_alt_setting(handle_, kDfuModeInterface, 2), LIBUSB_ERROR_NOT_FOUND);
-  ASSERT_EQ(libusb_set_interface_alt_setting(handle_, kDfuModeInterface, 0), 0);  // the inactive slot
-
-  // The envelope (docs/usb.md), then a pseudo-random payload.
-  const std::vector<std::uint8_t> payload = test_data::pseudo_random(3000, 7);
-  std::vector<std::uint8_t> image = test_data::model_image_file(payload);  // libusb takes non-const data
+  ASSERT_EQ(libusb_set_interface_alt_setting(handle_, kDfuModeInterface, 0), 0);  // model update
 
   constexpr std::size_t kBlock = 256;  // the DFU functional descriptor's wTransferSize
   std::uint16_t block = 0;
@@ -436,7 +444,7 @@ TEST_F(UsbHost, DfuModelImageDownloadAndUploadRoundTrip) {
   ASSERT_TRUE(poll_dfu_state(handle_, 2)) << "dfuIDLE after manifestation";
 
   std::vector<std::uint8_t> uploaded;
-  for (std::uint16_t b = 0; b < 100; ++b) {
+  for (std::uint16_t b = 0; b < 1000; ++b) {
     std::uint8_t in[kBlock];
     const int n = libusb_control_transfer(handle_, kDfuIn, 2, b, kDfuModeInterface, in, kBlock, kTimeoutMs);
     ASSERT_GE(n, 0) << libusb_error_name(n);
@@ -444,6 +452,13 @@ TEST_F(UsbHost, DfuModelImageDownloadAndUploadRoundTrip) {
     if (n < static_cast<int>(kBlock)) break;
   }
   EXPECT_EQ(uploaded, image);
+  // The hand took it into slot A; it runs after a reset (hand_device.h: a new hand over the same flash).
+  bus_->locked([&] { EXPECT_EQ(hand_->slot_status(model_update::SlotId::kA).state, model_update::SlotState::kValid); });
+  std::vector<std::uint8_t> cells;
+  bus_->locked([&] { cells = hand_->flash_cells(); });
+  const HandDevice rebooted(&cells);
+  EXPECT_EQ(rebooted.boot_choice().source, model_update::ModelSource::kSlotA);
+  EXPECT_EQ(rebooted.boot_choice().sequence, 2u);
 }
 
 TEST_F(UsbHost, DfuDetachReachesTheBoardHook) {

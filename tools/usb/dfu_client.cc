@@ -70,6 +70,7 @@ DfuStatus DfuClient::get_status() {
   s.poll_timeout_ms = static_cast<std::uint32_t>(b[1]) | (static_cast<std::uint32_t>(b[2]) << 8) |
                       (static_cast<std::uint32_t>(b[3]) << 16);
   s.state = static_cast<dfu::State>(b[4]);
+  s.string_index = b[5];
   return s;
 }
 

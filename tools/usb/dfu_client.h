@@ -44,6 +44,7 @@ struct DfuStatus {
   dfu::Status status = dfu::Status::kOk;
   std::uint32_t poll_timeout_ms = 0;  // bwPollTimeout
   dfu::State state = dfu::State::kIdle;
+  std::uint8_t string_index = 0;      // iString: a string descriptor describing the status (0: none)
 };
 
 // The device reported an error status (or an unexpected state).

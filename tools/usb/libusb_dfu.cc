@@ -142,6 +142,13 @@ std::size_t LibusbDfuInterface::control_in(std::uint8_t request, std::uint16_t v
   return static_cast<std::size_t>(r);
 }
 
+std::string LibusbDfuInterface::string_descriptor(std::uint8_t index) {
+  if (index == 0 || handle_ == nullptr) return {};
+  unsigned char text[256];
+  const int n = libusb_get_string_descriptor_ascii(handle_, index, text, sizeof text);
+  return n > 0 ? std::string(reinterpret_cast<char*>(text), static_cast<std::size_t>(n)) : std::string();
+}
+
 void detach_to_bootloader(libusb_device* device, std::uint8_t runtime_interface) {
   libusb_device_handle* handle = nullptr;
   if (const int r = libusb_open(device, &handle); r != LIBUSB_SUCCESS) throw std::runtime_error(open_error(r));

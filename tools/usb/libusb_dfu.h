@@ -40,6 +40,9 @@ class LibusbDfuInterface final : public DfuTransport {
   std::size_t control_in(std::uint8_t request, std::uint16_t value, std::span<std::uint8_t> buffer) override;
 
   const DfuFunctional& functional() const { return functional_; }
+  // String descriptor `index` as ASCII (a GETSTATUS iString); "" if it
+  // cannot be read or `index` is 0.
+  std::string string_descriptor(std::uint8_t index);
   // The name of every alternate setting of the interface (iInterface), in order.
   const std::vector<std::string>& alternate_names() const { return alternate_names_; }
 

@@ -6,6 +6,7 @@
 #include <cctype>
 #include <memory>
 #include <stdexcept>
+#include <string_view>
 
 #include "firmware/usb/usb_identity.h"
 
@@ -87,25 +88,36 @@ void read_strings(libusb_device* device, const libusb_device_descriptor& desc, A
   if (libusb_get_config_descriptor(device, 0, &config_raw) != LIBUSB_SUCCESS) return;
   const std::unique_ptr<libusb_config_descriptor, ConfigDeleter> config(config_raw);
   const std::string text = read_string(handle.get(), config->iConfiguration, out.read_error);
-  if (!text.empty() && !parse_configuration_string(text, out.firmware_version, out.model_hash) &&
-      out.read_error.empty()) {
-    out.read_error = "configuration string '" + text + "' is not 'fw <version> model <hash>'";
+  ConfigurationString parsed;
+  if (!text.empty() && parse_configuration_string(text, parsed)) {
+    out.firmware_version = parsed.firmware_version;
+    out.model_hash = parsed.model_hash;
+    out.model_source = parsed.model_source;
+  } else if (!text.empty() && out.read_error.empty()) {
+    out.read_error = "configuration string '" + text + "' is not 'fw <version> model <hash> (<source>)'";
   }
 }
 
 }  // namespace
 
-bool parse_configuration_string(const std::string& text, std::string& version, std::string& model_hash) {
+bool parse_configuration_string(const std::string& text, ConfigurationString& out) {
   constexpr std::string_view kFw = "fw ", kModel = " model ";
+  constexpr std::size_t kHashDigits = 16;
   if (text.compare(0, kFw.size(), kFw) != 0) return false;
-  const std::size_t at = text.rfind(kModel);
-  if (at == std::string::npos || at < kFw.size()) return false;
-  const std::string v = text.substr(kFw.size(), at - kFw.size());
-  const std::string h = text.substr(at + kModel.size());
-  if (v.empty() || h.size() != 16) return false;
-  if (!std::all_of(h.begin(), h.end(), [](unsigned char c) { return std::isxdigit(c) != 0; })) return false;
-  version = v;
-  model_hash = h;
+  const std::size_t at = text.find(kModel, kFw.size());
+  if (at == std::string::npos || at == kFw.size()) return false;
+  const std::string hash = text.substr(at + kModel.size(), kHashDigits);
+  if (hash.size() != kHashDigits) return false;
+  if (!std::all_of(hash.begin(), hash.end(), [](unsigned char c) { return std::isxdigit(c) != 0; })) return false;
+  const std::string rest = text.substr(at + kModel.size() + kHashDigits);
+  std::string source;
+  if (!rest.empty()) {
+    if (rest.size() < 3 || rest.compare(0, 2, " (") != 0 || rest.back() != ')') return false;
+    source = rest.substr(2, rest.size() - 3);
+  }
+  out.firmware_version = text.substr(kFw.size(), at - kFw.size());
+  out.model_hash = hash;
+  out.model_source = source;
   return true;
 }
 

@@ -36,9 +36,13 @@ struct AttachedDevice {
   // not be opened or its strings not read.
   std::string serial;
   std::string product;
-  // kHand: from iConfiguration, "fw <version> model <16 hex digits>".
+  // kHand: from iConfiguration, "fw <version> model <16 hex digits> (<source>)"
+  // (firmware/usb/running_model.h): the running model's hash and where it
+  // comes from ("factory", "slot A, sequence 2"; empty from a firmware that
+  // does not say).
   std::string firmware_version;
   std::string model_hash;
+  std::string model_source;
   InterfacesPresent interfaces;
   bool access_denied = false;  // LIBUSB_ERROR_ACCESS on open: udev rules missing
   std::string read_error;      // any other failure, in words
@@ -48,9 +52,17 @@ struct AttachedDevice {
 // order. Throws std::runtime_error only if libusb cannot list devices at all.
 std::vector<AttachedDevice> list_attached_devices(libusb_context* context);
 
-// "fw 0.1.0 model 0123456789abcdef" -> version "0.1.0", hash
-// "0123456789abcdef"; false (outputs unchanged) for any other text.
-bool parse_configuration_string(const std::string& text, std::string& version, std::string& model_hash);
+// The configuration string of a hand.
+struct ConfigurationString {
+  std::string firmware_version;  // "0.1.0"
+  std::string model_hash;        // 16 hex digits
+  std::string model_source;      // "factory", "slot A, sequence 2"; "" if the text has none
+};
+
+// "fw 0.1.0 model 0123456789abcdef (slot B, sequence 2)" (or without the
+// parenthesis: older firmware) -> its parts; false (`out` unchanged) for
+// any other text.
+bool parse_configuration_string(const std::string& text, ConfigurationString& out);
 
 }  // namespace hadynet::tools::usb
 
