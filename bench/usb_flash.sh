@@ -17,6 +17,13 @@
 #     0: no device waits, host and protocol only); the table adds what the
 #     datasheet figures (sector erase 800..4000 ms, 25 us/byte programming)
 #     would add on a real F405, from the sim's own sum of them.
+#   * a model update: a signed image of the build's model (this build's
+#     `hadynet model-image`) into the hand's slot not in use through its DFU
+#     model interface, `hadynet flash --model IMAGE` (send, read back and
+#     compare) against `dfu-util -i 4 -a 0 -D IMAGE`; the table adds the
+#     bwPollTimeouts a real F405 asks for (the firmware's poll rule with the
+#     datasheet's times, docs/usb.md: a block that starts a 128 KiB sector
+#     4007 ms, any other 7 ms, the header check 250 ms, the manifest 2000 ms).
 #   * `hadynet monitor`: latency from the publish of a telemetry record (one
 #     in flight) to its line on monitor's stdout, and records/s when the next
 #     record is published as soon as the host has taken the previous one.
@@ -71,6 +78,10 @@ awk '
     tool = field($0, "tool"); n[tool]++
     s[tool, n[tool]] = field($0, "seconds"); ds[tool] = field($0, "datasheet_poll_ms"); sec[tool] = field($0, "sectors")
   }
+  /^model / {
+    mtool = field($0, "tool"); mn[mtool]++
+    ms[mtool, mn[mtool]] = field($0, "seconds"); mbytes = field($0, "bytes")
+  }
   /^latency / { lat = $0 }
   /^throughput / { thr = $0 }
   END {
@@ -93,6 +104,25 @@ awk '
     }
     printf "\n+datasheet: the worst-case bwPollTimeouts a real F405 would add (the sim sums them: sector erases and\n"
     printf "25 us/byte programming), less the share already slept at %d %%; both clients sleep what the device asks.\n", poll
+    blocks = int((mbytes + 255) / 256); sectors = int((mbytes - 256 + 1024 + 131071) / 131072)
+    mds = (sectors * 4000 + blocks * 7 + 250 + 2000) * 0.99  # the hand already waits 1 % of it
+    printf "\nModel update: a %d-byte signed image of the build\47s model into the hand\47s slot not in use (DFU model\n", mbytes
+    printf "interface, wTransferSize 256; the hand\47s flash waits are 1 %% of the F405\47s); median of %d runs\n\n", reps
+    printf "%-9s %-26s %8s %8s %9s %12s %8s\n", "client", "does", "s", "kB/s", "ratio", "+datasheet", "= s"
+    for (k = 0; k < 2; ++k) {
+      tool = k == 0 ? "dfu-util" : "hadynet"
+      for (i = 1; i <= mn[tool]; ++i) l[i] = ms[tool, i]
+      mm[tool] = median(l, mn[tool])
+    }
+    for (k = 0; k < 2; ++k) {
+      tool = k == 0 ? "dfu-util" : "hadynet"
+      what = k == 0 ? "send" : "send, read back, compare"
+      printf "%-9s %-26s %8.3f %8.1f %8.2fx %11.1fs %8.1f\n", tool, what, mm[tool], mbytes / mm[tool] / 1000,
+             mm[tool] / mm["dfu-util"], mds / 1000.0, mm[tool] + mds / 1000.0
+    }
+    printf "\n+datasheet: %d blocks, %d sector erases at 4000 ms, 7 ms per block, 250 ms header check, 2000 ms manifest\n", blocks, sectors
+    printf "(the firmware\47s worst-case bwPollTimeouts on a real F405, which both clients sleep), less the 1 %% the\n"
+    printf "hand already waits.\n"
     printf "\nTelemetry through `hadynet monitor` (hidapi libusb backend; 4 x 64-byte HID reports per record)\n\n"
     printf "%-34s %10s %10s %10s\n", "", "median", "p90", "max"
     printf "%-34s %8.2fms %8.2fms %8.2fms\n", "latency publish -> stdout line (" field(lat, "records") ")",

@@ -57,7 +57,7 @@ class HadynetNet {
       // [x ; p] as one vector (zero-padded to the packed matrix's columns):
       // one exact dot product per row, requantised by the build's kernel.
       const auto& enc = t_->weights.enc;
-      alignas(8) Value xp[enc.kCols] = {};
+      alignas(8) Value xp[decltype(NetworkWeights<M>::enc)::kCols] = {};
       for (int i = 0; i < kX; ++i) xp[i] = x[i];
       for (int i = 0; i < kPb; ++i) xp[kX + i] = pb_[i];
       constexpr int kFrom = M::kFracEncW + M::kFracIn;
@@ -93,7 +93,8 @@ class HadynetNet {
       // most 15 bits), then one rounding to Q(kFracGate).
       static_assert(kAccFrac >= M::kFracGate, "gate sums have fewer fractional bits than the gates");
       const NetworkWeights<M>& kw = t_->weights;
-      alignas(8) Value up[kw.ih.kCols] = {};  // [u ; p]: one dot product per row of W_ih
+      // [u ; p]: one dot product per row of W_ih.
+      alignas(8) Value up[decltype(NetworkWeights<M>::ih)::kCols] = {};
       for (int i = 0; i < kU; ++i) up[i] = u[i];
       for (int i = 0; i < kPb; ++i) up[kU + i] = pb_[i];
       alignas(8) Value h_buffer[kHPadded];

@@ -10,6 +10,16 @@
 //             checked against the image (a run that does not write it is
 //             an error, exit 1). Wall time of the child process (start-up,
 //             enumeration and libusb included).
+//   model     a signed model image of the build's model (this build's
+//             `hadynet model-image`, development key) into the hand's slot
+//             not in use through its DFU model interface: `hadynet flash
+//             --model IMAGE` (send, read back + compare) and `dfu-util -i 4
+//             -a 0 -D IMAGE` (send), alternately, REPS times each, a fresh
+//             hand every run; the slot must then hold the image (sequence).
+//             The hand's flash is the F405's sector table with 1 % of its
+//             erase times and 1 us per programmed byte (hand_device.cc), so
+//             its bwPollTimeouts are small; the real F405's are summed
+//             from the same poll rule with the datasheet's times (report).
 //   telemetry `hadynet monitor` reading HID telemetry from the hand:
 //             latency = publish of record k (one record in flight) until
 //             its line ("period ... seq k ...") is read from the child's
@@ -19,6 +29,7 @@
 // Prints one `key=value` line per measurement (bench/usb_flash.sh makes
 // the table):
 //   flash tool=hadynet|dfu-util rep=R bytes=B seconds=S datasheet_poll_ms=P sectors=N
+//   model tool=hadynet|dfu-util rep=R bytes=B seconds=S
 //   latency records=N median_ms=.. p90_ms=.. max_ms=..
 //   throughput records=N seconds=S
 //
@@ -44,6 +55,7 @@
 #include "test/usb/test_bytes.h"
 #include "test/usb_host/child_process.h"
 #include "test/usb_host/hand_device.h"
+#include "test/usb_host/model_image_files.h"
 #include "test/usb_host/test_records.h"
 #include "test/usb_host/usb_testbed.h"
 
@@ -106,6 +118,39 @@ bool flash_once(hu::UsbTestbed& bus, std::uint8_t devnum, const Args& a, bool df
   std::printf("flash tool=%s rep=%d bytes=%zu seconds=%.4f datasheet_poll_ms=%llu sectors=%zu\n",
               dfu_util ? "dfu-util" : "hadynet", rep, image.size(), r.elapsed_s,
               static_cast<unsigned long long>(poll_ms), sectors);
+  std::fflush(stdout);
+  return true;
+}
+
+// One model update into a fresh hand at `devnum`; false (and `error`) if it failed.
+bool model_update_once(hu::UsbTestbed& bus, std::uint8_t devnum, bool dfu_util, const fs::path& image_path,
+                       std::size_t image_bytes, std::uint32_t sequence, int rep, std::string& error) {
+  auto hand = std::make_shared<hu::HandDevice>();
+  if (!bus.plug(devnum, hand)) {
+    error = "plug the hand: " + bus.error();
+    return false;
+  }
+  const std::vector<std::string> argv =
+      dfu_util ? std::vector<std::string>{DFU_UTIL_EXECUTABLE, "-d", "1209:0001", "-i", "4", "-a", "0", "-D",
+                                          image_path.string()}
+               : std::vector<std::string>{HADYNET_CLI_EXECUTABLE, "flash", "--model", image_path.string()};
+  const hu::ChildResult r = hu::run_child(bus, argv, 600s);
+  bus.unplug(devnum);
+  if (!r.started || r.timed_out || r.exit_code != 0) {
+    error = argv[0] + ": " + r.describe();
+    return false;
+  }
+  bool written = false;
+  bus.locked([&] {
+    for (const auto slot : {hadynet::model_update::SlotId::kA, hadynet::model_update::SlotId::kB})
+      written = written || hand->slot_status(slot).sequence == sequence;
+  });
+  if (!written) {
+    error = argv[0] + " exited 0 but no slot holds the image";
+    return false;
+  }
+  std::printf("model tool=%s rep=%d bytes=%zu seconds=%.4f\n", dfu_util ? "dfu-util" : "hadynet", rep, image_bytes,
+              r.elapsed_s);
   std::fflush(stdout);
   return true;
 }
@@ -217,6 +262,22 @@ int main(int argc, char** argv) {
       if (!flash_once(bus, devnum++, a, dfu_util, image_path, image, rep, error)) {
         rc = fail(error);
         break;
+      }
+    }
+  }
+  if (rc == 0) {
+    constexpr std::uint32_t kSequence = 2;
+    const fs::path model_image = hu::make_model_image(bus, dir, kSequence);
+    if (model_image.empty()) rc = fail("hadynet model-image failed");
+    const std::size_t model_bytes = rc == 0 ? fs::file_size(model_image) : 0;
+    std::uint8_t hand_devnum = kFirstRomDevnum + static_cast<std::uint8_t>(2 * a.reps);
+    for (int rep = 1; rep <= a.reps && rc == 0; ++rep) {
+      for (const bool dfu_util : {false, true}) {
+        std::string error;
+        if (!model_update_once(bus, hand_devnum++, dfu_util, model_image, model_bytes, kSequence, rep, error)) {
+          rc = fail(error);
+          break;
+        }
       }
     }
   }
