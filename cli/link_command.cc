@@ -66,6 +66,16 @@ int act(tools::ByteStream& stream, const std::vector<std::string>& action) {
   if (what == "pb" && action.size() == 2) {
     for (int k = 0; k < M::kStates; ++k) {
       if (action[1] == M::kStateNames[k]) {
+        // The row is looked up in this build's model: a device running
+        // another model (a model image from a slot) may order its PB table
+        // otherwise, so a state name is taken only for the same model.
+        if (session.info().model_hash != M::kModelHash) {
+          std::fprintf(stderr,
+                       "hadynet link: %s runs another model than this build's (a model image?): its PB table's "
+                       "rows may differ, so give the PB as %d comma-separated numbers\n",
+                       stream.name().c_str(), M::kPb);
+          return 1;
+        }
         session.set_pb_state(static_cast<std::uint16_t>(k));
         std::printf("%s: PB of state %s (row %d)\n", stream.name().c_str(), M::kStateNames[k], k);
         return 0;

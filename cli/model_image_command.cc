@@ -78,7 +78,7 @@ int run_model_image(int argc, char** argv) {
                 h.downgrade_allowed ? " (downgrade allowed)" : "", static_cast<unsigned long long>(h.shape_id),
                 h.payload_length, capacity);
     std::printf("  model %s (FNV-1a 64 %016llx), self-test checksum %08x\n", opt.positional().front().c_str(),
-                static_cast<unsigned long long>(h.model_hash), h.self_test_crc32);
+                static_cast<unsigned long long>(h.model_hash), h.self_test_checksum);
     std::printf("  signed by %s%s\n", host::hex(key.public_key).c_str(),
                 key.development ? " -- a DEVELOPMENT key: anyone can sign images a firmware with it accepts" : "");
     if (h.payload_length > capacity)

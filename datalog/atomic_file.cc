@@ -36,7 +36,8 @@ AtomicWriteError failure(const std::string& what, int error) {
 
 }  // namespace
 
-void write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
+void write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
+                           const AtomicWriteOptions& options) {
   if (!path.has_filename()) throw AtomicWriteError(path.string() + ": no file name");
   const std::filesystem::path folder = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
 
@@ -45,7 +46,7 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view b
   for (int attempt = 0; fd < 0; ++attempt) {
     temporary_path = folder / ("." + path.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
                                std::to_string(temporary_counter.fetch_add(1)));
-    fd = ::open(temporary_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    fd = ::open(temporary_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, static_cast<mode_t>(options.mode));
     const int error = errno;
     if (fd < 0 && (error != EEXIST || attempt >= 100)) throw failure("create temporary file " + temporary_path.string(), error);
   }
@@ -68,9 +69,16 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view b
     throw failure("fsync " + temporary_path.string(), error);
   }
   if (::close(fd) != 0) throw failure("close " + temporary_path.string(), errno);
-  if (::rename(temporary_path.c_str(), path.c_str()) != 0)
-    throw failure("rename " + temporary_path.string() + " to " + path.string(), errno);
-  temporary.release();
+  if (options.replace) {
+    if (::rename(temporary_path.c_str(), path.c_str()) != 0)
+      throw failure("rename " + temporary_path.string() + " to " + path.string(), errno);
+    temporary.release();
+  } else {
+    // link() never replaces: an existing PATH fails with EEXIST. The
+    // temporary name is removed by `temporary` either way.
+    if (::link(temporary_path.c_str(), path.c_str()) != 0)
+      throw failure("create " + path.string(), errno);
+  }
 
   const int folder_fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (folder_fd >= 0) {

@@ -20,8 +20,14 @@ class AtomicWriteError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Replaces PATH by `bytes`, atomically and durably. The folder must exist.
-// Throws AtomicWriteError.
-void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
+struct AtomicWriteOptions {
+  unsigned mode = 0666;  // permissions the file is created with (less the umask), before any byte is written
+  bool replace = true;   // false: an existing PATH is an error (EEXIST) and stays as it is
+};
+
+// Replaces PATH by `bytes` (or, with replace false, creates it), atomically
+// and durably. The folder must exist. Throws AtomicWriteError.
+void write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
+                           const AtomicWriteOptions& options = {});
 
 }  // namespace hadynet::datalog

@@ -65,7 +65,7 @@ class RuntimeSelfTest final : public model_update::SelfTest {
     last_checksum_ = runtime_checksum(runtime_);
     runtime_.use_model(firmware::kCompiledTensors<M>);
     runtime_.set_mode(mode);
-    return static_cast<std::uint32_t>(last_checksum_) == header.self_test_crc32;
+    return static_cast<std::uint32_t>(last_checksum_) == header.self_test_checksum;
   }
   std::uint64_t last_checksum() const noexcept { return last_checksum_; }
 

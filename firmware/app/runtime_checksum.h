@@ -46,11 +46,13 @@ void add_result(Fnv1a64& h, const firmware::StepResult<M>& r) noexcept {
 }
 
 // Runs a freshly constructed runtime through the fixed sequence (detect
-// mode, then control mode with the default settings) and returns the
-// checksum of all results.
+// mode, then control mode with the default settings; frames around the
+// standardisation of the model it runs) and returns the checksum of all
+// results: a function of the runtime's model alone, so a model image's
+// self-test checksum is reproduced by any firmware of its shape.
 template <firmware::GeneratedModel M>
 std::uint64_t runtime_checksum(firmware::HadynetRuntime<M>& runtime) noexcept {
-  SyntheticFrames<M> frames(kChecksumSeed);
+  SyntheticFrames<M> frames(kChecksumSeed, runtime.tensors());
   Fnv1a64 h;
   firmware::SensorFrame<M> frame;
   runtime.set_mode(firmware::Mode::kDetect);

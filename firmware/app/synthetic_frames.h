@@ -10,17 +10,24 @@
 #include <cstdint>
 
 #include "firmware/core/hadynet_runtime.h"
+#include "firmware/core/model_tensors.h"
 
 namespace hadynet::app {
 
 template <firmware::GeneratedModel M>
 class SyntheticFrames {
  public:
-  explicit SyntheticFrames(std::uint32_t seed) noexcept : state_(seed != 0 ? seed : 1) {}
+  // Frames around the standardisation of `tensors` (the model the frames
+  // are for: a model image's self-test must not depend on which model the
+  // firmware has compiled in), which must outlive this object.
+  explicit SyntheticFrames(std::uint32_t seed,
+                           const firmware::ModelTensors<M>& tensors = firmware::kCompiledTensors<M>) noexcept
+      : t_model_(&tensors), state_(seed != 0 ? seed : 1) {}
 
   void next(firmware::SensorFrame<M>& frame) noexcept {
-    for (int i = 0; i < M::kY; ++i) frame.y[i] = M::kYMean[i] + M::kYStd[i] * standard_value(i);
-    for (int i = 0; i < M::kU; ++i) frame.u_prev[i] = M::kUMean[i] + M::kUStd[i] * standard_value(i + M::kY);
+    const firmware::ModelTensors<M>& m = *t_model_;
+    for (int i = 0; i < M::kY; ++i) frame.y[i] = m.y_mean[i] + m.y_std[i] * standard_value(i);
+    for (int i = 0; i < M::kU; ++i) frame.u_prev[i] = m.u_mean[i] + m.u_std[i] * standard_value(i + M::kY);
     ++t_;
   }
 
@@ -39,6 +46,7 @@ class SyntheticFrames {
     state_ ^= state_ << 5;
     return state_;
   }
+  const firmware::ModelTensors<M>* t_model_;
   std::uint32_t state_;
   int t_ = 0;
 };

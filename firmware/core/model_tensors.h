@@ -101,7 +101,7 @@ struct ModelTensors {
 
 // The row-major arrays build_tensors reads, under the generated header's
 // names: M itself (its static members) or a host object with the same
-// members (the image writer's RowMajorModel, codegen/model_image.h).
+// members (the image writer's RowMajorModel, host-sim/model_image/row_major_model.h).
 // Counts and shapes are M's.
 template <GeneratedModel M, class Source>
 constexpr void build_tensors(const Source& s, ModelTensors<M>& t) noexcept {

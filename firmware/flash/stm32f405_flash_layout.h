@@ -7,7 +7,7 @@
 // rule, updates; the layout inside a slot is firmware/model_update/
 // slot_layout.h): sectors 8..9 and 10..11, 256 KiB each, two 128 KiB
 // sectors per slot; the firmware image keeps sectors 0..7 (512 KiB; today's
-// image is ~350 KB).
+// image is about 253 KB with the compiled-in model, docs/model-update.md).
 #ifndef HADYNET_FIRMWARE_FLASH_STM32F405_FLASH_LAYOUT_H_
 #define HADYNET_FIRMWARE_FLASH_STM32F405_FLASH_LAYOUT_H_
 

@@ -47,7 +47,7 @@ void encode_model_image_header(const ModelImageHeader& h, std::span<std::uint8_t
   put_le32(p + off::kSequence, h.sequence);
   put_le64(p + off::kShapeId, h.shape_id);
   put_le32(p + off::kPayloadLength, h.payload_length);
-  put_le32(p + off::kSelfTestCrc32, h.self_test_crc32);
+  put_le32(p + off::kSelfTestChecksum, h.self_test_checksum);
   for (std::size_t i = 0; i < kDimCount; ++i) put_le16(p + off::kDims + 2 * i, h.dims[i]);
   std::copy(h.frac_bits.begin(), h.frac_bits.end(), p + off::kFracBits);
   put_le64(p + off::kModelHash, h.model_hash);
@@ -75,7 +75,7 @@ HeaderFormat decode_model_image_header(std::span<const std::uint8_t, kImageHeade
   h.sequence = get_le32(p + off::kSequence);
   h.shape_id = get_le64(p + off::kShapeId);
   h.payload_length = get_le32(p + off::kPayloadLength);
-  h.self_test_crc32 = get_le32(p + off::kSelfTestCrc32);
+  h.self_test_checksum = get_le32(p + off::kSelfTestChecksum);
   for (std::size_t i = 0; i < kDimCount; ++i) h.dims[i] = get_le16(p + off::kDims + 2 * i);
   std::copy_n(p + off::kFracBits, kFracBitsUsed, h.frac_bits.begin());
   h.model_hash = get_le64(p + off::kModelHash);

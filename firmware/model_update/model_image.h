@@ -11,7 +11,7 @@
 //   12  u32     sequence number, >= 1, monotonic per signer
 //   16  u64     shape id (a hash of the model's compile-time shape)
 //   24  u32     payload length, bytes
-//   28  u32     self-test CRC-32 (the self-test's expected output; handed to the SelfTest)
+//   28  u32     self-test checksum (the self-test's expected output; handed to the SelfTest)
 //   32  u16[8]  dims: x, u, y, pb, hidden, states, train_steps, detect_steps (information)
 //   48  u8[16]  frac bits: 12 used, the last 4 zero (information)
 //   64  u64     model hash, FNV-1a 64 of the model file (information)
@@ -60,7 +60,7 @@ inline constexpr std::size_t kFlags = 11;
 inline constexpr std::size_t kSequence = 12;
 inline constexpr std::size_t kShapeId = 16;
 inline constexpr std::size_t kPayloadLength = 24;
-inline constexpr std::size_t kSelfTestCrc32 = 28;
+inline constexpr std::size_t kSelfTestChecksum = 28;
 inline constexpr std::size_t kDims = 32;
 inline constexpr std::size_t kFracBits = 48;      // 16 bytes, the last 4 must be zero
 inline constexpr std::size_t kModelHash = 64;
@@ -91,7 +91,7 @@ struct ModelImageHeader {
   std::uint32_t sequence = 0;      // >= 1
   std::uint64_t shape_id = 0;
   std::uint32_t payload_length = 0;  // bytes
-  std::uint32_t self_test_crc32 = 0;
+  std::uint32_t self_test_checksum = 0;
   std::array<std::uint16_t, kDimCount> dims{};
   std::array<std::uint8_t, kFracBitsUsed> frac_bits{};
   std::uint64_t model_hash = 0;

@@ -1,7 +1,7 @@
 // The application's self-test of a model image on trial (implemented by the
-// app: run the model on its compiled-in test input and compare the
-// output's CRC-32 with header.self_test_crc32, or whatever the app deems
-// right). Called once per trial by ModelSlots::boot(), after the slot was
+// app, firmware/app/model_store.h: run the model through a fixed synthetic
+// sequence and compare the low 32 bits of its results' checksum with
+// header.self_test_checksum). Called once per trial by ModelSlots::boot(), after the slot was
 // marked "tried" and before it is used; `payload` is the verified payload
 // in the mapped flash view. true = pass (the image is confirmed), false =
 // fail (the image is marked invalid and the boot chooses again). A crash or

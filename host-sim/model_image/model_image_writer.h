@@ -114,7 +114,7 @@ ModelImage make_model_image(const codegen::GeneratedHeader& header, const Signin
   h.sequence = request.sequence;
   h.shape_id = M::kShapeId;
   h.payload_length = static_cast<std::uint32_t>(n);
-  h.self_test_crc32 = static_cast<std::uint32_t>(image.self_test_checksum);
+  h.self_test_checksum = static_cast<std::uint32_t>(image.self_test_checksum);
   h.dims = {static_cast<std::uint16_t>(M::kX),       static_cast<std::uint16_t>(M::kU),
             static_cast<std::uint16_t>(M::kY),       static_cast<std::uint16_t>(M::kPb),
             static_cast<std::uint16_t>(M::kHidden),  static_cast<std::uint16_t>(M::kStates),

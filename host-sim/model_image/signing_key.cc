@@ -1,7 +1,6 @@
 #include "host-sim/model_image/signing_key.h"
 
 #include <sodium.h>
-#include <sys/stat.h>
 
 #include <cstring>
 #include <fstream>
@@ -84,9 +83,15 @@ SigningKey generate_signing_key(bool development) {
 }
 
 void write_signing_key(const std::filesystem::path& path, const SigningKey& key) {
-  if (std::filesystem::exists(path)) throw KeyFileError(path.string() + ": exists; not overwriting a key");
-  datalog::write_file_atomically(path, comments(key, true) + "secret " + hex(key.secret) + "\n");
-  ::chmod(path.c_str(), 0600);
+  // The secret key is created mode 0600 before its bytes are written, and
+  // never replaces an existing file.
+  try {
+    datalog::write_file_atomically(path, comments(key, true) + "secret " + hex(key.secret) + "\n",
+                                   {.mode = 0600, .replace = false});
+  } catch (const datalog::AtomicWriteError& e) {
+    if (std::filesystem::exists(path)) throw KeyFileError(path.string() + ": exists; not overwriting a key");
+    throw KeyFileError(e.what());
+  }
   std::filesystem::path pub = path;
   pub += ".pub";
   datalog::write_file_atomically(pub, comments(key, false) + "public " + hex(key.public_key) + "\n");

@@ -132,7 +132,7 @@ TEST(ModelImage, HeaderIsSignedOverWhatTheDeviceChecks) {
   EXPECT_EQ(decoded.sequence, 7u);
   EXPECT_EQ(decoded.shape_id, Q::kShapeId);
   EXPECT_EQ(decoded.payload_length, sizeof(ModelTensors<Q>));
-  EXPECT_EQ(decoded.self_test_crc32, static_cast<std::uint32_t>(image.self_test_checksum));
+  EXPECT_EQ(decoded.self_test_checksum, static_cast<std::uint32_t>(image.self_test_checksum));
   EXPECT_EQ(decoded.public_key, key.public_key);
   const std::span<const std::uint8_t> payload(image.bytes.data() + mu::kImageHeaderSize, decoded.payload_length);
   EXPECT_EQ(decoded.payload_sha256, hadynet::host::sha256(payload));
@@ -143,6 +143,25 @@ TEST(ModelImage, HeaderIsSignedOverWhatTheDeviceChecks) {
   tampered[12] ^= 1;  // the sequence number
   EXPECT_NE(0, crypto_sign_verify_detached(decoded.signature.data(), tampered.data(), mu::kSignedBytes,
                                            key.public_key.data()));
+}
+
+}  // namespace
+
+namespace {
+
+// The self-test's frames follow the standardisation of the model under test,
+// not the compiled-in one's: an image's checksum must be reproduced by any
+// firmware of its shape, whichever model that firmware has compiled in.
+// (With the compiled-in standardisation, frames would stay near it, |y| < 500.)
+TEST(ModelImage, SelfTestFramesFollowTheImagesStandardisation) {
+  auto shifted = std::make_unique<ModelTensors<Q>>(hadynet::firmware::kCompiledTensors<Q>);
+  for (float& m : shifted->y_mean) m += 1000.0f;
+  hadynet::app::SyntheticFrames<Q> frames(hadynet::app::kChecksumSeed, *shifted);
+  hadynet::firmware::SensorFrame<Q> frame;
+  for (int k = 0; k < 5; ++k) {
+    frames.next(frame);
+    for (int i = 0; i < Q::kY; ++i) EXPECT_GT(frame.y[i], 500.0f) << "frame " << k << " channel " << i;
+  }
 }
 
 }  // namespace

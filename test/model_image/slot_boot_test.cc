@@ -106,7 +106,7 @@ TEST(SlotBoot, ImageWhoseSelfTestFailsIsRevertedToTheFactoryModel) {
   auto image = hadynet::host::make_model_image<Q>(header_of(built_in().model), key, {1, false});
   // A validly signed header whose self-test checksum the model does not
   // reproduce (as if the host's and the device's runtimes disagreed).
-  image.header.self_test_crc32 ^= 1;
+  image.header.self_test_checksum ^= 1;
   std::array<std::uint8_t, mu::kImageHeaderSize> h{};
   mu::encode_model_image_header(image.header, h);
   image.header.signature = hadynet::host::sign(key, std::span<const std::uint8_t>(h.data(), mu::kSignedBytes));

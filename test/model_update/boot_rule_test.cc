@@ -58,7 +58,7 @@ TEST(BootRule, NewImageIsMarkedTriedBeforeItsSelfTestThenConfirmed) {
   EXPECT_EQ(flag_word(d, a, TrialFlag::kInvalid), kErasedWord);
   EXPECT_EQ(test.calls, 1);
   EXPECT_EQ(test.last_payload, as_bytes(payload_of(image)));
-  EXPECT_EQ(test.last_self_test_crc32, 0xC0FFEE00u + 1);
+  EXPECT_EQ(test.last_self_test_checksum, 0xC0FFEE00u + 1);
   EXPECT_EQ(c.source, ModelSource::kSlotA);
   EXPECT_EQ(c.sequence, 1u);
   EXPECT_TRUE(c.trial_this_boot);

@@ -38,7 +38,7 @@ ModelImageHeader header_for(const ModelIdentity& identity, std::uint32_t sequenc
   h.sequence = sequence;
   h.shape_id = identity.shape_id;
   h.payload_length = identity.payload_length;
-  h.self_test_crc32 = 0xC0FFEE00u + sequence;
+  h.self_test_checksum = 0xC0FFEE00u + sequence;
   h.dims = {18, 7, 18, 2, 64, 9, 60, 10};
   for (std::size_t i = 0; i < h.frac_bits.size(); ++i) h.frac_bits[i] = static_cast<std::uint8_t>(8 + i);
   h.model_hash = 0xCBF29CE484222325ull ^ sequence;

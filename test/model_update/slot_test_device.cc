@@ -48,7 +48,7 @@ const SigningKey& other_key() {
 bool ScriptedSelfTest::run(std::span<const std::uint8_t> payload, const ModelImageHeader& header) noexcept {
   ++calls;
   last_payload.assign(payload.begin(), payload.end());
-  last_self_test_crc32 = header.self_test_crc32;
+  last_self_test_checksum = header.self_test_checksum;
   if (during_run) during_run();
   return pass;
 }

@@ -44,7 +44,7 @@ class ScriptedSelfTest final : public SelfTest {
   bool pass;
   int calls = 0;
   Bytes last_payload;
-  std::uint32_t last_self_test_crc32 = 0;
+  std::uint32_t last_self_test_checksum = 0;
   std::function<void()> during_run;  // called inside run(), before the verdict
 };
 

@@ -152,7 +152,7 @@ Bytes compiled_model_image(std::uint32_t sequence) {
   mu::ModelImageHeader h = mu::test::header_for(app::model_identity<Q>(), sequence);
   h.model_hash = kSlotModelHash;
   auto reference = std::make_unique<firmware::HadynetRuntime<Q>>();
-  h.self_test_crc32 = static_cast<std::uint32_t>(app::runtime_checksum(*reference));
+  h.self_test_checksum = static_cast<std::uint32_t>(app::runtime_checksum(*reference));
   const auto* bytes = reinterpret_cast<const std::uint8_t*>(&firmware::kCompiledTensors<Q>);
   return mu::test::sign_image(h, std::span(bytes, sizeof(firmware::ModelTensors<Q>)), device_key());
 }
