@@ -108,6 +108,10 @@ class ModelSlots {
   void abort_update() noexcept;
 
   bool update_in_progress() const noexcept { return stream_.active(); }
+  // The slot the next begin_update() would write (the rule above): never the
+  // slot in use; with the factory model in use, the slot holding no usable
+  // image, else the one with the lower sequence (tie: A).
+  SlotId next_update_target() const noexcept;
   // The slot the current (or last accepted) update writes.
   SlotId update_target() const noexcept { return target_; }
   // Payload bytes accepted by the current (or last) update.
@@ -126,7 +130,6 @@ class ModelSlots {
   bool pick_winner(const std::array<bool, kSlotCount>& excluded, SlotId& winner) const noexcept;
   void invalidate(SlotId slot, UpdateError why) noexcept;
   void choose(SlotId slot, bool trial_this_boot) noexcept;
-  SlotId choose_update_target() const noexcept;
   std::uint32_t highest_usable_sequence() const noexcept;
   UpdateError record(UpdateError e) noexcept;
   UpdateError end_failed_update(UpdateError e) noexcept;

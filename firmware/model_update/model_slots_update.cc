@@ -12,7 +12,7 @@ UpdateError ModelSlots::record(UpdateError e) noexcept {
   return e;
 }
 
-SlotId ModelSlots::choose_update_target() const noexcept {
+SlotId ModelSlots::next_update_target() const noexcept {
   if (choice_.source == ModelSource::kSlotA) return SlotId::kB;
   if (choice_.source == ModelSource::kSlotB) return SlotId::kA;
   // The factory model runs: overwrite what is least worth keeping.
@@ -46,7 +46,7 @@ UpdateError ModelSlots::begin_update(std::span<const std::uint8_t> header) noexc
   const bool downgrade = decoded.sequence <= highest_usable_sequence();
   if (downgrade && !decoded.downgrade_allowed) return record(UpdateError::kNotNewer);
 
-  target_ = choose_update_target();
+  target_ = next_update_target();
   forced_downgrade_ = downgrade;
   flash_.reset_counters();
   update_counters_ = {};

@@ -21,21 +21,6 @@ bool is_class_request_to(const SetupPacket& s, std::uint8_t interface) noexcept 
 
 const char* slot_name(mu::SlotId s) noexcept { return s == mu::SlotId::kA ? "slot A" : "slot B"; }
 
-// The slot the next update would write. Mirrors ModelSlots' target rule
-// (model_slots.h, "THE UPDATE"; not public there): never the slot in use;
-// with the factory model in use, the slot holding no usable image, else the
-// one with the lower sequence (tie: A).
-mu::SlotId next_update_slot(const mu::ModelSlots& slots) noexcept {
-  const mu::ModelSource running = slots.choice().source;
-  if (running == mu::ModelSource::kSlotA) return mu::SlotId::kB;
-  if (running == mu::ModelSource::kSlotB) return mu::SlotId::kA;
-  const auto rank = [&slots](mu::SlotId s) {
-    const mu::SlotStatus& st = slots.slot_status(s);
-    return mu::holds_usable_image(st.state) ? st.sequence : 0u;
-  };
-  return rank(mu::SlotId::kB) < rank(mu::SlotId::kA) ? mu::SlotId::kB : mu::SlotId::kA;
-}
-
 }  // namespace
 
 DfuMode::DfuMode(const ModelSlotsAccess& model, std::uint8_t interface, std::uint8_t status_string) noexcept
@@ -185,10 +170,8 @@ std::uint32_t DfuMode::block_work_ms() const noexcept {
       ms += payload_append_ms(*flash_, slots_->slot_region(slots_->update_target()), slots_->update_received(),
                               payload_part);
     } else {
-      // begin_update() in the same service() picks the target: the worse slot.
-      const std::uint32_t a = payload_append_ms(*flash_, slots_->slot_region(mu::SlotId::kA), 0, payload_part);
-      const std::uint32_t b = payload_append_ms(*flash_, slots_->slot_region(mu::SlotId::kB), 0, payload_part);
-      ms += a > b ? a : b;
+      // begin_update() in the same service() picks the target by this rule.
+      ms += payload_append_ms(*flash_, slots_->slot_region(slots_->next_update_target()), 0, payload_part);
     }
   }
   return ms > kMaxPollMs ? kMaxPollMs : static_cast<std::uint32_t>(ms);
@@ -238,7 +221,7 @@ bool DfuMode::upload_slot(flash::FlashRegion& region) const noexcept {
   if (slots_->layout_error() != mu::UpdateError::kOk) return false;
   mu::SlotId slot = mu::SlotId::kA;
   if (alternate_ == kDfuAltModelUpdate) {
-    slot = wrote_a_slot_ ? written_slot_ : next_update_slot(*slots_);
+    slot = wrote_a_slot_ ? written_slot_ : slots_->next_update_target();
   } else {
     const mu::ModelSource running = slots_->choice().source;
     if (running == mu::ModelSource::kFactory) return false;  // no slot in use
