@@ -2,9 +2,16 @@
 
 #include <algorithm>
 
-#include "firmware/model_update/little_endian.h"
+#include "firmware/core/little_endian.h"
 
 namespace hadynet::model_update {
+
+using firmware::get_le16;
+using firmware::get_le32;
+using firmware::get_le64;
+using firmware::put_le16;
+using firmware::put_le32;
+using firmware::put_le64;
 
 namespace {
 

@@ -2,9 +2,12 @@
 
 #include <array>
 
-#include "firmware/model_update/little_endian.h"
+#include "firmware/core/little_endian.h"
 
 namespace hadynet::model_update {
+
+using firmware::get_le32;
+using firmware::put_le32;
 
 namespace {
 

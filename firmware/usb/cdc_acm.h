@@ -86,7 +86,7 @@ class CdcAcm final : public UsbFunction {
         return ControlReply::data_out();
       case cdc::kGetLineCoding:
         if (!s.is_in() || s.value != 0 || s.length != cdc::kLineCodingSize) break;
-        put_u32(buffer.data(), line_coding_.baud);
+        put_le32(buffer.data(), line_coding_.baud);
         buffer[4] = line_coding_.stop_bits;
         buffer[5] = line_coding_.parity;
         buffer[6] = line_coding_.data_bits;
@@ -110,7 +110,7 @@ class CdcAcm final : public UsbFunction {
   bool control_out(const SetupPacket& s, std::span<const std::uint8_t> data) noexcept override {
     if (s.request != cdc::kSetLineCoding || data.size() != cdc::kLineCodingSize) return false;
     LineCoding c;
-    c.baud = get_u32(data.data());
+    c.baud = get_le32(data.data());
     c.stop_bits = data[4];
     c.parity = data[5];
     c.data_bits = data[6];

@@ -1,6 +1,6 @@
 #include "firmware/usb/dfu_mode.h"
 
-#include "firmware/model_update/little_endian.h"
+#include "firmware/core/little_endian.h"
 #include "firmware/model_update/slot_status.h"
 #include "firmware/usb/dfu_update_timing.h"
 #include "firmware/usb/slot_image_file.h"
@@ -345,7 +345,7 @@ void DfuMode::manifest() noexcept {
 
 std::uint32_t DfuMode::header_sequence() const noexcept {
   if (header_received_ < mu::kImageHeaderSize) return 0;
-  return mu::get_le32(header_ + mu::header_offset::kSequence);
+  return get_le32(header_ + mu::header_offset::kSequence);
 }
 
 bool DfuMode::configure(DeviceController&) noexcept {

@@ -50,7 +50,7 @@ class TelemetryDecoder {
       return Event::kBadReport;
     }
     const std::size_t part = report[1];
-    const std::uint32_t sequence = get_u32(report.data() + 4);
+    const std::uint32_t sequence = get_le32(report.data() + 4);
     if (part == 0) {
       if (in_set_) ++stats_.incomplete_sets;
       in_set_ = true;

@@ -71,7 +71,7 @@ constexpr void encode_telemetry_reports(const app::PeriodRecord<M>& r,
     rep[1] = static_cast<std::uint8_t>(part);
     rep[2] = static_cast<std::uint8_t>(L::kParts);
     rep[3] = static_cast<std::uint8_t>(n);
-    put_u32(rep + 4, r.sequence);
+    put_le32(rep + 4, r.sequence);
     for (std::size_t i = 0; i < kTelemetryPartPayload; ++i) {
       rep[kTelemetryHeaderSize + i] = i < n ? payload[begin + i] : 0;
     }

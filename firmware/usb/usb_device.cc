@@ -357,7 +357,7 @@ std::size_t UsbDevice::string_descriptor(std::uint8_t index) noexcept {
   if (index == 0) {
     buffer_[0] = 4;
     buffer_[1] = descriptor::kString;
-    put_u16(buffer_ + 2, kLangIdEnglishUs);
+    put_le16(buffer_ + 2, kLangIdEnglishUs);
     return 4;
   }
   if (index >= descriptors_.strings.size() || descriptors_.strings[index] == nullptr) return 0;

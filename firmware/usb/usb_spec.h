@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <span>
 
+#include "firmware/core/little_endian.h"
+
 namespace hadynet::usb {
 
 // Endpoint address: bit 7 the direction (1 = IN, device to host), bits 0..3
@@ -115,20 +117,10 @@ constexpr std::uint8_t request_type(bool in, RequestKind kind, Recipient recipie
 }
 
 // Little-endian stores and loads into byte buffers (caller checks bounds).
-constexpr void put_u16(std::uint8_t* p, std::uint16_t v) noexcept {
-  p[0] = static_cast<std::uint8_t>(v);
-  p[1] = static_cast<std::uint8_t>(v >> 8);
-}
-constexpr void put_u32(std::uint8_t* p, std::uint32_t v) noexcept {
-  for (int k = 0; k < 4; ++k) p[k] = static_cast<std::uint8_t>(v >> (8 * k));
-}
-constexpr std::uint16_t get_u16(const std::uint8_t* p) noexcept {
-  return static_cast<std::uint16_t>(p[0] | (p[1] << 8));
-}
-constexpr std::uint32_t get_u32(const std::uint8_t* p) noexcept {
-  return static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
-         (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
-}
+using firmware::get_le16;
+using firmware::get_le32;
+using firmware::put_le16;
+using firmware::put_le32;
 
 }  // namespace hadynet::usb
 

@@ -186,7 +186,7 @@ dfu::Status DfuseRomInterface::run_command() noexcept {
   if (block_size_ != 5 || (command != kCmdSetAddress && command != kCmdErase)) {
     return dfu::Status::kErrUnknown;  // 0x92 (not modelled), other commands, wrong lengths
   }
-  const std::uint32_t address = get_u32(block_.data() + 1);
+  const std::uint32_t address = get_le32(block_.data() + 1);
   const std::optional<std::size_t> sector = RomFlashModel::sector_at(address);
   if (command == kCmdSetAddress) {
     if (alternate_ != 0 || !sector) return dfu::Status::kErrTarget;

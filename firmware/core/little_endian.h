@@ -1,12 +1,13 @@
-// Little-endian stores and loads of unsigned integers into byte buffers, for
-// the model image header (model_image.h). The caller checks bounds.
-#ifndef HADYNET_FIRMWARE_MODEL_UPDATE_LITTLE_ENDIAN_H_
-#define HADYNET_FIRMWARE_MODEL_UPDATE_LITTLE_ENDIAN_H_
+// Little-endian stores and loads of unsigned integers into byte buffers: the
+// wire formats the firmware reads and writes by hand (USB descriptors and
+// requests, the model image header and trial flags). The caller checks bounds.
+#ifndef HADYNET_FIRMWARE_CORE_LITTLE_ENDIAN_H_
+#define HADYNET_FIRMWARE_CORE_LITTLE_ENDIAN_H_
 
 #include <cstddef>
 #include <cstdint>
 
-namespace hadynet::model_update {
+namespace hadynet::firmware {
 
 // Stores the low `bytes` bytes of `value` at p[0..bytes), least significant first.
 constexpr void store_le(std::uint8_t* p, std::uint64_t value, std::size_t bytes) noexcept {
@@ -27,6 +28,6 @@ constexpr std::uint16_t get_le16(const std::uint8_t* p) noexcept { return static
 constexpr std::uint32_t get_le32(const std::uint8_t* p) noexcept { return static_cast<std::uint32_t>(load_le(p, 4)); }
 constexpr std::uint64_t get_le64(const std::uint8_t* p) noexcept { return load_le(p, 8); }
 
-}  // namespace hadynet::model_update
+}  // namespace hadynet::firmware
 
-#endif  // HADYNET_FIRMWARE_MODEL_UPDATE_LITTLE_ENDIAN_H_
+#endif  // HADYNET_FIRMWARE_CORE_LITTLE_ENDIAN_H_
