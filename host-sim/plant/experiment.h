@@ -22,7 +22,7 @@ struct ExperimentSpec {
   int init_id = 0;          // initialisation (encoder zeroing) id
   double wear_level = 0.0;  // 0 new .. 1 worn
   int steps = 500;          // rows in the log (0.2 s each)
-  std::uint64_t seed = 1;   // dataset seed; everything else derives from it
+  std::uint64_t seed = 1;   // dataset seed: motions and sensor noise (not the zeroing: see state_id)
   Effects effects;          // switchable effects (default: none)
   bool declare_effects = false;  // write the effects into the log metadata
   bool sensor_realism = true;
@@ -30,10 +30,12 @@ struct ExperimentSpec {
 };
 
 // "Cylinder/i2/w0": the dynamics-state id (object x initialisation x wear).
+// It names one dynamics state: the encoder zeroing follows from the object and
+// the init id alone, so the same id means the same state under any dataset seed.
 std::string state_id(const ExperimentSpec& spec);
 // "Cylinder_random1_i2_w0.csv"
 std::string log_file_name(const ExperimentSpec& spec);
-// The full plant description for a spec (offsets and wear derived from seeds).
+// The full plant description for a spec (offsets from the object and init id, wear from its level).
 HandSpec hand_spec_for(const ExperimentSpec& spec);
 
 struct ExperimentResult {

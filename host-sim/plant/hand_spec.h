@@ -1,6 +1,7 @@
 // Parameters of one simulated dynamics state of the flexible hand:
 // grasped object x initialisation (encoder zero offsets) x wear.
-// Everything here is reproducible from (object, init id, wear level, seed).
+// Everything here is reproducible from (object, init id, wear level); the
+// dataset seed only draws motions and sensor noise (experiment.h).
 #pragma once
 
 #include <array>

@@ -81,7 +81,7 @@ TEST(GraspSession, SameSeedGivesIdenticalY) {
   };
   const auto a = run(11), b = run(11), c = run(12);
   EXPECT_EQ(a, b);
-  EXPECT_NE(a, c);  // another seed: other offsets, grasp and noise
+  EXPECT_NE(a, c);  // another seed: other grasp and noise (the zeroing is the state's)
 }
 
 TEST(GraspSession, CommandsAreRoundedToTheCommandResolution) {
