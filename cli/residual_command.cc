@@ -12,6 +12,7 @@
 
 #include "cli/commands.h"
 #include "cli/error_text.h"
+#include "cli/number_text.h"
 #include "cli/options.h"
 #include "cli/residual_fix_report.h"
 #include "cli/residual_report.h"
@@ -102,7 +103,11 @@ int run_residual(int argc, char** argv) {
               "effect'. Works on any (u, y) logs the model's channels fit.",
               "MODEL LOG|DIR... [options]");
   opt.value("pb", "PB",
-            "auto (the state's PB if the model knows it, else adapted), state, adapt, zero, a state, or values", "auto");
+            "auto (the state's trained PB if the model knows it and it predicts the state's held-out rows\n"
+            "at most " + num("%g", rs::kStoredPbMargin) +
+                " times worse than one adapted to its other rows, else adapted), state, adapt, zero,\n"
+                "a state, or values",
+            "auto");
   opt.value("horizon", "N", "multi-step horizon (default: the model's N_train)");
   opt.value("max-lag", "L", "correlation lags 1..L (whiteness) and -L..L (independence)",
             std::to_string(rs::kDefaultMaxLag));
@@ -120,7 +125,11 @@ int run_residual(int argc, char** argv) {
                   "on the first --train-fraction of each log and report before/after on the rest; the effect is\n"
                   "confirmed (and the model kept) only when it beats fine-tuning alone on the held-out rows of\n"
                   "the channels it changes (one-sided Diebold-Mariano test at --alpha), else 'unexplained structure'");
-  opt.value("out", "FILE", "with --fix: write the augmented model (only when something was fixed)");
+  opt.value("rounds", "N",
+            "with --fix: repeat analysis and fix on the fixed model until nothing is confirmed, at most N rounds\n"
+            "(so that two effects at once are both found); round k > 1 reports into DIR/round-k", "1");
+  opt.value("out", "FILE", "with --fix: write the augmented model of the last confirmed round (only when\n"
+                           "something was fixed)");
   opt.value("fix-epochs", "N", "with --fix: fine-tuning epochs", "20");
   opt.value("fix-lr", "X", "with --fix: Adam learning rate", "0.001");
   opt.value("fix-seed", "N", "with --fix: seed of the window order", "1");
@@ -147,7 +156,12 @@ int run_residual(int argc, char** argv) {
   const auto fix_epochs = opt.get_int("fix-epochs", 1, 100000);
   const auto fix_lr = opt.get_double("fix-lr", 1e-12, 10.0);
   const auto fix_seed = opt.get_int("fix-seed", 0, (1ll << 62));
-  if (!fix_epochs || !fix_lr || !fix_seed) return 2;
+  const auto rounds = opt.get_int("rounds", 1, 20);
+  if (!fix_epochs || !fix_lr || !fix_seed || !rounds) return 2;
+  if (opt.has("rounds") && !opt.has("fix")) {
+    std::fprintf(stderr, "hadynet residual: --rounds needs --fix\n");
+    return 2;
+  }
   if (opt.has("out") && !opt.has("fix")) {
     std::fprintf(stderr, "hadynet residual: --out needs --fix\n");
     return 2;
@@ -171,46 +185,78 @@ int run_residual(int argc, char** argv) {
     ao.attribution.min_explained = *min_share;
     ao.attribution.min_explained_std = *min_std;
     const std::string& pb_choice = ao.pb_choice;
-    const rs::Analysis a = rs::analyse(model, inputs, ao);
-    const auto& d = a.data;
-    print_summary(a, pb_choice, opt.has("fix"));
-
-    json j = analysis_json(a, model_path, pb_choice);
     rs::FixOptions fo;
     fo.train_fraction = *fraction;
     fo.epochs = static_cast<int>(*fix_epochs);
     fo.lr = *fix_lr;
     fo.seed = static_cast<std::uint64_t>(*fix_seed);
     fo.control = !opt.has("no-control");
-    std::optional<rs::FixResult> fixed;
-    std::string written;
-    if (opt.has("fix")) {
-      fixed = rs::fix(model, inputs, d, a.attribution, fo);
-      print_fix(*fixed);
-      if (fixed->changed && opt.has("out")) {
-        written = opt.get("out");
-        trainer::save_model(written, fixed->model);
-        std::fprintf(stderr, "wrote %s\n", written.c_str());
-      } else if (opt.has("out")) {
-        std::fprintf(stderr, "nothing fixed: %s not written\n", opt.get("out").c_str());
-      }
-      j["fix"] = fix_json(*fixed, fo);
-      if (!written.empty()) j["fix"]["model"] = written;
-    }
-    auto write_json = [&](const std::string& path) {
+
+    // One round: analyse `current`, fix when asked; returns the fix (if any).
+    // Round 1 reports into --report DIR and --json FILE; round k > 1 into
+    // DIR/round-k (and the JSON's "rounds").
+    json rounds_json = json::array();
+    auto write_json = [](const json& j, const std::string& path) {
       std::ofstream out(path);
       if (!out) throw std::runtime_error(path + ": cannot write");
       out << j.dump(1) << '\n';
       if (!out) throw std::runtime_error(path + ": write failed");
       std::fprintf(stderr, "wrote %s\n", path.c_str());
     };
-    if (opt.has("json")) write_json(opt.get("json"));
-    if (opt.has("report")) {
-      const std::filesystem::path dir = opt.get("report");
-      std::filesystem::create_directories(dir);
-      write_json((dir / "residual.json").string());
-      write_report(dir, a, model_path, pb_choice, fixed ? &*fixed : nullptr, fo, written);
+    trainer::HadynetModel current = model;
+    std::string current_path = model_path;
+    std::string written;
+    int confirmed_rounds = 0;
+    std::vector<std::string> confirmed_effects;
+    const int round_count = opt.has("fix") ? static_cast<int>(*rounds) : 1;
+    json first_json;
+    for (int round = 1; round <= round_count; ++round) {
+      if (round > 1) std::printf("\n=== round %d: the model fixed in round %d, on the same logs ===\n", round, round - 1);
+      const rs::Analysis a = rs::analyse(current, inputs, ao);
+      print_summary(a, pb_choice, opt.has("fix"));
+      json j = analysis_json(a, current_path, pb_choice);
+      std::optional<rs::FixResult> fixed;
+      std::string round_written;
+      if (opt.has("fix")) {
+        fixed = rs::fix(current, inputs, a.data, a.attribution, fo);
+        print_fix(*fixed);
+        j["fix"] = fix_json(*fixed, fo);
+        if (fixed->changed) {
+          ++confirmed_rounds;
+          confirmed_effects.push_back(fixed->augmentation->description);
+          if (opt.has("out")) {
+            round_written = opt.get("out");
+            trainer::save_model(round_written, fixed->model);
+            std::fprintf(stderr, "wrote %s (round %d)\n", round_written.c_str(), round);
+            j["fix"]["model"] = round_written;
+            written = round_written;
+          }
+        }
+      }
+      j["round"] = round;
+      if (opt.has("report")) {
+        std::filesystem::path dir = opt.get("report");
+        if (round > 1) dir /= "round-" + std::to_string(round);
+        std::filesystem::create_directories(dir);
+        write_json(j, (dir / "residual.json").string());
+        write_report(dir, a, current_path, pb_choice, fixed ? &*fixed : nullptr, fo, round_written);
+      }
+      if (round == 1) first_json = j;
+      else rounds_json.push_back(j);
+      if (!fixed || !fixed->changed) break;
+      current = fixed->model;
+      current_path = written.empty() ? "(the model of round " + std::to_string(round) + ", not written)" : written;
+      if (round == round_count && round_count > 1)
+        std::printf("\n--rounds %d reached with the last round confirmed: more may remain\n", round_count);
     }
+    if (opt.has("fix") && round_count > 1) {
+      std::printf("\nrounds: %d confirmed", confirmed_rounds);
+      for (const auto& e : confirmed_effects) std::printf("; %s", e.c_str());
+      std::printf("\n");
+      first_json["rounds"] = rounds_json;
+    }
+    if (opt.has("out") && written.empty()) std::fprintf(stderr, "nothing fixed: %s not written\n", opt.get("out").c_str());
+    if (opt.has("json")) write_json(first_json, opt.get("json"));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hadynet residual: %s\n", error_text(e).c_str());
     return 1;

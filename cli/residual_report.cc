@@ -69,6 +69,12 @@ nlohmann::json analysis_json(const rs::Analysis& a, const std::string& model_pat
                     {"state", log.seq.state},
                     {"rows", log.seq.steps()},
                     {"pb_source", log.pb_source},
+                    {"pb_check", log.pb_check.checked
+                                     ? json{{"stored_loss", log.pb_check.stored_loss},
+                                            {"adapted_loss", log.pb_check.adapted_loss},
+                                            {"margin", rs::kStoredPbMargin},
+                                            {"replaced", log.pb_check.replace}}
+                                     : json(nullptr)},
                     {"pb", std::vector<float>(log.pb.data(), log.pb.data() + log.pb.size())}});
   }
   json fit = json::object(), rmse = json::object();

@@ -32,8 +32,8 @@ inline const std::vector<PlantLog> kEffectLogs = {
     {"Cylinder", "random2", 1}, {"Ball", "random2", 2}, {"Gripper", "random2", 0}, {"Cylinder", "random1", 0}};
 
 // The logs recorded with `effect` ("" for clean; plant syntax NAME[=VALUE]).
-// Seed 1 is the model's training dataset seed; other seeds give fresh noise,
-// motions and encoder zeroings under the same state names.
+// Seed 1 is the model's training dataset seed; other seeds give fresh noise
+// and motions in the same states (a state id decides its zeroing).
 inline std::vector<trainer::residual::LogInput> plant_logs(const std::string& effect, int steps = 300,
                                                            std::uint64_t seed = 1) {
   std::vector<trainer::residual::LogInput> out;
@@ -49,6 +49,28 @@ inline std::vector<trainer::residual::LogInput> plant_logs(const std::string& ef
       if (!err.empty()) throw std::invalid_argument(err);
     }
     out.push_back({plant::run_experiment(spec).log, plant::log_file_name(spec)});
+  }
+  return out;
+}
+
+// The clean grasps of kEffectLogs recorded under another zeroing (init id
+// `init` + the log's index, which the model never saw) and relabelled with
+// the trained state names: a hand re-zeroed at start-up that keeps its names.
+inline std::vector<trainer::residual::LogInput> rezeroed_plant_logs(int init, int steps = 300,
+                                                                    std::uint64_t seed = 1) {
+  std::vector<trainer::residual::LogInput> out;
+  for (std::size_t i = 0; i < kEffectLogs.size(); ++i) {
+    const auto& l = kEffectLogs[i];
+    plant::ExperimentSpec spec;
+    spec.object = *plant::parse_object(l.object);
+    spec.motion = *plant::parse_motion(l.motion);
+    spec.init_id = init + static_cast<int>(i);
+    spec.steps = steps;
+    spec.seed = seed;
+    datalog::LogTable log = plant::run_experiment(spec).log;
+    spec.init_id = l.init;
+    log.metadata.set("state", plant::state_id(spec));
+    out.push_back({std::move(log), plant::log_file_name(spec)});
   }
   return out;
 }

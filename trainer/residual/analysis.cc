@@ -50,12 +50,14 @@ std::string verdict_text(const Attribution& attribution) {
 
 std::string pb_summary(const ResidualData& data, const std::string& pb_choice) {
   std::map<std::string, int> logs_by_source;  // given PBs, by their text
-  int trained = 0, adapted = 0;
+  int trained = 0, adapted = 0, replaced = 0;
   for (const auto& log : data.logs) {
     if (log.pb_origin == ResidualLog::PbOrigin::kTrained) {
       ++trained;
     } else if (log.pb_origin == ResidualLog::PbOrigin::kAdapted) {
       ++adapted;
+    } else if (log.pb_origin == ResidualLog::PbOrigin::kAdaptedOverTrained) {
+      ++replaced;
     } else {
       ++logs_by_source[log.pb_source];
     }
@@ -70,6 +72,11 @@ std::string pb_summary(const ResidualData& data, const std::string& pb_choice) {
   if (adapted > 0) {
     s += sep + logs(adapted) + " with a PB adapted to their state's logs" +
          (pb_choice == "auto" ? " (states the model was not trained on)" : "");
+    sep = ", ";
+  }
+  if (replaced > 0) {
+    s += sep + logs(replaced) + " with a PB adapted to their state's logs (the state's trained PB predicted "
+                                "their held-out rows worse: re-zeroed or worn since training?)";
     sep = ", ";
   }
   for (const auto& [source, n] : logs_by_source) {

@@ -11,6 +11,7 @@
 #include "trainer/model_frame.h"
 #include "trainer/output_clip.h"
 #include "trainer/pb_adaptation.h"
+#include "trainer/training.h"
 #include "trainer/window_dataset.h"
 
 namespace hadynet::trainer::residual {
@@ -47,6 +48,36 @@ Eigen::VectorXf adapt_to(const HadynetModel& model, const std::vector<LogSequenc
   std::vector<int> ids(static_cast<std::size_t>(data.size()));
   std::iota(ids.begin(), ids.end(), 0);
   return adapt_pb(model, data, ids, Eigen::VectorXf::Zero(model.params.dims.pb), AdaptOptions{}).pb;
+}
+
+// --pb auto on a state the model was trained on. A state's name is a
+// label: a real hand re-zeroed at start-up, or worn since training, keeps its
+// name and changes its dynamics. So the trained PB is checked: a PB is adapted
+// to the first 70 % of the state's windows and both are scored on the last
+// 30 % (WindowDataset::split_tail: no observation in both). The trained PB is
+// replaced (by a PB adapted to all the windows) only when its held-out loss
+// exceeds the adapted one's by more than kStoredPbMargin.
+constexpr double kCheckHeldOutFraction = 0.3;
+
+StoredPbCheck check_stored_pb(const HadynetModel& model, const std::vector<LogSequence>& seqs,
+                              const Eigen::VectorXf& stored) {
+  const WindowDataset data(seqs, std::vector<int>(seqs.size(), 0), model.layout, model.norm, model.train_steps);
+  const WindowDataset::Split split = data.split_tail(kCheckHeldOutFraction);
+  StoredPbCheck c;
+  if (split.train.empty() || split.held_out.empty()) return c;
+  const Eigen::VectorXf adapted =
+      adapt_pb(model, data, split.train, Eigen::VectorXf::Zero(model.params.dims.pb), AdaptOptions{}).pb;
+  c.checked = true;
+  c.stored_loss = evaluate_loss(model, data, split.held_out, stored);
+  c.adapted_loss = evaluate_loss(model, data, split.held_out, adapted);
+  c.replace = c.stored_loss > kStoredPbMargin * c.adapted_loss;
+  return c;
+}
+
+std::string loss_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
 }
 
 // An explicit PB: "zero", a state of the model, or comma-separated numbers.
@@ -139,6 +170,24 @@ ResidualData compute_residuals(const HadynetModel& model, const std::vector<LogI
       pb = model.params.pb.row(k).transpose();
       source = "state " + state;
       origin = ResidualLog::PbOrigin::kTrained;
+      if (pb_choice == "auto") {
+        std::vector<LogSequence> seqs;
+        for (std::size_t i : members) seqs.push_back(data.logs[i].seq);
+        const StoredPbCheck check = check_stored_pb(model, seqs, pb);
+        for (std::size_t i : members) data.logs[i].pb_check = check;
+        const std::string losses = "held-out loss " + loss_text(check.stored_loss) + " trained, " +
+                                   loss_text(check.adapted_loss) + " adapted";
+        if (check.replace) {
+          pb = adapt_to(model, seqs);
+          source = "adapted to the state's logs: the trained PB of " + state + " fits them worse (" + losses +
+                   "; margin " + loss_text(kStoredPbMargin) + ")";
+          origin = ResidualLog::PbOrigin::kAdaptedOverTrained;
+        } else if (check.checked) {
+          source = "state " + state + " (checked: " + losses + ")";
+        } else {
+          source = "state " + state + " (not checked: too few windows to hold some out)";
+        }
+      }
     } else {
       pb = explicit_pb(model, pb_choice);
       source = pb_choice;

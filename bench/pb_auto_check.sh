@@ -1,0 +1,120 @@
+#!/usr/bin/env bash
+# How often `hadynet residual --pb auto` replaces a state's trained PB by one
+# adapted to the logs (issue 12; not a test). The check scores the trained PB
+# and a PB adapted to the first 70 % of the state's windows on the last 30 %,
+# and replaces the trained one when its held-out loss is more than
+# kStoredPbMargin (1.2, trainer/residual/residuals.h) times the adapted one's.
+# Three kinds of log sets, four 300-row grasps each (the states of
+# docs/residual.md: Cylinder/random2/i1, Ball/random2/i2, Gripper/random2/i0,
+# Cylinder/random1/i0):
+#   clean      the trained states (their own zeroings), fresh motions and noise;
+#   effect     the same with one plant effect at its default strength
+#              (sensor-delay, friction, crosstalk, drift, saturation);
+#   rezeroed   the same grasps under zeroings the model never saw (init ids
+#              below), relabelled with the trained state names: a hand
+#              re-zeroed at start-up that keeps its names.
+# Seeds and zeroings (disjoint roles): training is seed 1 (inits 0-2, test 3,
+# validation 4-6); the margin was chosen on development data only (the seed-1
+# effect logs, stored/adapted 1.02-1.06, and seed-11 logs recorded when a
+# state's zeroing still followed the seed, 1.37-17.8); recognition benchmarks
+# use inits 100-149. Measured here: seeds 141-150 (clean, effect) and inits
+# 200-209 (rezeroed, seed 141), used for nothing else.
+#
+# Usage: bench/pb_auto_check.sh [--model M] [--out DIR] [--seeds N]
+#   defaults: models/hand.safetensors, build/pb-auto-check, 10 seeds/zeroings
+# Environment: HADYNET (default build/release/cli/hadynet).
+# Prints one line per log set with an ETA, then the counts (OUT/summary.txt).
+set -euo pipefail
+usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
+model=models/hand.safetensors
+out=build/pb-auto-check
+n=10
+while (($#)); do
+  case "$1" in
+    -h | --help) usage; exit 0 ;;
+    --model) model=$2; shift 2 ;;
+    --out) out=$2; shift 2 ;;
+    --seeds) n=$2; shift 2 ;;
+    *) echo "pb_auto_check: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
+cd "$(dirname "$0")/.."
+hadynet="${HADYNET:-build/release/cli/hadynet}"
+[[ -x "$hadynet" ]] || { echo "pb_auto_check: $hadynet not found" >&2; exit 2; }
+mkdir -p "$out"
+summary="$out/summary.txt"
+: >"$summary"
+grasps=("Cylinder random2 1" "Ball random2 2" "Gripper random2 0" "Cylinder random1 0")
+effects=(sensor-delay friction crosstalk drift saturation)
+
+# collect_set DIR SEED INIT_OVERRIDE [--effect E]: the four grasps; with an
+# init override, recorded under that zeroing and relabelled with the trained name.
+collect_set() {
+  local dir=$1 seed=$2 init_override=$3
+  shift 3
+  rm -rf "$dir" && mkdir -p "$dir/logs"
+  for g in "${grasps[@]}"; do
+    set -- $g "$@"
+    local object=$1 motion=$2 init=$3
+    shift 3
+    local rec_init=${init_override:-$init}
+    "$hadynet" collect --object "$object" --motion "$motion" --init "$rec_init" --rows 300 --seed "$seed" \
+      --out "$dir/raw" --quiet "$@" >/dev/null
+    local f
+    f=$(ls "$dir"/raw/*/"${object}_${motion}_i${rec_init}_w0.csv")
+    sed "s|^# state: .*|# state: $object/i$init/w0|" "$f" >"$dir/logs/${object}_${motion}_i${init}.csv"
+  done
+}
+
+# check_set NAME DIR: residual --pb auto, one line with each state's losses and verdict.
+total_sets=$((n * (2 + ${#effects[@]}))) done_sets=0 start=$(date +%s)
+check_set() {
+  local name=$1 dir=$2
+  "$hadynet" residual "$model" "$dir/logs" --json "$dir/residual.json" >"$dir/out.txt" 2>&1 ||
+    { echo "$name: hadynet residual failed: $(tail -1 "$dir/out.txt")" | tee -a "$summary"; return; }
+  done_sets=$((done_sets + 1))
+  local eta=$(( ($(date +%s) - start) * (total_sets - done_sets) / done_sets ))
+  python3 - "$name" "$dir/residual.json" "[$done_sets/$total_sets, ETA ${eta}s]" <<'PY' | tee -a "$summary"
+import json, sys
+name, path, progress = sys.argv[1:4]
+seen = {}
+for log in json.load(open(path))["logs"]:
+    c = log["pb_check"]
+    if c is not None:
+        seen[log["state"]] = c
+cells = [f"{s} {c['stored_loss'] / c['adapted_loss']:.2f}{' REPLACED' if c['replaced'] else ''}" for s, c in sorted(seen.items())]
+print(f"{name}: " + ", ".join(cells) + f"   {progress}")
+PY
+}
+
+for ((k = 0; k < n; ++k)); do
+  seed=$((141 + k))
+  collect_set "$out/clean$seed" "$seed" ""
+  check_set "clean seed $seed" "$out/clean$seed"
+  for e in "${effects[@]}"; do
+    collect_set "$out/$e$seed" "$seed" "" --effect "$e"
+    check_set "$e seed $seed" "$out/$e$seed"
+  done
+  init=$((200 + k))
+  collect_set "$out/rezeroed$init" 141 "$init"
+  check_set "rezeroed init $init" "$out/rezeroed$init"
+done
+
+python3 - "$summary" <<'PY' | tee -a "$summary"
+import re, sys
+counts = {}
+for line in open(sys.argv[1]):
+    m = re.match(r"(\S+) (seed|init) \d+: (.*?)   \[", line)
+    if not m:
+        continue
+    kind = m.group(1)
+    kind = kind if kind in ("clean", "rezeroed") else "effect"
+    cells = m.group(3).split(", ")
+    c = counts.setdefault(kind, [0, 0])
+    c[0] += sum("REPLACED" in x for x in cells)
+    c[1] += len(cells)
+print("stored/adapted held-out loss ratio per state shown above; trained PB replaced (margin 1.2):")
+for kind in ("clean", "effect", "rezeroed"):
+    if kind in counts:
+        print(f"  {kind:9s} {counts[kind][0]} of {counts[kind][1]} state checks")
+PY
