@@ -20,6 +20,7 @@
 #include "trainer/model_file.h"
 #include "trainer/residual/analysis.h"
 #include "trainer/residual/augment.h"
+#include "trainer/residual/rated_ranges.h"
 
 namespace hadynet::cli {
 
@@ -118,6 +119,10 @@ int run_residual(int argc, char** argv) {
   opt.value("min-explained-std", "V",
             "floor: held-out explained variance in standardised units (drop of the channel's 1-step loss)", "0.05");
   opt.flag("all-sources", "cross-talk sources from every observed group (default: the target's group)");
+  opt.repeated("rated-range", "NAME=LOW..HIGH",
+               "a sensor's rated range (datasheet) for an output group or channel, e.g. fc=0..50: the predictions\n"
+               "are clipped there as known before anything is searched (a rail there is not an effect); either\n"
+               "bound may be left out (f=0..)");
   opt.value("report", "DIR", "write DIR/REPORT.md with PNG plots (gnuplot) and DIR/residual.json");
   opt.value("json", "FILE", "write every number as JSON");
   opt.flag("fix", "add the winning effect (sensor delay: time alignment; cross-talk: removal; drift: a bias state;\n"
@@ -167,9 +172,23 @@ int run_residual(int argc, char** argv) {
     return 2;
   }
 
+  std::vector<rs::RatedRange> rated_ranges;
+  try {
+    for (const auto& text : opt.all("rated-range")) rated_ranges.push_back(rs::parse_rated_range(text));
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "hadynet residual: --rated-range: %s\n", e.what());
+    return 2;
+  }
+
   try {
     const std::string model_path = opt.positional().front();
-    const trainer::HadynetModel model = trainer::load_model(model_path);
+    std::vector<trainer::OutputClip> known_clips;
+    const trainer::HadynetModel model = rs::with_rated_ranges(trainer::load_model(model_path), rated_ranges, &known_clips);
+    if (!known_clips.empty()) {
+      std::printf("rated ranges: the predictions are clipped as known at");
+      for (const auto& c : known_clips) std::printf(" %s %s %g;", c.channel.c_str(), c.side > 0 ? "<=" : ">=", c.rail);
+      std::printf(" no rail there is searched for\n");
+    }
     const std::vector<std::string> args(opt.positional().begin() + 1, opt.positional().end());
     std::vector<rs::LogInput> inputs;
     for (const auto& path : trainer::expand_log_paths(args)) inputs.push_back({datalog::read_log(path), path});
@@ -215,6 +234,7 @@ int run_residual(int argc, char** argv) {
       const rs::Analysis a = rs::analyse(current, inputs, ao);
       print_summary(a, pb_choice, opt.has("fix"));
       json j = analysis_json(a, current_path, pb_choice);
+      j["rated_ranges"] = opt.all("rated-range");
       std::optional<rs::FixResult> fixed;
       std::string round_written;
       if (opt.has("fix")) {

@@ -71,6 +71,10 @@ expect 2 "option '--alpha' needs a value" "$model" good.csv --json out.json --al
 expect 2 "--alpha: expected a number in 1e-12..0.5, got '2'" "$model" good.csv --json out.json --alpha 2
 expect 2 "--horizon: expected a whole number in 1..1000, got '0'" "$model" good.csv --json out.json --horizon 0
 expect 2 "--out needs --fix" "$model" good.csv --out fixed.safetensors
+expect 2 "--rounds needs --fix" "$model" good.csv --rounds 2 --json out.json
+expect 2 "--rated-range: rated range 'fc=5..1': LOW must be below HIGH" "$model" good.csv --rated-range fc=5..1 --json out.json
+expect 2 "expected NAME=LOW..HIGH" "$model" good.csv --rated-range fc --json out.json
+expect 1 "rated range 'u': no output channel or group of that name" "$model" good.csv --rated-range u=0..1 --json out.json
 # Failures: exit 1, the file named.
 expect 1 "missing.safetensors: cannot read safetensors file" missing.safetensors good.csv --json out.json
 expect 1 "good.csv: header length" good.csv good.csv --json out.json

@@ -1,0 +1,122 @@
+#!/usr/bin/env bash
+# Detection rates of the residual loop (issue 12; not a test): every plant
+# effect of the library at two strengths, each on fresh log sets (the four
+# grasps of docs/residual.md, 300 rows, the effect switched on and declared
+# nowhere), through `hadynet residual MODEL LOGS --fix` with the plant's
+# datasheet ranges (--rated-range fc=0..50 --rated-range f=0..200). Per run:
+#   named     --fix confirmed the right effect with the right parameter:
+#             sensor-delay: the delay in steps; crosstalk: a plant pair
+#             (fc0<-fc1, fc1<-fc2, fc2<-fc3, fc3<-fc4, fc4<-fc3); friction:
+#             tendon channels (f*); drift: a load drift on a loadcell;
+#             saturation: a loadcell's upper rail within 10 % of the plant's;
+#   cut       the held-out 1-step RMSE on the changed channels (mean ratio
+#             after/before) is at most 0.7;
+#   <control  the augmented model's RMSE there is below fine-tuning alone's.
+# Seeds: 181-190 (never used for training, calibration, development or any
+# other benchmark; see bench/residual_false_positives.sh for the others).
+#
+# Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N]
+#   defaults: models/hand.safetensors, build/residual-detection, 10
+# Environment: HADYNET (default build/release/cli/hadynet).
+# Prints one line per run with an ETA, then the table (OUT/summary.txt).
+set -euo pipefail
+usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
+model=models/hand.safetensors
+out=build/residual-detection
+n=10
+while (($#)); do
+  case "$1" in
+    -h | --help) usage; exit 0 ;;
+    --model) model=$2; shift 2 ;;
+    --out) out=$2; shift 2 ;;
+    --seeds) n=$2; shift 2 ;;
+    *) echo "residual_detection: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
+cd "$(dirname "$0")/.."
+hadynet="${HADYNET:-build/release/cli/hadynet}"
+[[ -x "$hadynet" ]] || { echo "residual_detection: $hadynet not found" >&2; exit 2; }
+mkdir -p "$out"
+runs="$out/runs.txt"
+: >"$runs"
+# effect=strength, weaker first; the second is the larger strength.
+cases=(sensor-delay=1 sensor-delay=2 friction=2 friction=4 crosstalk=0.2 crosstalk=0.35 drift=0.01 drift=0.02
+  saturation=3 saturation=2)
+total=$((n * ${#cases[@]})) done_runs=0 start=$(date +%s)
+for ((k = 0; k < n; ++k)); do
+  seed=$((181 + k))
+  for c in "${cases[@]}"; do
+    d="$out/$c/seed$seed"
+    rm -rf "$d" && mkdir -p "$d"
+    for g in "Cylinder random2 1" "Ball random2 2" "Gripper random2 0" "Cylinder random1 0"; do
+      set -- $g
+      "$hadynet" collect --object "$1" --motion "$2" --init "$3" --rows 300 --seed "$seed" --out "$d/logs" \
+        --effect "$c" --quiet >/dev/null
+    done
+    "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 --fix \
+      --json "$d/residual.json" >"$d/out.txt" 2>&1 || { echo "$c seed $seed: residual failed" >>"$runs"; continue; }
+    done_runs=$((done_runs + 1))
+    eta=$(( ($(date +%s) - start) * (total - done_runs) / done_runs ))
+    python3 - "$c" "$seed" "$d/residual.json" "[$done_runs/$total, ETA ${eta}s]" <<'PY' | tee -a "$runs"
+import json, re, sys
+case, seed, path, progress = sys.argv[1:5]
+effect, strength = case.split("=")
+strength = float(strength)
+fix = json.load(open(path))["fix"]
+aug = fix.get("augmentation") or {}
+named_effect = aug.get("effect", "-")
+confirmed = bool(fix.get("changed"))
+channels = aug.get("channels", [])
+pairs = {("fc0", "fc1"), ("fc1", "fc2"), ("fc2", "fc3"), ("fc3", "fc4"), ("fc4", "fc3")}
+param_ok = False
+if effect == "sensor-delay":
+    param_ok = named_effect == "sensor-delay" and aug.get("delay_steps") == int(strength)
+elif effect == "crosstalk":
+    param_ok = named_effect == "crosstalk" and bool(channels) and (channels[0], aug.get("source")) in pairs
+elif effect == "friction":
+    param_ok = named_effect == "friction" and bool(channels) and all(re.fullmatch(r"f\d+", c) for c in channels)
+elif effect == "drift":
+    param_ok = named_effect == "drift-load" and bool(channels) and all(c.startswith("fc") for c in channels)
+elif effect == "saturation":
+    rails = [float(x) for x in re.findall(r"fc\d+ <= ([0-9.eE+-]+)", aug.get("description", ""))]
+    param_ok = named_effect == "saturation" and bool(rails) and all(abs(r - strength) <= 0.1 * strength for r in rails)
+named = confirmed and param_ok
+cut = below_control = False
+ratio = float("nan")
+if fix.get("after") and fix.get("before") and channels:
+    def rmse(part):
+        return {c["channel"]: c["rmse"] for c in fix[part]["channels"]}
+    before, after = rmse("before"), rmse("after")
+    control = rmse("control") if fix.get("control") else {}
+    tested = [c for c in (fix.get("confirmation", {}).get("channels") or channels) if c in before and c in after]
+    if tested:
+        ratio = sum(after[c] / before[c] for c in tested) / len(tested)
+        cut = ratio <= 0.7
+        below_control = bool(control) and sum(after[c] for c in tested) < sum(control[c] for c in tested)
+label = (aug.get("description", fix.get("status", "-")))[:60]
+print(f"{case} seed {seed}: named {'yes' if named else 'no '} cut {'yes' if cut else 'no '} "
+      f"(after/before {ratio:.2f}) <control {'yes' if below_control else 'no '} | "
+      f"{'confirmed' if confirmed else 'not confirmed'}: {named_effect}: {label}   {progress}")
+PY
+  done
+done
+
+python3 - "$runs" "${cases[@]}" <<'PY' | tee "$out/summary.txt"
+import re, sys
+path, cases = sys.argv[1], sys.argv[2:]
+rows = {c: [0, 0, 0, 0] for c in cases}
+for line in open(path):
+    m = re.match(r"(\S+) seed \d+: named (yes|no) +cut (yes|no) .*<control (yes|no)", line)
+    if not m:
+        continue
+    r = rows[m.group(1)]
+    r[0] += 1
+    r[1] += m.group(2) == "yes"
+    r[2] += m.group(2) == "yes" and m.group(3) == "yes"
+    r[3] += m.group(2) == "yes" and m.group(3) == "yes" and m.group(4) == "yes"
+print("| effect=strength | runs | named and confirmed (right parameter) | + held-out RMSE cut >= 30 % | + below the fine-tune-only control |")
+print("|---|---|---|---|---|")
+for c in cases:
+    r = rows[c]
+    print(f"| {c} | {r[0]} | {r[1]} | {r[2]} | {r[3]} |")
+PY
