@@ -88,6 +88,15 @@ void print_fix(const rs::FixResult& fixed) {
     for (const auto& c : fixed.confirmation_channels) std::printf(" %s", c.c_str());
     std::printf(": Diebold-Mariano p %.2g: %s\n", fixed.confirmation.p_value,
                 fixed.changed ? "confirmed" : "not confirmed, nothing applied");
+    if (fixed.candidates.size() > 1) {
+      std::printf("candidates (the screen's order; * the one tested: the first whose gain over fine-tuning alone on\n"
+                  "the training rows' last 25 %% is significant, else the screen's first):\n");
+      for (const auto& c : fixed.candidates) {
+        std::printf("  %c %-74.74s", c.chosen ? '*' : ' ', (c.effect + ": " + c.description).c_str());
+        if (c.selected_by_training_rows) std::printf(" training rows: p %.2g\n", c.selection.p_value);
+        else std::printf(" not judged\n");
+      }
+    }
     std::printf("verdict after: %s\n", fixed.after.verdict.c_str());
   }
 }
@@ -138,6 +147,10 @@ int run_residual(int argc, char** argv) {
   opt.value("fix-epochs", "N", "with --fix: fine-tuning epochs", "20");
   opt.value("fix-lr", "X", "with --fix: Adam learning rate", "0.001");
   opt.value("fix-seed", "N", "with --fix: seed of the window order", "1");
+  opt.value("candidates", "K", "with --fix: how many of the screen's candidates may be tried: in its order, each added,\n"
+                              "fine-tuned on the first 75 % of the training rows and compared with fine-tuning alone\n"
+                              "on the rest; the first significant there (else the screen's first) is the one the\n"
+                              "decision tests on the held-out rows", "3");
   opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
                         "unchanged model, a weaker guard)");
   if (!opt.parse(argc, argv)) return 2;
@@ -162,7 +175,8 @@ int run_residual(int argc, char** argv) {
   const auto fix_lr = opt.get_double("fix-lr", 1e-12, 10.0);
   const auto fix_seed = opt.get_int("fix-seed", 0, (1ll << 62));
   const auto rounds = opt.get_int("rounds", 1, 20);
-  if (!fix_epochs || !fix_lr || !fix_seed || !rounds) return 2;
+  const auto candidates = opt.get_int("candidates", 1, 20);
+  if (!fix_epochs || !fix_lr || !fix_seed || !rounds || !candidates) return 2;
   if (opt.has("rounds") && !opt.has("fix")) {
     std::fprintf(stderr, "hadynet residual: --rounds needs --fix\n");
     return 2;
@@ -210,6 +224,7 @@ int run_residual(int argc, char** argv) {
     fo.lr = *fix_lr;
     fo.seed = static_cast<std::uint64_t>(*fix_seed);
     fo.control = !opt.has("no-control");
+    fo.candidates = static_cast<int>(*candidates);
 
     // One round: analyse `current`, fix when asked; returns the fix (if any).
     // Round 1 reports into --report DIR and --json FILE; round k > 1 into

@@ -65,6 +65,17 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                          {"rows", f.confirmation.samples},
                          {"p_value", f.confirmation.p_value},
                          {"confirmed", f.changed}};
+    json candidates = json::array();
+    for (const auto& c : f.candidates)
+      candidates.push_back({{"effect", c.effect},
+                            {"description", c.description},
+                            {"channels", c.channels},
+                            {"selected_by_training_rows", c.selected_by_training_rows},
+                            {"selection_statistic", c.selection.stat},
+                            {"selection_p_value", c.selection.p_value},
+                            {"selection_mean_loss_difference", c.selection.mean},
+                            {"chosen", c.chosen}});
+    j["candidates"] = candidates;
   }
   return j;
 }

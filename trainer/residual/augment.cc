@@ -40,36 +40,40 @@ Segments standardised_loss(const HadynetModel& model, const HeldOutError& e, con
 
 bool fix_supported(EffectKind kind) { return effect_info(kind).plan != nullptr; }
 
-std::optional<Augmentation> plan_augmentation(const ResidualData& data, const Attribution& attribution) {
+std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attribution& attribution, int count) {
+  std::vector<Augmentation> out;
   const auto winner = attribution.winner();
-  if (!winner) return std::nullopt;
-  // The best significant hypothesis whose effect --fix can add: the winner,
-  // unless its effect has no augmentation (input-delay), then the next one
-  // in the ranking. A sensor delay on a channel the commands drive directly
-  // leaves nearly the residual of an input delay on that channel alone, so
-  // the two can swap places (docs/residual.md).
-  const HypothesisResult* w = nullptr;
+  if (!winner || count < 1) return out;
+  // The significant hypotheses whose effect --fix can add, in ranking order,
+  // one per distinct augmentation (a family's members plan the same one: a
+  // delay on fc1 and on fc2 align the same group). A sensor delay on a
+  // channel the commands drive directly leaves nearly the residual of an
+  // input delay on that channel alone, so the two can swap places
+  // (docs/residual.md): an input-delay winner is skipped and said.
   for (const auto& r : attribution.ranked) {
-    if (!r.significant) break;
-    if (fix_supported(r.hypothesis.kind)) {
-      w = &r;
-      break;
-    }
+    if (!r.significant || static_cast<int>(out.size()) >= count) break;
+    if (!fix_supported(r.hypothesis.kind)) continue;
+    Augmentation a;
+    a.kind = r.hypothesis.kind;
+    a.effect = r.effect;
+    effect_info(a.kind).plan(data, attribution, r, a);
+    const bool seen = std::any_of(out.begin(), out.end(), [&](const Augmentation& b) {
+      return b.kind == a.kind && b.description == a.description;
+    });
+    if (seen) continue;
+    if (out.empty() && r.label != winner->label)
+      a.description = "the winner (" + winner->effect + ": " + winner->label +
+                      ") has no augmentation; the best significant effect that has: " + r.label + "; " + a.description;
+    out.push_back(std::move(a));
   }
-  Augmentation a;
-  if (w == nullptr) {  // nothing significant can be added: fix() says "not supported"
+  if (out.empty()) {  // nothing significant can be added: fix() says "not supported"
+    Augmentation a;
     a.kind = winner->hypothesis.kind;
     a.effect = winner->effect;
     a.description = effect_info(a.kind).augmentation;
-    return a;
+    out.push_back(std::move(a));
   }
-  a.kind = w->hypothesis.kind;
-  a.effect = w->effect;
-  effect_info(a.kind).plan(data, attribution, *w, a);
-  if (w->label != winner->label)
-    a.description = "the winner (" + winner->effect + ": " + winner->label +
-                    ") has no augmentation; the best significant effect that has: " + w->label + "; " + a.description;
-  return a;
+  return out;
 }
 
 SensorModel sensor_after(const SensorModel& before, const Augmentation& a) {
@@ -102,21 +106,30 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   if (logs.size() != data.logs.size()) throw std::invalid_argument("--fix: logs and analysis differ");
   FixResult result;
   result.model = model;
-  result.augmentation = plan_augmentation(data, attribution);
-  const Augmentation* aug = result.augmentation ? &*result.augmentation : nullptr;
-  // Rows a sensor delay costs at the end of each log, before or after.
-  const int d = std::max(model.sensor.max_delay(), aug != nullptr ? sensor_after(model.sensor, *aug).max_delay() : 0);
+  std::vector<Augmentation> planned = plan_candidates(data, attribution, options.candidates);
+  // Rows a sensor delay costs at the end of each log, before or after: the
+  // largest over every candidate, so that all are judged on the same rows.
+  int d = model.sensor.max_delay();
+  for (const auto& a : planned) d = std::max(d, sensor_after(model.sensor, a).max_delay());
 
-  // Held-out rows of each log: [first, end), the same for every model.
-  std::vector<int> split;
+  // Held-out rows of each log: [split, end), the same for every model. The
+  // selection among candidates uses the training part alone: its first
+  // kSelectionFraction trains, rows [inner, split - d) judge.
+  constexpr double kSelectionFraction = 0.75;
+  constexpr int kMinSelectionRows = 20;
+  std::vector<int> split, inner;
+  bool can_select = true;
   for (const auto& in : logs) {
     const int T = static_cast<int>(in.table.rows());
     const int first = std::max(static_cast<int>(std::floor(options.train_fraction * T)), d + 2);
     if (first >= T - d) throw std::runtime_error(in.file + ": too short for --fix's time split");
     split.push_back(first);
+    inner.push_back(static_cast<int>(std::floor(kSelectionFraction * first)));
+    if (inner.back() < d + 2 + kMinSelectionRows || first - d - inner.back() < kMinSelectionRows) can_select = false;
   }
-  // Each model is fed the logs in its own frame and judged on the measured rows.
-  auto eval_logs = [&](const HadynetModel& m, const std::vector<Eigen::VectorXf>& pbs) {
+  // Each model is fed the logs in its own frame and judged on the measured rows [from[i], to(i)).
+  auto eval_rows = [&](const HadynetModel& m, const std::vector<Eigen::VectorXf>& pbs, const std::vector<int>& from,
+                       bool held_out) {
     std::vector<HeldOutLog> out;
     for (std::size_t i = 0; i < logs.size(); ++i) {
       HeldOutLog e;
@@ -124,11 +137,14 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       e.measured = log_sequence(logs[i].table, logs[i].file, m.layout);
       e.frame = in_model_frame(m.sensor, m.layout, logs[i].table, logs[i].file).sequence;
       e.pb = pbs[i];
-      e.first = split[i];
-      e.end = e.measured.steps() - d;
+      e.first = from[i];
+      e.end = held_out ? e.measured.steps() - d : split[i] - d;
       out.push_back(std::move(e));
     }
     return out;
+  };
+  auto eval_logs = [&](const HadynetModel& m, const std::vector<Eigen::VectorXf>& pbs) {
+    return eval_rows(m, pbs, split, true);
   };
   auto state_pbs = [&](const HadynetModel& m) {
     std::vector<Eigen::VectorXf> pbs;
@@ -141,16 +157,17 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.before = held_out_error(model, eval_logs(model, before_pbs));
   result.before.verdict = verdict_text(attribution);
 
-  if (aug == nullptr) {
+  if (planned.empty()) {
     result.status = "no significant effect";
     return result;
   }
-  if (!fix_supported(aug->kind)) {
-    result.status = "not supported: " + aug->effect + ": " + aug->description;
+  if (!fix_supported(planned.front().kind)) {
+    result.augmentation = planned.front();
+    result.status = "not supported: " + planned.front().effect + ": " + planned.front().description;
     return result;
   }
 
-  // What the augmentation re-estimates on the training rows before
+  // What an augmentation re-estimates on the training rows before
   // fine-tuning (drift: the rates), probing the unchanged network with a
   // sensor model.
   HadynetModel probe = model;
@@ -163,42 +180,109 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     }
     return held_out_error(probe, train).rmse(static_cast<Eigen::Index>(index_of(model.layout.y_names, channel)));
   };
-  Augmentation& planned = *result.augmentation;
-  std::visit([&](auto& change) { change.refine(planned, model.sensor, training_rmse, result.fitted_rates); },
-             planned.change);
 
-  // Training parts: raw rows [0, first) in the measured frame; a frame
-  // aligned by a delay of s rows holds them in rows [0, first - s).
-  auto training_part = [&](const SensorModel& sensor, const FeatureLayout& layout) {
+  // Training data: raw rows [0, cut[i]) in the measured frame; a frame
+  // aligned by a delay of s rows holds them in rows [0, cut[i] - s).
+  auto training_rows = [&](const SensorModel& sensor, const FeatureLayout& layout, const std::vector<int>& cut) {
     std::vector<LogSequence> seqs;
     for (std::size_t i = 0; i < logs.size(); ++i) {
       LogSequence s = in_model_frame(sensor, layout, logs[i].table, logs[i].file).sequence;
-      const int keep = split[i] - sensor.max_delay();
+      const int keep = cut[i] - sensor.max_delay();
       s.y = s.y.leftCols(keep).eval();
       s.u = s.u.leftCols(keep).eval();
       seqs.push_back(std::move(s));
     }
     return seqs;
   };
+  // A model fine-tuned on rows [0, cut) (the control: no augmentation).
+  struct Tuned {
+    HadynetModel model;
+    std::vector<double> loss_history;
+    long train_windows = 0;
+  };
+  auto tune = [&](const Augmentation* a, const std::vector<int>& cut) {
+    Tuned t;
+    const SensorModel sensor = a != nullptr ? sensor_after(model.sensor, *a) : model.sensor;
+    const FeatureLayout layout = a != nullptr ? augmented_layout(model.layout, *a) : model.layout;
+    // The augmented layout first (aux adds a channel, friction commands), then its training data.
+    const auto seqs = training_rows(sensor, layout, cut);
+    t.model = a != nullptr ? augmented_model(model, *a, seqs) : model;
+    const auto rows = ensure_states(t.model, seqs, before_pbs);
+    t.loss_history = fine_tune(t.model, seqs, rows, tuning, &t.train_windows);
+    t.model.check_consistent();
+    return t;
+  };
+  auto channels_of = [&](const Augmentation& a) {
+    std::vector<std::string> out;
+    for (const auto& name : a.found_on) {
+      if (index_of(model.layout.y_names, name) < 0) continue;
+      if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
+    }
+    return out;
+  };
+
+  std::vector<std::vector<double>> fitted_rates(planned.size());
+  for (std::size_t k = 0; k < planned.size(); ++k)
+    std::visit([&](auto& change) { change.refine(planned[k], model.sensor, training_rmse, fitted_rates[k]); },
+               planned[k].change);
+
+  // Selection (several candidates), on the training rows alone: each
+  // candidate in the screen's order and the control are fine-tuned on the
+  // first 75 % of the training rows and compared on the rest; the first
+  // candidate whose gain there is significant at alpha (one-sided
+  // Diebold-Mariano) is chosen, else the screen's first. The held-out rows
+  // play no part, so the decision below tests one candidate at the full alpha.
+  std::size_t chosen = 0;
+  for (std::size_t k = 0; k < planned.size(); ++k) {
+    CandidateTrial c;
+    c.effect = planned[k].effect;
+    c.description = planned[k].description;
+    c.channels = channels_of(planned[k]);
+    result.candidates.push_back(std::move(c));
+  }
+  if (planned.size() > 1 && can_select) {
+    const Tuned control = tune(nullptr, inner);
+    const HeldOutError control_rows =
+        held_out_error(control.model, eval_rows(control.model, state_pbs(control.model), inner, false));
+    for (std::size_t k = 0; k < planned.size(); ++k) {
+      const Tuned t = tune(&planned[k], inner);
+      const HeldOutError rows = held_out_error(t.model, eval_rows(t.model, state_pbs(t.model), inner, false));
+      CandidateTrial& c = result.candidates[k];
+      c.selection = diebold_mariano(standardised_loss(model, control_rows, c.channels),
+                                    standardised_loss(model, rows, c.channels));
+      c.selected_by_training_rows = true;
+      if (c.selection.mean > 0 && c.selection.p_value < attribution.options.alpha) {
+        chosen = k;
+        break;  // the rest are not needed
+      }
+    }
+  }
+  result.candidates[chosen].chosen = true;
 
   if (options.control) {
-    HadynetModel c = model;
-    const auto seqs = training_part(c.sensor, c.layout);
-    const auto rows = ensure_states(c, seqs, before_pbs);
-    fine_tune(c, seqs, rows, tuning, nullptr);
-    result.control = held_out_error(c, eval_logs(c, state_pbs(c)));
+    const Tuned c = tune(nullptr, split);
+    result.control = held_out_error(c.model, eval_logs(c.model, state_pbs(c.model)));
   }
+  const HeldOutError& reference = result.control ? *result.control : result.before;
+  result.reference = result.control ? "fine-tuning alone" : "the unchanged model";
 
-  // The augmented layout first (aux adds a channel, friction commands), then its training data.
-  const auto seqs = training_part(sensor_after(model.sensor, *aug), augmented_layout(model.layout, *aug));
-  HadynetModel after = augmented_model(model, *aug, seqs);
-  const auto rows = ensure_states(after, seqs, before_pbs);
-  result.loss_history = fine_tune(after, seqs, rows, tuning, &result.train_windows);
-  after.check_consistent();
-  result.after = held_out_error(after, eval_logs(after, state_pbs(after)));
+  // The decision: the chosen candidate, fine-tuned on the whole training
+  // part, against the reference on the held-out rows of the channels it was
+  // found on (the plan's found_on, of the model's own channels: the aligned,
+  // cleaned, clipped, drifting or friction channels; for an aux channel, the
+  // channels its significant hypotheses explain).
+  Tuned after = tune(&planned[chosen], split);
+  result.augmentation = planned[chosen];
+  result.fitted_rates = fitted_rates[chosen];
+  result.loss_history = after.loss_history;
+  result.train_windows = after.train_windows;
+  result.after = held_out_error(after.model, eval_logs(after.model, state_pbs(after.model)));
+  result.confirmation_channels = result.candidates[chosen].channels;
+  result.confirmation = diebold_mariano(standardised_loss(model, reference, result.confirmation_channels),
+                                        standardised_loss(model, result.after, result.confirmation_channels));
 
   // The residual analysis of the augmented model (in its own frame).
-  ResidualData again = compute_residuals(after, logs, "state");
+  ResidualData again = compute_residuals(after.model, logs, "state");
   // An aux column the model now predicts is no longer an unused channel.
   for (std::size_t a = again.aux_names.size(); a-- > 0;) {
     if (index_of(again.y_names, again.aux_names[a]) < 0) continue;
@@ -214,30 +298,17 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.after.verdict = verdict_text(attribute(again, enumerate_hypotheses(again, lib), attribution.options));
   result.tried = true;
 
-  // The decision: after against the reference on the channels the effect
-  // was found on (the plan's found_on, of the model's own channels): the
-  // aligned, cleaned, clipped, drifting or friction channels; for an aux
-  // channel, the channels its significant hypotheses explain.
-  for (const auto& name : aug->found_on) {
-    if (index_of(model.layout.y_names, name) < 0) continue;
-    if (std::find(result.confirmation_channels.begin(), result.confirmation_channels.end(), name) ==
-        result.confirmation_channels.end())
-      result.confirmation_channels.push_back(name);
-  }
-  const HeldOutError& reference = result.control ? *result.control : result.before;
-  result.reference = result.control ? "fine-tuning alone" : "the unchanged model";
-  result.confirmation = diebold_mariano(standardised_loss(model, reference, result.confirmation_channels),
-                                        standardised_loss(model, result.after, result.confirmation_channels));
   const bool confirmed = result.confirmation.mean > 0 && result.confirmation.p_value < attribution.options.alpha;
   char p[32];
   std::snprintf(p, sizeof p, "%.2g", result.confirmation.p_value);
   if (!confirmed) {
-    result.status = "unexplained structure: adding " + aug->effect + " (" + aug->description + ") did not beat " +
+    const auto& a = *result.augmentation;
+    result.status = "unexplained structure: adding " + a.effect + " (" + a.description + ") did not beat " +
                     result.reference + " on the held-out rows of the channels it was found on (Diebold-Mariano p " +
                     p + ")";
     return result;
   }
-  result.model = std::move(after);
+  result.model = std::move(after.model);
   result.changed = true;
   result.status = "fixed";
   return result;

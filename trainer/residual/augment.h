@@ -42,6 +42,11 @@ struct FixOptions {
   double lr = 1e-3;             // Adam
   std::uint64_t seed = 1;       // window order
   bool control = true;          // also fine-tune without the augmentation (same data, epochs, seed)
+  // How many of the screen's candidates may be tried (plan_candidates): in
+  // the screen's order, each is added and fine-tuned on the first 75 % of
+  // the training rows and judged on the rest against the control; the first
+  // significant there (else the screen's first) goes to the decision.
+  int candidates = 3;
 };
 
 struct Augmentation;
@@ -160,12 +165,14 @@ struct Augmentation {
 // True for the effects --fix implements (those with a plan: all but input-delay).
 bool fix_supported(EffectKind kind);
 
-// The augmentation of the attribution's winner, with its family (the
-// effect's plan, effects.cc). When the winner's effect has no augmentation
-// (input-delay), the best significant hypothesis that has one, and the
-// description says so; when none has, the winner's (fix() then reports "not
-// supported"). None without a winner.
-std::optional<Augmentation> plan_augmentation(const ResidualData& data, const Attribution& attribution);
+// The screen's candidates for --fix: the augmentations (each with its
+// family: the effect's plan, effects.cc) of the significant hypotheses in
+// ranking order whose effect has one, one per distinct augmentation, at most
+// `count`. When the winner's effect has no augmentation (input-delay), the
+// first candidate's description says so; when no significant effect has
+// one, the winner's alone (fix() then reports "not supported"). Empty
+// without a winner.
+std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attribution& attribution, int count);
 
 // The sensor model after adding the augmentation's part (add_to_sensor:
 // delay, cross-talk, drift, clips; the others leave it as it is). A delay
@@ -188,18 +195,33 @@ FeatureLayout augmented_layout(const FeatureLayout& layout, const Augmentation& 
 HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
                              const std::vector<LogSequence>& train_seqs);
 
+// One of the screen's candidates (FixResult::candidates).
+struct CandidateTrial {
+  std::string effect, description;
+  std::vector<std::string> channels;  // where it was found: the decision's channels
+  // The selection on the training rows alone (several candidates, logs long
+  // enough): the control's loss minus the candidate's on the last 25 % of
+  // the training rows, each fine-tuned on the first 75 %.
+  DieboldMariano selection;
+  bool selected_by_training_rows = false;  // false: not judged (logs too short, one candidate, or an earlier one won)
+  bool chosen = false;                     // the candidate the decision tested
+};
+
 // The decision (issue 12, "decide by what the fix does"): the screen only
-// proposes; the augmented, fine-tuned model is kept only when it beats the
-// fine-tune-only control (or, with control off, the unchanged model) on the
-// held-out rows of the channels the effect was found on: a one-sided
-// Diebold-Mariano test (statistics.h) on the per-row standardised squared
-// error, mean over those channels, at the attribution's alpha. Otherwise the
-// status is "unexplained structure" and no model is produced.
+// proposes. Of its first FixOptions::candidates candidates, the first that
+// beats the control significantly on the training rows alone is chosen,
+// else the screen's first (selection: CandidateTrial). The chosen augmented, fine-tuned model is kept only when
+// it beats the fine-tune-only control (or, with control off, the unchanged
+// model) on the held-out rows of the channels its effect was found on: a
+// one-sided Diebold-Mariano test (statistics.h) on the per-row standardised
+// squared error, mean over those channels, at the attribution's alpha (one
+// test: the held-out rows chose nothing). Otherwise the status is
+// "unexplained structure" and no model is produced.
 struct FixResult {
   // "no significant effect", "not supported: ...", "fixed" (confirmed) or
   // "unexplained structure: ..." (tried, not confirmed)
   std::string status;
-  std::optional<Augmentation> augmentation;
+  std::optional<Augmentation> augmentation;  // the candidate kept, or (none confirmed) the screen's first
   bool tried = false;          // the augmented model was fine-tuned and evaluated (after is valid)
   bool changed = false;        // confirmed: a new model was produced
   HadynetModel model;          // the augmented, fine-tuned model (the input model if !changed)
@@ -207,6 +229,7 @@ struct FixResult {
   std::vector<std::string> confirmation_channels;  // where the effect was found (the test's channels)
   std::string reference;                           // "fine-tuning alone" or "the unchanged model"
   DieboldMariano confirmation;                     // reference's loss minus after's (valid if tried)
+  std::vector<CandidateTrial> candidates;          // the screen's candidates, in its order
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
   std::vector<double> fitted_rates;     // drift: the attribution's rate per channel, before refine()
