@@ -12,12 +12,13 @@
 #   cut       the held-out 1-step RMSE on the changed channels (mean ratio
 #             after/before) is at most 0.7;
 #   <control  the augmented model's RMSE there is below fine-tuning alone's.
-# Seeds: 191-200 (never used for training, calibration, development or any
-# other benchmark; 181-184 measured the decision before it tried several
-# candidates; see bench/residual_false_positives.sh for the others).
+# Seeds: 231-240 (never used for training, calibration, development or any
+# other benchmark; 181-184 and 191-192 were development runs of the decision
+# with several candidates; see bench/residual_false_positives.sh for the
+# others).
 #
-# Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
-#   defaults: models/hand.safetensors, build/residual-detection, 10, 191
+# Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
+#   defaults: models/hand.safetensors, build/residual-detection, 10, 231, --candidates 1
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
 set -euo pipefail
@@ -25,7 +26,8 @@ usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
 model=models/hand.safetensors
 out=build/residual-detection
 n=10
-first_seed=191
+first_seed=231
+candidates=()
 while (($#)); do
   case "$1" in
     -h | --help) usage; exit 0 ;;
@@ -33,6 +35,7 @@ while (($#)); do
     --out) out=$2; shift 2 ;;
     --seeds) n=$2; shift 2 ;;
     --first-seed) first_seed=$2; shift 2 ;;
+    --candidates) candidates=(--candidates "$2"); shift 2 ;;
     *) echo "residual_detection: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -56,7 +59,7 @@ for ((k = 0; k < n; ++k)); do
       "$hadynet" collect --object "$1" --motion "$2" --init "$3" --rows 300 --seed "$seed" --out "$d/logs" \
         --effect "$c" --quiet >/dev/null
     done
-    "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 --fix \
+    "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 --fix "${candidates[@]}" \
       --json "$d/residual.json" >"$d/out.txt" 2>&1 || { echo "$c seed $seed: residual failed" >>"$runs"; continue; }
     done_runs=$((done_runs + 1))
     eta=$(( ($(date +%s) - start) * (total - done_runs) / done_runs ))

@@ -11,10 +11,12 @@
 # decision and its rail rule (development; docs/residual.md lists what each
 # showed); 61-80 measured the decision, 121-140 the code after a state id
 # decided its zeroing, 161-180 the same with the plant's rated ranges given
-# (--rated-range; docs/residual.md's table); 141-150 belong to
-# bench/pb_auto_check.sh. Give others as arguments.
+# (--rated-range; docs/residual.md's table), 241-260 the decision trying
+# three candidates (--candidates 3); 141-150 belong to
+# bench/pb_auto_check.sh, 221-240 to the other residual benchmarks. Give
+# others as arguments.
 #
-# Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [SEED...]
+# Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K] [SEED...]
 #   defaults: models/hand.safetensors, build/residual-false-positives, 161..180,
 #   no rated range (the plant's datasheet: --rated-range fc=0..50 --rated-range f=0..200)
 # Environment: HADYNET (default build/release/cli/hadynet).
@@ -31,6 +33,7 @@ while (($#)); do
     --model) model=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --rated-range) ranges+=(--rated-range "$2"); shift 2 ;;
+    --candidates) ranges+=(--candidates "$2"); shift 2 ;;
     -*) echo "residual_false_positives: unknown option $1" >&2; exit 2 ;;
     *) seeds+=("$1"); shift ;;
   esac

@@ -150,7 +150,7 @@ int run_residual(int argc, char** argv) {
   opt.value("candidates", "K", "with --fix: how many of the screen's candidates may be tried: in its order, each added,\n"
                               "fine-tuned on the first 75 % of the training rows and compared with fine-tuning alone\n"
                               "on the rest; the first significant there (else the screen's first) is the one the\n"
-                              "decision tests on the held-out rows", "3");
+                              "decision tests on the held-out rows (1: the screen's winner)", "1");
   opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
                         "unchanged model, a weaker guard)");
   if (!opt.parse(argc, argv)) return 2;

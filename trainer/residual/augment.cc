@@ -45,22 +45,22 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   const auto winner = attribution.winner();
   if (!winner || count < 1) return out;
   // The significant hypotheses whose effect --fix can add, in ranking order,
-  // one per distinct augmentation (a family's members plan the same one: a
-  // delay on fc1 and on fc2 align the same group). A sensor delay on a
+  // one per effect (the best of each, with its family): on fresh logs the
+  // model's own misfit between neighbouring channels can fill the top of the
+  // ranking with pairs of one effect (cross-talk fc1 -> fc2, fc2 -> fc1,
+  // fc4 -> fc3 above a 2-step sensor delay; docs/residual.md). A sensor delay on a
   // channel the commands drive directly leaves nearly the residual of an
   // input delay on that channel alone, so the two can swap places
   // (docs/residual.md): an input-delay winner is skipped and said.
   for (const auto& r : attribution.ranked) {
     if (!r.significant || static_cast<int>(out.size()) >= count) break;
     if (!fix_supported(r.hypothesis.kind)) continue;
+    const bool seen = std::any_of(out.begin(), out.end(), [&](const Augmentation& b) { return b.kind == r.hypothesis.kind; });
+    if (seen) continue;
     Augmentation a;
     a.kind = r.hypothesis.kind;
     a.effect = r.effect;
     effect_info(a.kind).plan(data, attribution, r, a);
-    const bool seen = std::any_of(out.begin(), out.end(), [&](const Augmentation& b) {
-      return b.kind == a.kind && b.description == a.description;
-    });
-    if (seen) continue;
     if (out.empty() && r.label != winner->label)
       a.description = "the winner (" + winner->effect + ": " + winner->label +
                       ") has no augmentation; the best significant effect that has: " + r.label + "; " + a.description;

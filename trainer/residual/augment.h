@@ -45,8 +45,9 @@ struct FixOptions {
   // How many of the screen's candidates may be tried (plan_candidates): in
   // the screen's order, each is added and fine-tuned on the first 75 % of
   // the training rows and judged on the rest against the control; the first
-  // significant there (else the screen's first) goes to the decision.
-  int candidates = 3;
+  // significant there (else the screen's first) goes to the decision. 1: the
+  // screen's winner alone (measured: docs/residual.md, "Detection").
+  int candidates = 1;
 };
 
 struct Augmentation;
@@ -167,7 +168,7 @@ bool fix_supported(EffectKind kind);
 
 // The screen's candidates for --fix: the augmentations (each with its
 // family: the effect's plan, effects.cc) of the significant hypotheses in
-// ranking order whose effect has one, one per distinct augmentation, at most
+// ranking order whose effect has one, the best of each effect, at most
 // `count`. When the winner's effect has no augmentation (input-delay), the
 // first candidate's description says so; when no significant effect has
 // one, the winner's alone (fix() then reports "not supported"). Empty
