@@ -226,9 +226,11 @@ int run_residual(int argc, char** argv) {
     fo.control = !opt.has("no-control");
     fo.candidates = static_cast<int>(*candidates);
 
-    // One round: analyse `current`, fix when asked; returns the fix (if any).
-    // Round 1 reports into --report DIR and --json FILE; round k > 1 into
-    // DIR/round-k (and the JSON's "rounds").
+    // Rounds: each analyses `current` (the model of the last confirmed round)
+    // and fixes when asked; the loop ends at the first round that confirms
+    // nothing. Round 1 reports into --report DIR and --json FILE; round k > 1
+    // into DIR/round-k and the JSON's "rounds". --out holds the last
+    // confirmed round's model, which carries every earlier round's change.
     json rounds_json = json::array();
     auto write_json = [](const json& j, const std::string& path) {
       std::ofstream out(path);
