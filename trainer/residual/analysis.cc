@@ -76,7 +76,7 @@ std::string pb_summary(const ResidualData& data, const std::string& pb_choice) {
   }
   if (replaced > 0) {
     s += sep + logs(replaced) + " with a PB adapted to their state's logs (the state's trained PB predicted "
-                                "their held-out rows worse: re-zeroed or worn since training?)";
+                                "their held-out rows worse: re-zeroed, worn, or grasped unlike the training logs)";
     sep = ", ";
   }
   for (const auto& [source, n] : logs_by_source) {
