@@ -39,12 +39,12 @@ while (($#)); do
   esac
 done
 cd "$(dirname "$0")/.."
+source bench/residual_grasps.sh
 hadynet="${HADYNET:-build/release/cli/hadynet}"
 [[ -x "$hadynet" ]] || { echo "pb_auto_check: $hadynet not found" >&2; exit 2; }
 mkdir -p "$out"
 summary="$out/summary.txt"
 : >"$summary"
-grasps=("Cylinder random2 1" "Ball random2 2" "Gripper random2 0" "Cylinder random1 0")
 effects=(sensor-delay friction crosstalk drift saturation)
 
 # collect_set DIR SEED INIT_OVERRIDE [--effect E]: the four grasps; with an
@@ -53,7 +53,7 @@ collect_set() {
   local dir=$1 seed=$2 init_override=$3
   shift 3
   rm -rf "$dir" && mkdir -p "$dir/logs"
-  for g in "${grasps[@]}"; do
+  for g in "${residual_grasps[@]}"; do
     set -- $g "$@"
     local object=$1 motion=$2 init=$3
     shift 3

@@ -40,6 +40,7 @@ while (($#)); do
   esac
 done
 cd "$(dirname "$0")/.."
+source bench/residual_grasps.sh
 hadynet="${HADYNET:-build/release/cli/hadynet}"
 [[ -x "$hadynet" ]] || { echo "residual_detection: $hadynet not found" >&2; exit 2; }
 mkdir -p "$out"
@@ -54,11 +55,7 @@ for ((k = 0; k < n; ++k)); do
   for c in "${cases[@]}"; do
     d="$out/$c/seed$seed"
     rm -rf "$d" && mkdir -p "$d"
-    for g in "Cylinder random2 1" "Ball random2 2" "Gripper random2 0" "Cylinder random1 0"; do
-      set -- $g
-      "$hadynet" collect --object "$1" --motion "$2" --init "$3" --rows 300 --seed "$seed" --out "$d/logs" \
-        --effect "$c" --quiet >/dev/null
-    done
+    collect_residual_grasps "$hadynet" "$d/logs" "$seed" --effect "$c"
     "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 --fix "${candidates[@]}" \
       --json "$d/residual.json" >"$d/out.txt" 2>&1 || { echo "$c seed $seed: residual failed" >>"$runs"; continue; }
     done_runs=$((done_runs + 1))

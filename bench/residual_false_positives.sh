@@ -39,6 +39,7 @@ while (($#)); do
   esac
 done
 cd "$(dirname "$0")/.."
+source bench/residual_grasps.sh
 ((${#seeds[@]})) || seeds=($(seq 161 180))
 hadynet="${HADYNET:-build/release/cli/hadynet}"
 [[ -x "$hadynet" ]] || { echo "residual_false_positives: $hadynet not found" >&2; exit 2; }
@@ -50,10 +51,7 @@ for seed in "${seeds[@]}"; do
   i=$((i + 1))
   d="$out/seed$seed"
   rm -rf "$d" && mkdir -p "$d/logs"
-  for o in "Cylinder random2 1" "Ball random2 2" "Gripper random2 0" "Cylinder random1 0"; do
-    set -- $o
-    "$hadynet" collect --object "$1" --motion "$2" --init "$3" --rows 300 --seed "$seed" --out "$d/logs" --quiet >/dev/null
-  done
+  collect_residual_grasps "$hadynet" "$d/logs" "$seed"
   # stdout and stderr apart (a file's stdout is block-buffered: interleaved, a
   # line could be cut); the counts come from the JSON, not from the text.
   if ! "$hadynet" residual "$model" "$d/logs" "${ranges[@]}" --fix --json "$d/residual.json" >"$d/out.txt" \

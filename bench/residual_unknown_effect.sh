@@ -28,6 +28,7 @@ while (($#)); do
   esac
 done
 cd "$(dirname "$0")/.."
+source bench/residual_grasps.sh
 hadynet="${HADYNET:-build/release/cli/hadynet}"
 [[ -x "$hadynet" ]] || { echo "residual_unknown_effect: $hadynet not found" >&2; exit 2; }
 mkdir -p "$out"
@@ -38,10 +39,7 @@ for ((k = 0; k < n; ++k)); do
   seed=$((221 + k))
   d="$out/seed$seed"
   rm -rf "$d" && mkdir -p "$d/logs"
-  for g in "Cylinder random2 1" "Ball random2 2" "Gripper random2 0" "Cylinder random1 0"; do
-    set -- $g
-    "$hadynet" collect --object "$1" --motion "$2" --init "$3" --rows 300 --seed "$seed" --out "$d/raw" --quiet >/dev/null
-  done
+  collect_residual_grasps "$hadynet" "$d/raw" "$seed"
   # The curve, on the recorded values (comments and header kept).
   python3 - "$d/raw" "$d/logs" <<'PY'
 import glob, os, sys

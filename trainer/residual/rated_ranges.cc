@@ -1,9 +1,9 @@
 #include "trainer/residual/rated_ranges.h"
 
 #include <algorithm>
-#include <cmath>
 #include <stdexcept>
 
+#include "datalog/log_rules.h"
 #include "trainer/log_dataset.h"
 
 namespace hadynet::trainer::residual {
@@ -12,15 +12,8 @@ namespace {
 
 std::optional<double> parse_bound(const std::string& text, const std::string& whole) {
   if (text.empty()) return std::nullopt;
-  std::size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != text.size() || !std::isfinite(v))
-    throw std::invalid_argument("rated range '" + whole + "': '" + text + "' is not a number");
+  const std::optional<double> v = datalog::rules::parse_finite_number(text);
+  if (!v) throw std::invalid_argument("rated range '" + whole + "': '" + text + "' is not a number");
   return v;
 }
 
