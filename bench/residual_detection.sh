@@ -15,15 +15,19 @@
 # Seeds: 231-240 (never used for training, calibration, development or any
 # other benchmark; 181-184 and 191-192 were development runs of the decision
 # with several candidates; see bench/residual_false_positives.sh for the
-# others).
+# others). With a calibrated null (--reference-seed 270, the clean sets of
+# that seed): seeds 291-300; its floor was chosen on development effect
+# logs of seeds 181-184.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
-#   defaults: models/hand.safetensors, build/residual-detection, 10, 231, --candidates 1
+#          [--reference-seed S]
+#   defaults: models/hand.safetensors, build/residual-detection, 10, 231, --candidates 1, no null
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
 set -euo pipefail
 usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
 model=models/hand.safetensors
+reference_seed=
 out=build/residual-detection
 n=10
 first_seed=231
@@ -32,6 +36,7 @@ while (($#)); do
   case "$1" in
     -h | --help) usage; exit 0 ;;
     --model) model=$2; shift 2 ;;
+    --reference-seed) reference_seed=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --seeds) n=$2; shift 2 ;;
     --first-seed) first_seed=$2; shift 2 ;;
@@ -44,6 +49,7 @@ source bench/residual_grasps.sh
 hadynet="${HADYNET:-build/release/cli/hadynet}"
 [[ -x "$hadynet" ]] || { echo "residual_detection: $hadynet not found" >&2; exit 2; }
 mkdir -p "$out"
+record_reference "$hadynet" "$out" "$reference_seed"
 runs="$out/runs.txt"
 : >"$runs"
 # effect=strength, weaker first; the second is the larger strength.
@@ -56,7 +62,8 @@ for ((k = 0; k < n; ++k)); do
     d="$out/$c/seed$seed"
     rm -rf "$d" && mkdir -p "$d"
     collect_residual_grasps "$hadynet" "$d/logs" "$seed" --effect "$c"
-    "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 --fix "${candidates[@]}" \
+    "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 "${reference_args[@]}" --fix \
+      "${candidates[@]}" \
       --json "$d/residual.json" >"$d/out.txt" 2>&1 || { echo "$c seed $seed: residual failed" >>"$runs"; continue; }
     done_runs=$((done_runs + 1))
     eta=$(( ($(date +%s) - start) * (total - done_runs) / done_runs ))

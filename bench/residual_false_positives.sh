@@ -13,17 +13,24 @@
 # decided its zeroing, 161-180 the same with the plant's rated ranges given
 # (--rated-range; docs/residual.md's table), 241-260 the decision trying
 # three candidates (--candidates 3); 141-150 belong to
-# bench/pb_auto_check.sh, 221-240 to the other residual benchmarks. Give
-# others as arguments.
+# bench/pb_auto_check.sh, 221-240 to the other residual benchmarks.
+# With a calibrated null (--reference-seed): seed 11's clean sets were the
+# null and 13-16 (clean) the development logs its floor was chosen on;
+# seed 270 is the null of the measurement and 271-290 the measured sets.
+# Give others as arguments.
 #
-# Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K] [SEED...]
+# Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
+#          [--reference-seed S] [SEED...]
 #   defaults: models/hand.safetensors, build/residual-false-positives, 161..180,
-#   no rated range (the plant's datasheet: --rated-range fc=0..50 --rated-range f=0..200)
+#   no rated range (the plant's datasheet: --rated-range fc=0..50 --rated-range f=0..200),
+#   no calibrated null (--reference-seed S: clean sets of the four grasps recorded with seed S
+#   are the null, `hadynet residual --reference`)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per seed with an ETA, then the counts; OUT/summary.txt.
 set -euo pipefail
 usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
 model=models/hand.safetensors
+reference_seed=
 out=build/residual-false-positives
 seeds=()
 ranges=()
@@ -31,6 +38,7 @@ while (($#)); do
   case "$1" in
     -h | --help) usage; exit 0 ;;
     --model) model=$2; shift 2 ;;
+    --reference-seed) reference_seed=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --rated-range) ranges+=(--rated-range "$2"); shift 2 ;;
     --candidates) ranges+=(--candidates "$2"); shift 2 ;;
@@ -44,6 +52,7 @@ source bench/residual_grasps.sh
 hadynet="${HADYNET:-build/release/cli/hadynet}"
 [[ -x "$hadynet" ]] || { echo "residual_false_positives: $hadynet not found" >&2; exit 2; }
 mkdir -p "$out"
+record_reference "$hadynet" "$out" "$reference_seed"
 summary="$out/summary.txt"
 : >"$summary"
 screened=0 confirmed=0 i=0 start=$(date +%s)
@@ -54,7 +63,7 @@ for seed in "${seeds[@]}"; do
   collect_residual_grasps "$hadynet" "$d/logs" "$seed"
   # stdout and stderr apart (a file's stdout is block-buffered: interleaved, a
   # line could be cut); the counts come from the JSON, not from the text.
-  if ! "$hadynet" residual "$model" "$d/logs" "${ranges[@]}" --fix --json "$d/residual.json" >"$d/out.txt" \
+  if ! "$hadynet" residual "$model" "$d/logs" "${ranges[@]}" "${reference_args[@]}" --fix --json "$d/residual.json" >"$d/out.txt" \
     2>"$d/err.txt"; then
     echo "seed $seed: hadynet residual failed: $(tail -1 "$d/err.txt")" | tee -a "$summary"
     continue

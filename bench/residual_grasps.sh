@@ -16,3 +16,15 @@ collect_residual_grasps() {
     shift 3
   done
 }
+
+# record_reference HADYNET OUT SEED: clean log sets of the four grasps with
+# SEED in OUT/reference, the calibrated null of `hadynet residual --reference`
+# (docs/residual.md, "A calibrated null"), and sets reference_args to the
+# options that use it. With SEED empty, reference_args is empty (no null).
+record_reference() {
+  reference_args=()
+  [[ -n "$3" ]] || return 0
+  rm -rf "$2/reference"
+  collect_residual_grasps "$1" "$2/reference" "$3"
+  reference_args=(--reference "$2/reference")
+}

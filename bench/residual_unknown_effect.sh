@@ -7,23 +7,29 @@
 # logs of the four grasps of docs/residual.md after recording. The library
 # has no static nonlinearity; the nearest classes are a gain (none), a rail,
 # a drift or a cross-talk. Run with the plant's rated ranges.
-# Seeds: 221-230 (never used elsewhere; see bench/residual_false_positives.sh).
+# Seeds: 221-230 (never used elsewhere; see bench/residual_false_positives.sh);
+# with the calibrated null of seed 270 (--reference-seed 270): 301-310.
 #
-# Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N]
-#   defaults: models/hand.safetensors, build/residual-unknown-effect, 10
+# Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
+#          [--reference-seed S]
+#   defaults: models/hand.safetensors, build/residual-unknown-effect, 10, 221, no calibrated null
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per log set with an ETA, then the counts (OUT/summary.txt).
 set -euo pipefail
 usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
 model=models/hand.safetensors
+reference_seed=
 out=build/residual-unknown-effect
 n=10
+first_seed=221
 while (($#)); do
   case "$1" in
     -h | --help) usage; exit 0 ;;
     --model) model=$2; shift 2 ;;
+    --reference-seed) reference_seed=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --seeds) n=$2; shift 2 ;;
+    --first-seed) first_seed=$2; shift 2 ;;
     *) echo "residual_unknown_effect: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -32,11 +38,12 @@ source bench/residual_grasps.sh
 hadynet="${HADYNET:-build/release/cli/hadynet}"
 [[ -x "$hadynet" ]] || { echo "residual_unknown_effect: $hadynet not found" >&2; exit 2; }
 mkdir -p "$out"
+record_reference "$hadynet" "$out" "$reference_seed"
 summary="$out/summary.txt"
 : >"$summary"
 start=$(date +%s)
 for ((k = 0; k < n; ++k)); do
-  seed=$((221 + k))
+  seed=$((first_seed + k))
   d="$out/seed$seed"
   rm -rf "$d" && mkdir -p "$d/logs"
   collect_residual_grasps "$hadynet" "$d/raw" "$seed"
@@ -56,7 +63,7 @@ for path in glob.glob(os.path.join(src, "*", "*.csv")):
         lines[i] = ",".join(v)
     open(os.path.join(dst, os.path.basename(path)), "w").write("\n".join(lines) + "\n")
 PY
-  "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 --fix \
+  "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 "${reference_args[@]}" --fix \
     --json "$d/residual.json" >"$d/out.txt" 2>"$d/err.txt" ||
     { echo "seed $seed: residual failed: $(tail -1 "$d/err.txt")" | tee -a "$summary"; continue; }
   eta=$(( ($(date +%s) - start) * (n - k - 1) / (k + 1) ))

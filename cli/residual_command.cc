@@ -44,12 +44,19 @@ void print_summary(const rs::Analysis& a, const std::string& pb_choice, bool fix
                 a.horizon.rmse(r, 0), a.horizon.fit(r, H), a.horizon.rmse(r, H), a.whiteness[c].ljung_box.p_value,
                 a.whiteness[c].white() ? "yes" : "no");
   }
+  std::printf("%s\n", rs::floors_summary(a).c_str());
   std::printf("\n%ld hypotheses tested; top of the ranking:\n", a.attribution.tested);
   for (std::size_t i = 0; i < a.attribution.ranked.size() && i < 10; ++i) {
     const auto& r = a.attribution.ranked[i];
-    std::printf("  %c %-62s explained %6.3f (std %.4f)  p(Holm) %.2g  %s\n", r.significant ? '*' : ' ',
-                r.label.c_str(), r.explained, r.explained_std, r.p_adjusted,
-                rs::hypothesis_status(r, a.attribution.options));
+    if (a.attribution.null)
+      std::printf("  %c %-62s explained %6.3f (std %.4f, null %.4f: %.2f x clean)  p(Holm) %.2g  %s\n",
+                  r.significant ? '*' : ' ', r.label.c_str(), r.explained, r.explained_std, r.null_explained_std,
+                  r.excess_share, r.p_adjusted,
+                  rs::hypothesis_status(r, a.attribution.options));
+    else
+      std::printf("  %c %-62s explained %6.3f (std %.4f)  p(Holm) %.2g  %s\n", r.significant ? '*' : ' ',
+                  r.label.c_str(), r.explained, r.explained_std, r.p_adjusted,
+                  rs::hypothesis_status(r, a.attribution.options));
   }
   std::printf("\nverdict: %s\n", a.verdict.c_str());
   if (a.attribution.winner() && !fixing)
@@ -126,7 +133,15 @@ int run_residual(int argc, char** argv) {
   opt.value("alpha", "A", "family-wise error rate of the Holm-corrected tests", "0.01");
   opt.value("min-explained", "S", "floor: share of the held-out residual variance an effect must explain", "0.1");
   opt.value("min-explained-std", "V",
-            "floor: held-out explained variance in standardised units (drop of the channel's 1-step loss)", "0.05");
+            "floor without --reference: held-out explained variance in standardised units (drop of the channel's\n"
+            "1-step loss; the default was set on the hand's models)", "0.05");
+  opt.repeated("reference", "LOG|DIR",
+               "clean logs of the same channels for a calibrated null: neither the model's training logs nor the\n"
+               "logs under test (e.g. validation logs recorded with them). Every hypothesis is also tested there;\n"
+               "an effect must then explain more than on the null by --min-excess-null times its channel's clean\n"
+               "residual level (replacing --min-explained-std), so the floors follow the model's own scale");
+  opt.value("min-excess-null", "S", "with --reference: how many times its channel's clean residual level an effect must\n"
+                                     "explain beyond the null", num("%g", rs::kDefaultMinExcessNull));
   opt.flag("all-sources", "cross-talk sources from every observed group (default: the target's group)");
   opt.repeated("rated-range", "NAME=LOW..HIGH",
                "a sensor's rated range (datasheet) for an output group or channel, e.g. fc=0..50: the predictions\n"
@@ -165,12 +180,17 @@ int run_residual(int argc, char** argv) {
   const auto alpha = opt.get_double("alpha", 1e-12, 0.5);
   const auto min_share = opt.get_double("min-explained", 0.0, 1.0);
   const auto min_std = opt.get_double("min-explained-std", 0.0, 1e6);
+  const auto min_excess = opt.get_double("min-excess-null", 0.0, 1e6);
   std::optional<long long> horizon;
   if (opt.has("horizon")) {
     horizon = opt.get_int("horizon", 1, 1000);
     if (!horizon) return 2;
   }
-  if (!max_lag || !max_delay || !fraction || !alpha || !min_share || !min_std) return 2;
+  if (!max_lag || !max_delay || !fraction || !alpha || !min_share || !min_std || !min_excess) return 2;
+  if (opt.has("min-excess-null") && opt.all("reference").empty()) {
+    std::fprintf(stderr, "hadynet residual: --min-excess-null needs --reference\n");
+    return 2;
+  }
   const auto fix_epochs = opt.get_int("fix-epochs", 1, 100000);
   const auto fix_lr = opt.get_double("fix-lr", 1e-12, 10.0);
   const auto fix_seed = opt.get_int("fix-seed", 0, (1ll << 62));
@@ -206,6 +226,15 @@ int run_residual(int argc, char** argv) {
     const std::vector<std::string> args(opt.positional().begin() + 1, opt.positional().end());
     std::vector<rs::LogInput> inputs;
     for (const auto& path : trainer::expand_log_paths(args)) inputs.push_back({datalog::read_log(path), path});
+    std::vector<rs::LogInput> reference;
+    if (!opt.all("reference").empty()) {
+      for (const auto& path : trainer::expand_log_paths(opt.all("reference"))) {
+        for (const auto& in : inputs)
+          if (std::filesystem::equivalent(in.file, path))
+            throw std::invalid_argument("--reference " + path + " is also a log under test; a null must be other logs");
+        reference.push_back({datalog::read_log(path), path});
+      }
+    }
 
     rs::AnalysisOptions ao;
     ao.pb_choice = opt.get("pb");
@@ -217,6 +246,7 @@ int run_residual(int argc, char** argv) {
     ao.attribution.alpha = *alpha;
     ao.attribution.min_explained = *min_share;
     ao.attribution.min_explained_std = *min_std;
+    ao.attribution.min_excess_null = *min_excess;
     const std::string& pb_choice = ao.pb_choice;
     rs::FixOptions fo;
     fo.train_fraction = *fraction;
@@ -225,6 +255,7 @@ int run_residual(int argc, char** argv) {
     fo.seed = static_cast<std::uint64_t>(*fix_seed);
     fo.control = !opt.has("no-control");
     fo.candidates = static_cast<int>(*candidates);
+    fo.reference = &reference;
 
     // Rounds: each analyses `current` (the model of the last confirmed round)
     // and fixes when asked; the loop ends at the first round that confirms
@@ -248,10 +279,11 @@ int run_residual(int argc, char** argv) {
     json first_json;
     for (int round = 1; round <= round_count; ++round) {
       if (round > 1) std::printf("\n=== round %d: the model fixed in round %d, on the same logs ===\n", round, round - 1);
-      const rs::Analysis a = rs::analyse(current, inputs, ao);
+      const rs::Analysis a = rs::analyse(current, inputs, ao, reference);
       print_summary(a, pb_choice, opt.has("fix"));
       json j = analysis_json(a, current_path, pb_choice);
       j["rated_ranges"] = opt.all("rated-range");
+      j["reference"] = opt.all("reference");
       std::optional<rs::FixResult> fixed;
       std::string round_written;
       if (opt.has("fix")) {

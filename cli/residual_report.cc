@@ -30,6 +30,9 @@ json hypothesis_json(const rs::ResidualData& data, const rs::HypothesisResult& r
             {"explained", r.explained},
             {"explained_train", r.explained_train},
             {"explained_std", r.explained_std},
+            {"null_explained_std", r.null_explained_std},
+            {"excess_std", r.excess_std},
+            {"excess_share", r.excess_share},
             {"t", r.t_stat},
             {"p_value", r.p_value},
             {"p_adjusted", r.p_adjusted},
@@ -115,6 +118,13 @@ nlohmann::json analysis_json(const rs::Analysis& a, const std::string& model_pat
                        {"augmentation", e.augmentation}});
   }
   const auto w = att.winner();
+  json null_json = nullptr;
+  if (att.null) {
+    json level = json::object();
+    for (std::size_t c = 0; c < d.y_names.size(); ++c)
+      level[d.y_names[c]] = att.null->residual_level(static_cast<Eigen::Index>(c));
+    null_json = {{"logs", att.null->logs}, {"pb_summary", a.reference_pb}, {"residual_level", level}};
+  }
   return {{"model", model_path},
           {"pb", pb_choice},
           {"pb_summary", rs::pb_summary(d, pb_choice)},
@@ -133,6 +143,9 @@ nlohmann::json analysis_json(const rs::Analysis& a, const std::string& model_pat
             {"alpha", att.options.alpha},
             {"min_explained", att.options.min_explained},
             {"min_explained_std", att.options.min_explained_std},
+            {"min_excess_null", att.options.min_excess_null},
+            {"null", null_json},
+            {"floors", rs::floors_summary(a)},
             {"tested", att.tested},
             {"winner", w ? hypothesis_json(d, *w) : json(nullptr)},
             {"winner_family", family},
@@ -217,24 +230,30 @@ std::string ranking_plot(const rs::Analysis& a, const std::string& png) {
   std::vector<const rs::HypothesisResult*> top;
   for (const auto& r : ranked)
     if (r.testable) top.push_back(&r);
-  std::stable_sort(top.begin(), top.end(), [](auto* x, auto* y) { return x->explained_std > y->explained_std; });
+  const auto stat = [&a](const rs::HypothesisResult* r) { return rs::floor_statistic(a.attribution, *r); };
+  std::stable_sort(top.begin(), top.end(), [&stat](auto* x, auto* y) { return stat(x) > stat(y); });
   if (top.size() > 20) top.resize(20);
   std::string s = "$b << EOD\n";
   for (std::size_t i = 0; i < top.size(); ++i) {
     std::string label = top[i]->label;
     for (char& ch : label)
       if (ch == '"') ch = '\'';
-    s += std::to_string(i) + " " + num("%.6g", std::max(0.0, top[i]->explained_std)) + " " +
+    s += std::to_string(i) + " " + num("%.6g", std::max(0.0, stat(top[i]))) + " " +
          (top[i]->significant ? "1" : "0") + " \"" + label + "\"\n";
   }
   s += "EOD\n";
   s += "set terminal pngcairo size 1400,700 font 'sans,9' noenhanced\nset output " + gnuplot_quote(png) + "\n";
-  s += "set title " + gnuplot_quote("hypotheses by held-out explained variance (standardised units); green: significant "
-                                    "(Holm-corrected p < " + num("%g", a.attribution.options.alpha) + ", above both floors)") + "\n";
+  const bool null = a.attribution.null.has_value();
+  s += "set title " + gnuplot_quote(std::string(null ? "hypotheses by held-out explained variance beyond the calibrated null, "
+                                                            "in the channel's clean residual levels"
+                                                     : "hypotheses by held-out explained variance (standardised units)") +
+                                    "; green: significant (Holm-corrected p < " +
+                                    num("%g", a.attribution.options.alpha) + ", above both floors)") + "\n";
   s += "set style fill solid 0.8\nset boxwidth 0.7\nset grid x\nset yrange [" + std::to_string(top.size()) +
        ":-1]\nset ytics font 'sans,8'\nset key off\n";
-  s += "set arrow from " + num("%g", a.attribution.options.min_explained_std) + ",-1 to " +
-       num("%g", a.attribution.options.min_explained_std) + "," + std::to_string(top.size()) + " nohead dt 2 lc rgb 'red'\n";
+  const double floor = rs::floor_of(a.attribution.options, null);
+  s += "set arrow from " + num("%g", floor) + ",-1 to " + num("%g", floor) + "," + std::to_string(top.size()) +
+       " nohead dt 2 lc rgb 'red'\n";
   s += "plot $b using (0.5*$2):1:(0.5*$2):(0.35):($3 > 0 ? 0x2ca02c : 0x999999):ytic(4) with boxxyerror lc rgb variable\n";
   return run_gnuplot(s, png);
 }
@@ -294,14 +313,20 @@ std::string markdown(const rs::Analysis& a, const std::string& model_path, const
        " % of each log and tested on the rest: one-sided t-test of the whitened held-out residual on the fixed "
        "prediction, Holm-corrected over the " + std::to_string(att.tested) + " testable hypotheses (alpha " +
        num("%g", att.options.alpha) + "). Significant also requires a held-out explained share >= " +
-       num("%g", att.options.min_explained) + " and >= " + num("%g", att.options.min_explained_std) +
-       " in standardised units. Ranked by the latter.\n\n"
-       "| rank | hypothesis | effect | held-out explained (share) | standardised | train share | t | p (Holm) | status |\n"
-       "|---|---|---|---|---|---|---|---|---|\n";
+       num("%g", att.options.min_explained) +
+       (att.null ? " and, beyond what the same hypothesis explains on the calibrated null, >= " +
+                       num("%g", att.options.min_excess_null) +
+                       " times its channel's clean residual level there. Ranked by that excess. " +
+                       rs::floors_summary(a) + ".\n\n"
+                 : " and >= " + num("%g", att.options.min_explained_std) +
+                       " in standardised units. Ranked by the latter. " + rs::floors_summary(a) + ".\n\n") +
+       "| rank | hypothesis | effect | held-out explained (share) | standardised | on the null | excess / clean level | train share | t | p (Holm) | status |\n"
+       "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (std::size_t i = 0; i < att.ranked.size() && i < 20; ++i) {
     const auto& r = att.ranked[i];
     m += "| " + std::to_string(i + 1) + " | " + r.label + " | " + r.effect + " | " + num("%.3f", r.explained) + " | " +
-         num("%.4f", r.explained_std) + " | " + num("%.3f", r.explained_train) + " | " + num("%.1f", r.t_stat) + " | " +
+         num("%.4f", r.explained_std) + " | " + (att.null ? num("%.4f", r.null_explained_std) : std::string("-")) +
+         " | " + (att.null ? num("%.2f", r.excess_share) : std::string("-")) + " | " + num("%.3f", r.explained_train) + " | " + num("%.1f", r.t_stat) + " | " +
          num("%.2g", r.p_adjusted) + " | " + rs::hypothesis_status(r, att.options) + " |\n";
   }
   m += "\n## Effect library\n\n| effect | feature test | parameter | augmentation (--fix) |\n|---|---|---|---|\n";

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <stdexcept>
 
 namespace hadynet::trainer::residual {
 namespace {
@@ -174,6 +175,92 @@ TEST(Attribution, ConstantRegressorIsNotTestable) {
   const HypothesisResult r = test_hypothesis(d, {EffectKind::kFriction, 0, 0, 0, 0, 0}, {});
   EXPECT_FALSE(r.testable);
   EXPECT_EQ(r.p_value, 1.0);
+}
+
+
+// ---- The calibrated null (attribution.h; docs/residual.md, "A calibrated null") ----
+
+// The residual of a system whose model is very good (noise sd 0.001, as the
+// Cascaded Tanks' whole 1-step residual is about 0.0025 standardised units)
+// with a1 reported 2 steps late at the same tiny scale.
+ResidualData scaled(std::uint64_t seed, double scale, bool delayed) {
+  return synthetic(seed, [&](ResidualLog& log) {
+    log.r *= scale;
+    if (!delayed) return;
+    for (Eigen::Index j = 2; j < log.r.cols(); ++j) log.r(1, j) += scale * (log.y_hat(1, j - 2) - log.y_hat(1, j));
+  });
+}
+
+Attribution run_with_null(const ResidualData& d, const ResidualData& reference) {
+  const auto hypotheses = enumerate_hypotheses(d, {});
+  const NullCalibration null = calibrate_null(d, reference, hypotheses, {});
+  return attribute(d, hypotheses, {}, &null);
+}
+
+// The issue-12 finding on measured data: an absolute floor in standardised
+// units can never be reached by a model whose whole residual is far below
+// it. Relative to the model's residual on a clean null, the same effect is
+// named, and the verdict does not depend on the scale: excess_share is a
+// ratio of variances of the same units (equal to 1e-9 relative: rounding).
+TEST(CalibratedNull, AnEffectOfATinyResidualIsNamedRelativeToTheNullAtAnyScale) {
+  const Attribution absolute = run(scaled(21, 0.01, true));
+  ASSERT_FALSE(absolute.ranked.empty());
+  EXPECT_LT(absolute.ranked.front().p_adjusted, 1e-6);  // the structure is there...
+  EXPECT_FALSE(absolute.winner().has_value());          // ...and under the absolute floor
+  double share[2] = {0, 0};
+  const double scales[2] = {0.01, 1.0};
+  for (int i = 0; i < 2; ++i) {
+    const Attribution a = run_with_null(scaled(21, scales[i], true), scaled(22, scales[i], false));
+    ASSERT_TRUE(a.null.has_value());
+    ASSERT_TRUE(a.winner().has_value()) << "scale " << scales[i];
+    EXPECT_EQ(a.winner()->hypothesis.kind, EffectKind::kSensorDelay);
+    EXPECT_EQ(a.winner()->hypothesis.delay, 2);
+    EXPECT_EQ(a.winner()->hypothesis.target, 1);
+    share[i] = a.winner()->excess_share;
+  }
+  EXPECT_GT(share[0], kDefaultMinExcessNull);
+  EXPECT_NEAR(share[0] / share[1], 1.0, 1e-9);
+}
+
+// Clean data on both sides: nothing passes the relative floor (white noise
+// has no structure; three seeds).
+TEST(CalibratedNull, CleanLogsAgainstACleanNullGiveNothing) {
+  for (std::uint64_t seed : {23, 24, 25}) {
+    const Attribution a = run_with_null(scaled(seed, 0.01, false), scaled(seed + 10, 0.01, false));
+    EXPECT_FALSE(a.winner().has_value()) << "seed " << seed << ": " << a.ranked.front().label;
+  }
+}
+
+// Structure the model shows on its clean null as well (a misfit of the
+// model, a rail the sensor really has) is the null, not an effect: a
+// friction-like residual on a0 in both wins without a null and is discounted
+// with it (what it explains on the null is subtracted).
+TEST(CalibratedNull, StructureTheNullAlsoShowsIsNoEffect) {
+  const auto friction = [](ResidualLog& log) {
+    double state = 0;
+    for (Eigen::Index j = 0; j < log.r.cols(); ++j) {
+      const double u = log.seq.u(1, ResidualLog::row(static_cast<int>(j)) - 1);
+      if (u != 0) state = u > 0 ? 1 : -1;
+      log.r(0, j) += -0.3 * state;
+    }
+  };
+  const ResidualData test = synthetic(26, friction);
+  const Attribution without = run(test);
+  ASSERT_TRUE(without.winner().has_value());
+  EXPECT_EQ(without.winner()->hypothesis.kind, EffectKind::kFriction);
+  const Attribution with = run_with_null(test, synthetic(27, friction));
+  EXPECT_FALSE(with.winner().has_value()) << with.ranked.front().label;
+  for (const auto& r : with.ranked) {
+    if (r.hypothesis.kind != EffectKind::kFriction || r.hypothesis.target != 0 || r.hypothesis.source != 1) continue;
+    EXPECT_GT(r.null_explained_std, 0.5 * r.explained_std);
+  }
+}
+
+TEST(CalibratedNull, AReferenceWithOtherChannelsIsRefused) {
+  const ResidualData d = scaled(28, 1.0, false);
+  ResidualData other = scaled(29, 1.0, false);
+  other.y_names = {"a0", "b1"};
+  EXPECT_THROW(calibrate_null(d, other, enumerate_hypotheses(d, {}), {}), std::invalid_argument);
 }
 
 }  // namespace

@@ -264,5 +264,41 @@ TEST(RatedRange, AKnownRatedFloorIsNotAnEffect) {
   EXPECT_EQ(n_after, 0);
 }
 
+
+// The calibrated null (docs/residual.md, "A calibrated null"): clean logs of
+// the same four grasps recorded with seed 12 (development data) are the
+// null; the floors are relative to the model's residual there.
+const std::vector<trainer::residual::LogInput>& null_logs() {
+  static const auto logs = plant_logs("", 300, 12);
+  return logs;
+}
+
+// Seed 64's confirmed false positive without rated ranges was a contact-free
+// loadcell's real floor at 0 N (RatedRange above): the clean null shows the
+// same floor, so with it nothing is significant, with no rated range given.
+TEST(CalibratedNull, ASensorsRealFloorIsTheNullNotAnEffect) {
+  namespace rs = trainer::residual;
+  const auto logs = plant_logs("", 300, 64);
+  const rs::Analysis without = rs::analyse(build_model(), logs, {});
+  ASSERT_TRUE(without.attribution.winner().has_value()) << "seed 64 no longer shows its floor";
+  const rs::Analysis with = rs::analyse(build_model(), logs, {}, null_logs());
+  ASSERT_TRUE(with.attribution.null.has_value());
+  std::printf("seed 64: without a null: %s; with: %s\n", without.verdict.c_str(), with.verdict.c_str());
+  EXPECT_FALSE(with.attribution.winner().has_value()) << with.verdict;
+}
+
+// An effect beyond the null is still named: friction of 4 N on the tendons
+// (the effect logs of the other tests), on a tension with its own muscle.
+TEST(CalibratedNull, FrictionBeyondTheNullIsNamedOnATension) {
+  namespace rs = trainer::residual;
+  const rs::Analysis a = rs::analyse(build_model(), plant_logs("friction=4"), {}, null_logs());
+  std::printf("friction=4 with the null: %s\n", a.verdict.c_str());
+  ASSERT_TRUE(a.attribution.winner().has_value());
+  const auto w = *a.attribution.winner();
+  EXPECT_EQ(w.hypothesis.kind, EffectKind::kFriction);
+  EXPECT_EQ(channel_group(a.data.y_names[static_cast<std::size_t>(w.hypothesis.target)]), "f");
+  EXPECT_GE(w.excess_share, kDefaultMinExcessNull);
+}
+
 }  // namespace
 }  // namespace hadynet::test

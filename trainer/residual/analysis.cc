@@ -1,11 +1,13 @@
 #include "trainer/residual/analysis.h"
 
+#include <cstdio>
 #include <map>
 #include <stdexcept>
 
 namespace hadynet::trainer::residual {
 
-Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, const AnalysisOptions& options) {
+Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, const AnalysisOptions& options,
+                 const std::vector<LogInput>& reference) {
   Analysis a;
   a.max_lag = options.max_lag;
   a.data = compute_residuals(model, logs, options.pb_choice);
@@ -28,9 +30,35 @@ Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, c
     for (std::size_t j = 0; j < ny; ++j)
       if (j != c) a.with_observed[c][j] = cross_correlate(r, observed[j], a.max_lag);
   }
-  a.attribution = attribute(d, enumerate_hypotheses(d, options.library), options.attribution);
+  const std::vector<Hypothesis> hypotheses = enumerate_hypotheses(d, options.library);
+  if (reference.empty()) {
+    a.attribution = attribute(d, hypotheses, options.attribution);
+  } else {
+    const ResidualData ref = compute_residuals(model, reference, options.pb_choice);
+    a.reference_pb = pb_summary(ref, options.pb_choice);
+    const NullCalibration null = calibrate_null(d, ref, hypotheses, options.attribution);
+    a.attribution = attribute(d, hypotheses, options.attribution, &null);
+  }
   a.verdict = verdict_text(a.attribution);
   return a;
+}
+
+std::string floors_summary(const Analysis& a) {
+  const auto& o = a.attribution.options;
+  char buf[512];
+  if (!a.attribution.null) {
+    std::snprintf(buf, sizeof buf,
+                  "floors: no calibrated null (--reference): absolute floors assumed, an effect must lower its "
+                  "channel's standardised 1-step loss by >= %g (set for the hand's models) and explain >= %g of "
+                  "its held-out residual variance",
+                  o.min_explained_std, o.min_explained);
+    return buf;
+  }
+  std::snprintf(buf, sizeof buf,
+                "floors: calibrated null of %ld reference logs (%s): an effect must explain >= %g times its "
+                "channel's clean residual level more than on the null, and >= %g of its held-out residual variance",
+                a.attribution.null->logs, a.reference_pb.c_str(), o.min_excess_null, o.min_explained);
+  return buf;
 }
 
 std::string verdict_text(const Attribution& attribution) {
@@ -98,7 +126,8 @@ const HypothesisResult* hypothesis_to_show(const Attribution& attribution) {
   if (!attribution.ranked.empty() && attribution.ranked.front().significant) return &attribution.ranked.front();
   const HypothesisResult* best = nullptr;
   for (const auto& r : attribution.ranked)
-    if (r.testable && (best == nullptr || r.explained_std > best->explained_std)) best = &r;
+    if (r.testable && (best == nullptr || floor_statistic(attribution, r) > floor_statistic(attribution, *best)))
+      best = &r;
   return best;
 }
 

@@ -33,14 +33,24 @@ struct Analysis {
   std::vector<Whiteness> whiteness;                         // per y channel
   std::vector<std::vector<CrossCorrelation>> with_inputs;    // [c][j]: residual of y_c with u_j
   std::vector<std::vector<CrossCorrelation>> with_observed;  // [c][j]: with y_j (j != c; [c][c] empty)
-  Attribution attribution;
+  Attribution attribution;  // with attribution.null when reference logs were given
+  std::string reference_pb;  // with reference logs: pb_summary() of the reference
   std::string verdict;  // verdict_text(attribution)
 };
 
-// Runs the whole analysis. Throws std::runtime_error naming the log or the
+// Runs the whole analysis. With `reference` logs (clean, the same channels;
+// never the model's training data nor `logs`), the floors are calibrated on
+// them (calibrate_null(), attribution.h); without, the absolute floors of
+// options.attribution hold. Throws std::runtime_error naming the log or the
 // bad PB text (compute_residuals), or when the model's prediction is not
-// finite on these logs (never a table of NaN with a verdict under it).
-Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, const AnalysisOptions& options);
+// finite on these logs (never a table of NaN with a verdict under it);
+// std::invalid_argument when the reference's channels differ.
+Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, const AnalysisOptions& options,
+                 const std::vector<LogInput>& reference = {});
+
+// What the floors of an analysis were, in words: the calibrated null (logs,
+// PBs) or the absolute floors assumed without one.
+std::string floors_summary(const Analysis& analysis);
 
 // The one wording of a verdict: "no significant effect", or
 // "<effect>: <winner's label>; also significant: <label>, ..." listing the
@@ -59,8 +69,8 @@ std::string pb_summary(const ResidualData& data, const std::string& pb_choice);
 const char* hypothesis_status(const HypothesisResult& result, const AttributionOptions& options);
 
 // The hypothesis a report shows in detail: the winner when there is one,
-// else the testable hypothesis that explains most in standardised units
-// (labelled "not significant"); nullptr when nothing was testable.
+// else the testable hypothesis with the largest floor_statistic() (explained
+// in standardised units, or beyond the null; labelled "not significant"); nullptr when nothing was testable.
 const HypothesisResult* hypothesis_to_show(const Attribution& attribution);
 
 // The fitted prediction Z beta of a hypothesis, per log (0 where the

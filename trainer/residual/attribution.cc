@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <stdexcept>
 
 #include "trainer/residual/statistics.h"
 
@@ -196,13 +197,69 @@ std::vector<HypothesisResult> Attribution::family_of(const HypothesisResult& lea
   return out;
 }
 
+NullCalibration calibrate_null(const ResidualData& data, const ResidualData& reference,
+                               const std::vector<Hypothesis>& hypotheses, const AttributionOptions& options) {
+  if (reference.y_names != data.y_names || reference.u_names != data.u_names ||
+      reference.aux_names != data.aux_names) {
+    throw std::invalid_argument("the reference logs' channels (y, u and aux_* columns) differ from the logs "
+                                "under test; a null must be recorded with the same channels");
+  }
+  NullCalibration null;
+  null.logs = static_cast<long>(reference.logs.size());
+  const auto ny = static_cast<Eigen::Index>(reference.y_names.size());
+  null.residual_level = Eigen::VectorXd::Zero(ny);
+  for (Eigen::Index c = 0; c < ny; ++c) {
+    double ss = 0;
+    long n = 0;
+    for (const auto& log : reference.logs) {
+      const int rows = log.size();
+      const int split = static_cast<int>(options.train_fraction * rows);
+      if (split < 1 || rows - split < 1) continue;
+      const Eigen::VectorXd r = log.r.row(c).transpose();
+      const double mean = r.head(split).mean();
+      ss += (r.segment(split, rows - split).array() - mean).square().sum();
+      n += rows - split;
+    }
+    const double scale = reference.y_scale(c);
+    if (n > 0) null.residual_level(c) = ss / static_cast<double>(n) / (scale * scale);
+  }
+  null.explained_std.reserve(hypotheses.size());
+  for (const auto& h : hypotheses) {
+    const HypothesisResult r = test_hypothesis(reference, h, options);
+    null.explained_std.push_back(r.testable ? std::max(0.0, r.explained_std) : 0.0);
+  }
+  return null;
+}
+
+double floor_statistic(const Attribution& attribution, const HypothesisResult& result) {
+  return attribution.null ? result.excess_share : result.explained_std;
+}
+
+double floor_of(const AttributionOptions& options, bool with_null) {
+  return with_null ? options.min_excess_null : options.min_explained_std;
+}
+
 Attribution attribute(const ResidualData& data, const std::vector<Hypothesis>& hypotheses,
-                      const AttributionOptions& options) {
+                      const AttributionOptions& options, const NullCalibration* null) {
   Attribution att;
   att.options = options;
+  if (null != nullptr) {
+    if (null->explained_std.size() != hypotheses.size())
+      throw std::invalid_argument("attribute: the null was calibrated for other hypotheses");
+    att.null = *null;
+  }
   std::vector<HypothesisResult> results;
   results.reserve(hypotheses.size());
-  for (const auto& h : hypotheses) results.push_back(test_hypothesis(data, h, options));
+  for (std::size_t i = 0; i < hypotheses.size(); ++i) {
+    results.push_back(test_hypothesis(data, hypotheses[i], options));
+    auto& r = results.back();
+    r.null_explained_std = null != nullptr ? null->explained_std[i] : 0.0;
+    r.excess_std = r.explained_std - r.null_explained_std;
+    if (null != nullptr) {
+      const double level = null->residual_level(r.hypothesis.target);
+      r.excess_share = level > 0 ? r.excess_std / level : 0.0;
+    }
+  }
   // The family: every testable hypothesis (an untestable one has no p-value).
   std::vector<double> p;
   std::vector<std::size_t> family;
@@ -218,11 +275,12 @@ Attribution attribute(const ResidualData& data, const std::vector<Hypothesis>& h
     results[i].p_adjusted = adjusted[f];
     results[i].significant = adjusted[f] < options.alpha &&
                              results[i].explained >= options.min_explained &&
-                             results[i].explained_std >= options.min_explained_std && results[i].plausible;
+                             floor_statistic(att, results[i]) >= floor_of(options, null != nullptr) &&
+                             results[i].plausible;
   }
-  std::stable_sort(results.begin(), results.end(), [](const HypothesisResult& a, const HypothesisResult& b) {
+  std::stable_sort(results.begin(), results.end(), [&att](const HypothesisResult& a, const HypothesisResult& b) {
     if (a.significant != b.significant) return a.significant;
-    if (a.significant) return a.explained_std > b.explained_std;
+    if (a.significant) return floor_statistic(att, a) > floor_statistic(att, b);
     return a.p_value < b.p_value;
   });
   att.ranked = std::move(results);

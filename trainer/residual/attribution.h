@@ -25,6 +25,16 @@
 //      e.g. an untouched loadcell, does not count as an effect).
 //   5. Rank the significant hypotheses by held-out explained variance in
 //      standardised units; the first is the winner.
+//
+// With a calibrated null (NullCalibration: the same hypotheses on clean
+// reference logs that are neither the model's training data nor the logs
+// under test), the absolute floor of step 4 is replaced by a relative one:
+// what a hypothesis explains beyond what it explains on the null, as a share
+// of its channel's clean 1-step residual level there (the model's own loss
+// on that channel of the reference: excess_share), must reach
+// `min_excess_null`, and step 5 ranks by excess_share. Structure the model shows on clean data as well (its
+// misfit of new motions, a real rail of the sensor) then counts as the null,
+// not as an effect, and the floor means the same on any system's scale.
 #pragma once
 
 #include <Eigen/Core>
@@ -37,6 +47,8 @@
 
 namespace hadynet::trainer::residual {
 
+inline constexpr double kDefaultMinExcessNull = 3.0;
+
 struct AttributionOptions {
   double train_fraction = 0.6;  // of each log's residual series, in time
   int max_ar_order = 10;        // whitening filter order (chosen by BIC in 0..max)
@@ -47,6 +59,11 @@ struct AttributionOptions {
   // docs/residual.md).
   double min_explained_std = 0.05;
   int min_support = 5;          // a regressor must be non-zero on this many training samples
+  // With a calibrated null only (it then replaces min_explained_std): the
+  // floor of excess_share. About twice the largest excess_share of any
+  // hypothesis on clean development logs (1.76; docs/residual.md, "A
+  // calibrated null"), as min_explained_std was for the absolute floor.
+  double min_excess_null = kDefaultMinExcessNull;
 };
 
 struct HypothesisResult {
@@ -66,11 +83,33 @@ struct HypothesisResult {
   bool testable = true;        // false: a regressor is (nearly) constant in the training part
   bool plausible = true;       // the parameter is in the effect's physical domain (effects.h plausible())
   double t_stat = 0, p_value = 1, p_adjusted = 1;
+  // With a calibrated null: explained_std of the same hypothesis on the null's
+  // held-out part (0 where it is not testable there or explains nothing).
+  double null_explained_std = 0;
+  // explained_std - null_explained_std (standardised units; explained_std without a null).
+  double excess_std = 0;
+  // With a null: excess_std / the null's residual level of the target channel
+  // (0 where that level is 0). What the floor and the ranking use.
+  double excess_share = 0;
   bool significant = false;
+};
+
+// The calibrated null: the model's residual on clean reference logs and what
+// each hypothesis of the library explains there (docs/residual.md).
+struct NullCalibration {
+  long logs = 0;
+  // Per y channel: mean squared 1-step residual on the held-out part of the
+  // reference (each log's rows after train_fraction, centred on its training
+  // part's mean), in the model's standardised units.
+  Eigen::VectorXd residual_level;
+  // Per hypothesis, in the order given to calibrate_null(): its held-out
+  // explained_std on the reference, floored at 0 (0 where not testable).
+  std::vector<double> explained_std;
 };
 
 struct Attribution {
   AttributionOptions options;
+  std::optional<NullCalibration> null;  // the floors' null; none: absolute floors
   long tested = 0;                       // family size of the Holm correction
   std::vector<HypothesisResult> ranked;  // significant by explained (desc), then the rest by p
   // The winner (ranked[0]) when it is significant; otherwise none.
@@ -86,8 +125,21 @@ struct Attribution {
 // Fits and tests one hypothesis (steps 1-3; p_adjusted and significant are left for step 4).
 HypothesisResult test_hypothesis(const ResidualData& data, const Hypothesis& h, const AttributionOptions& options);
 
-// Every hypothesis, Holm-corrected and ranked (steps 1-5).
+// The null of `hypotheses` on `reference` (clean logs of the same model and
+// channels; never its training data nor the logs under test). Throws
+// std::invalid_argument when the reference's channels differ from `data`'s
+// (the hypotheses index them).
+NullCalibration calibrate_null(const ResidualData& data, const ResidualData& reference,
+                               const std::vector<Hypothesis>& hypotheses, const AttributionOptions& options);
+
+// What the floor of step 4 and the ranking of step 5 compare: excess_share
+// with a null, else explained_std; and the floor it must reach.
+double floor_statistic(const Attribution& attribution, const HypothesisResult& result);
+double floor_of(const AttributionOptions& options, bool with_null);
+
+// Every hypothesis, Holm-corrected and ranked (steps 1-5); with `null`
+// (from calibrate_null() of the same hypotheses), its relative floors.
 Attribution attribute(const ResidualData& data, const std::vector<Hypothesis>& hypotheses,
-                      const AttributionOptions& options);
+                      const AttributionOptions& options, const NullCalibration* null = nullptr);
 
 }  // namespace hadynet::trainer::residual

@@ -281,21 +281,33 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.confirmation = diebold_mariano(standardised_loss(model, reference, result.confirmation_channels),
                                         standardised_loss(model, result.after, result.confirmation_channels));
 
-  // The residual analysis of the augmented model (in its own frame).
-  ResidualData again = compute_residuals(after.model, logs, "state");
+  // The residual analysis of the augmented model (in its own frame), against
+  // the calibrated null of the same model when the analysis had one.
   // An aux column the model now predicts is no longer an unused channel.
-  for (std::size_t a = again.aux_names.size(); a-- > 0;) {
-    if (index_of(again.y_names, again.aux_names[a]) < 0) continue;
-    again.aux_names.erase(again.aux_names.begin() + static_cast<std::ptrdiff_t>(a));
-    for (auto& log : again.logs) {
-      Eigen::MatrixXd kept(log.aux.rows() - 1, log.aux.cols());
-      kept << log.aux.topRows(static_cast<Eigen::Index>(a)),
-          log.aux.bottomRows(log.aux.rows() - 1 - static_cast<Eigen::Index>(a));
-      log.aux = kept;
+  const auto drop_predicted_aux = [](ResidualData& residuals) {
+    for (std::size_t a = residuals.aux_names.size(); a-- > 0;) {
+      if (index_of(residuals.y_names, residuals.aux_names[a]) < 0) continue;
+      residuals.aux_names.erase(residuals.aux_names.begin() + static_cast<std::ptrdiff_t>(a));
+      for (auto& log : residuals.logs) {
+        Eigen::MatrixXd kept(log.aux.rows() - 1, log.aux.cols());
+        kept << log.aux.topRows(static_cast<Eigen::Index>(a)),
+            log.aux.bottomRows(log.aux.rows() - 1 - static_cast<Eigen::Index>(a));
+        log.aux = kept;
+      }
     }
-  }
+  };
+  ResidualData again = compute_residuals(after.model, logs, "state");
+  drop_predicted_aux(again);
   LibraryOptions lib;
-  result.after.verdict = verdict_text(attribute(again, enumerate_hypotheses(again, lib), attribution.options));
+  const std::vector<Hypothesis> hypotheses_after = enumerate_hypotheses(again, lib);
+  if (options.reference != nullptr && !options.reference->empty()) {
+    ResidualData ref = compute_residuals(after.model, *options.reference, "auto");
+    drop_predicted_aux(ref);
+    const NullCalibration null = calibrate_null(again, ref, hypotheses_after, attribution.options);
+    result.after.verdict = verdict_text(attribute(again, hypotheses_after, attribution.options, &null));
+  } else {
+    result.after.verdict = verdict_text(attribute(again, hypotheses_after, attribution.options));
+  }
   result.tried = true;
 
   const bool confirmed = result.confirmation.mean > 0 && result.confirmation.p_value < attribution.options.alpha;

@@ -48,6 +48,9 @@ struct FixOptions {
   // significant there (else the screen's first) goes to the decision. 1: the
   // screen's winner alone (measured: docs/residual.md, "Detection").
   int candidates = 1;
+  // The calibrated null's logs of the analysis (analyse()'s reference), for
+  // the augmented model's verdict; nullptr or empty: absolute floors.
+  const std::vector<LogInput>* reference = nullptr;
 };
 
 struct Augmentation;
