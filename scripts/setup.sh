@@ -21,7 +21,8 @@ packages=(
 )
 if [[ "${1:-}" == "--bench" ]]; then
   # OpenBLAS: without it Debian's torch falls back to the reference BLAS (an unfair baseline)
-  packages+=(python3-torch python3-numpy libopenblas0-pthread)
+  packages+=(python3-torch python3-numpy libopenblas0-pthread
+    time)  # GNU time: peak memory in bench/residual_memory.sh
 fi
 
 missing=()

@@ -77,5 +77,37 @@ TEST(ResidualGenericLayout, DelayedSpringChannelIsNamedAndAligned) {
   EXPECT_LT(f.after.rmse(3), margins.winner_vs_control.limit * f.control->rmse(3));
 }
 
+
+// The network runs over a log's windows in chunks (residuals.cc, so memory
+// does not grow with the log's length): every window's prediction must be
+// the one it gets alone (windows are independent in eval mode), on both
+// sides of a chunk boundary (256 windows). Tolerance 1e-5 (absolute, on
+// values of order 0.1-1): float32 products of another batch width (one
+// window: matrix-vector; many: matrix-matrix kernels) round differently by
+// a few float32 ulps (~1e-7), grown over 5 recurrent steps; measured
+// differences are about 1e-7.
+TEST(ResidualGenericLayout, WindowPredictionsDoNotDependOnTheChunking) {
+  const auto& model = spring_model();
+  const std::vector<LogInput> logs = {{tt::spring_log(tt::kSoftStiffness, 700, 104, "soft"), "long.csv"}};
+  const ResidualData data = compute_residuals(model, logs, "state");
+  const trainer::LogSequence& seq = data.logs.front().seq;
+  const int steps = 5;
+  const Eigen::MatrixXd all = predict_windows(model, seq, data.logs.front().pb, steps);
+  const Eigen::Index B = all.cols() / steps;
+  ASSERT_GT(B, 600);
+  for (const int b : {0, 255, 256, 511, 512, static_cast<int>(B) - 1}) {
+    // Window b starts at row b + 1 and needs rows b .. b + steps + 1: a log of those rows has one window.
+    trainer::LogSequence one = seq;
+    one.y = seq.y.middleCols(b, steps + 2);
+    one.u = seq.u.middleCols(b, steps + 2);
+    const Eigen::MatrixXd alone = predict_windows(model, one, data.logs.front().pb, steps);
+    ASSERT_EQ(alone.cols(), steps);
+    for (int k = 0; k < steps; ++k) {
+      const double diff = (alone.col(k) - all.col(static_cast<Eigen::Index>(k) * B + b)).cwiseAbs().maxCoeff();
+      EXPECT_LT(diff, 1e-5) << "window " << b << " step " << k;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace hadynet::test

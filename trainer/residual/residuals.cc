@@ -101,22 +101,43 @@ Eigen::VectorXf explicit_pb(const HadynetModel& model, const std::string& text) 
 
 }  // namespace
 
-Eigen::MatrixXd predict_windows(const HadynetModel& model, const LogSequence& seq, const Eigen::VectorXf& pb,
-                                int steps) {
-  const WindowDataset data({seq}, {0}, model.layout, model.norm, steps);
-  const int B = data.size();
-  if (B == 0) return Eigen::MatrixXd(model.params.dims.y, 0);
-  std::vector<int> ids(static_cast<std::size_t>(B));
-  std::iota(ids.begin(), ids.end(), 0);
+namespace {
+
+// Windows per network call: bounds the forward pass's activations (they grow
+// with windows x steps; 40 000 windows of 50 steps at once took 8 GB).
+constexpr int kWindowChunk = 256;
+
+// Predictions of windows [first, first + count) of `data`, laid out as
+// predict_windows() documents for `count` windows.
+Eigen::MatrixXd predict_window_range(const HadynetModel& model, const WindowDataset& data, const Eigen::VectorXf& pb,
+                                     int first, int count) {
+  std::vector<int> ids(static_cast<std::size_t>(count));
+  std::iota(ids.begin(), ids.end(), first);
   WindowBatch<float> batch;
   Matrix<float> target;
   data.gather(ids, batch, target);
-  batch.pb = pb.replicate(1, B);
+  batch.pb = pb.replicate(1, count);
   HadynetNetwork<float> net;
   Eigen::MatrixXd y = net.forward(model.params, batch, BnMode::kEval).cast<double>();
   y = (y.array().colwise() * model.norm.y.std.array()).colwise() + model.norm.y.mean.array();
   apply_output_clips(model, y);
   return y;
+}
+
+}  // namespace
+
+Eigen::MatrixXd predict_windows(const HadynetModel& model, const LogSequence& seq, const Eigen::VectorXf& pb,
+                                int steps) {
+  const WindowDataset data({seq}, {0}, model.layout, model.norm, steps);
+  const int B = data.size();
+  Eigen::MatrixXd out(model.params.dims.y, static_cast<Eigen::Index>(B) * steps);
+  for (int first = 0; first < B; first += kWindowChunk) {
+    const int count = std::min(kWindowChunk, B - first);
+    const Eigen::MatrixXd y = predict_window_range(model, data, pb, first, count);
+    for (int k = 0; k < steps; ++k)
+      out.middleCols(static_cast<Eigen::Index>(k) * B + first, count) = y.middleCols(static_cast<Eigen::Index>(k) * count, count);
+  }
+  return out;
 }
 
 ResidualData compute_residuals(const HadynetModel& model, const std::vector<LogInput>& logs,
@@ -212,19 +233,24 @@ HorizonMetrics horizon_metrics(const HadynetModel& model, const ResidualData& da
   HorizonMetrics m;
   m.horizon = horizon;
   Eigen::MatrixXd sum_y = Eigen::MatrixXd::Zero(ny, horizon), sum_yy = sum_y, sum_ee = sum_y;
+  // Window by window chunk, so memory does not grow with the log's length.
   for (const auto& log : data.logs) {
-    const Eigen::MatrixXd y_hat = predict_windows(model, log.seq, log.pb, horizon);
-    const Eigen::Index B = y_hat.cols() / horizon;
+    const WindowDataset windows({log.seq}, {0}, model.layout, model.norm, horizon);
+    const int B = windows.size();
     m.samples += B;
-    for (int k = 0; k < horizon; ++k) {
-      // Window b starts at row b + 1 and predicts row b + 1 + k + 1 at step k.
-      const Eigen::MatrixXd y_phys = log.seq.y.middleCols(k + 2, B);
-      const Eigen::MatrixXd e = y_phys - y_hat.middleCols(k * B, B);
-      // Sums of y - (training mean): the shift keeps ||y - mean(y)||^2 free of cancellation.
-      const Eigen::MatrixXd y = y_phys.colwise() - model.norm.y.mean;
-      sum_y.col(k) += y.rowwise().sum();
-      sum_yy.col(k) += y.array().square().matrix().rowwise().sum();
-      sum_ee.col(k) += e.array().square().matrix().rowwise().sum();
+    for (int first = 0; first < B; first += kWindowChunk) {
+      const int count = std::min(kWindowChunk, B - first);
+      const Eigen::MatrixXd y_hat = predict_window_range(model, windows, log.pb, first, count);
+      for (int k = 0; k < horizon; ++k) {
+        // Window b starts at row b + 1 and predicts row b + 1 + k + 1 at step k.
+        const Eigen::MatrixXd y_phys = log.seq.y.middleCols(first + k + 2, count);
+        const Eigen::MatrixXd e = y_phys - y_hat.middleCols(static_cast<Eigen::Index>(k) * count, count);
+        // Sums of y - (training mean): the shift keeps ||y - mean(y)||^2 free of cancellation.
+        const Eigen::MatrixXd y = y_phys.colwise() - model.norm.y.mean;
+        sum_y.col(k) += y.rowwise().sum();
+        sum_yy.col(k) += y.array().square().matrix().rowwise().sum();
+        sum_ee.col(k) += e.array().square().matrix().rowwise().sum();
+      }
     }
   }
   const double n = static_cast<double>(m.samples);
