@@ -21,29 +21,105 @@ HadynetParams<float> single_pb_params(const HadynetModel& model, const Eigen::Ve
   return p;
 }
 
+// Windows [first, first + count) of a batch (WindowBatch's step-major layout).
+WindowBatch<float> window_range(const WindowBatch<float>& batch, const Matrix<float>& y, int first, int count,
+                                Matrix<float>& y_out) {
+  const int B = batch.windows(), N = batch.steps();
+  WindowBatch<float> out;
+  out.x0 = batch.x0.middleCols(first, count);
+  out.u.resize(batch.u.rows(), static_cast<Eigen::Index>(N) * count);
+  y_out.resize(y.rows(), static_cast<Eigen::Index>(N) * count);
+  for (int k = 0; k < N; ++k) {
+    out.u.middleCols(static_cast<Eigen::Index>(k) * count, count) =
+        batch.u.middleCols(static_cast<Eigen::Index>(k) * B + first, count);
+    y_out.middleCols(static_cast<Eigen::Index>(k) * count, count) =
+        y.middleCols(static_cast<Eigen::Index>(k) * B + first, count);
+  }
+  out.state.assign(batch.state.begin() + first, batch.state.begin() + first + count);
+  if (batch.pb.size() > 0) out.pb = batch.pb.middleCols(first, count);
+  return out;
+}
+
+// The full-batch loss of a fit and its gradient, over the batch in chunks of
+// AdaptOptions::windows_per_pass windows (a fit over the 40 000 windows of
+// one long log took 3 GB in one pass), each weighted by its share of the
+// windows. gradient() is taken at the point of the last loss()
+// call: with one chunk, by the backward pass of that forward pass (as the
+// unchunked fit did); with several, the chunks' forward and backward passes
+// are run again there. loss() never changes the last gradient.
+class ChunkedObjective {
+ public:
+  ChunkedObjective(const WindowBatch<float>& batch, const Matrix<float>& y, int windows_per_pass)
+      : whole_(&batch), y_whole_(&y) {
+    if (windows_per_pass < 1) throw std::invalid_argument("PB adaptation: windows_per_pass must be >= 1");
+    const int B = batch.windows();
+    if (B <= windows_per_pass) return;
+    for (int first = 0; first < B; first += windows_per_pass) {
+      const int count = std::min(windows_per_pass, B - first);
+      targets_.emplace_back();
+      chunks_.push_back(window_range(batch, y, first, count, targets_.back()));
+      weights_.push_back(static_cast<double>(count) / static_cast<double>(B));
+    }
+  }
+
+  double loss(const HadynetParams<float>& params) {
+    if (chunks_.empty()) return static_cast<double>(mse_loss(net_.forward(params, *whole_, BnMode::kEval), *y_whole_, &d_y_));
+    double total = 0;
+    for (std::size_t i = 0; i < chunks_.size(); ++i)
+      total += weights_[i] * static_cast<double>(mse_loss(net_.forward(params, chunks_[i], BnMode::kEval), targets_[i]));
+    return total;
+  }
+
+  // dL/d(params) at the point of the last loss() call (PB rows summed over chunks; the other
+  // groups are not used by the PB-only optimiser).
+  const HadynetGrads<float>& gradient(const HadynetParams<float>& params) {
+    if (chunks_.empty()) {
+      net_.backward(params, d_y_, grads_);  // at `params`: the last forward was there
+      return grads_;
+    }
+    Matrix<float> pb_sum;
+    for (std::size_t i = 0; i < chunks_.size(); ++i) {
+      mse_loss(net_.forward(params, chunks_[i], BnMode::kEval), targets_[i], &d_y_);
+      net_.backward(params, d_y_, grads_);
+      const Matrix<float> weighted = static_cast<float>(weights_[i]) * grads_.params.pb;
+      pb_sum = i == 0 ? weighted : Matrix<float>(pb_sum + weighted);
+    }
+    grads_.params.pb = pb_sum;
+    return grads_;
+  }
+
+ private:
+  const WindowBatch<float>* whole_;
+  const Matrix<float>* y_whole_;
+  std::vector<WindowBatch<float>> chunks_;  // empty: one pass over the whole batch
+  std::vector<Matrix<float>> targets_;
+  std::vector<double> weights_;
+  HadynetNetwork<float> net_;
+  HadynetGrads<float> grads_;
+  Matrix<float> d_y_;
+};
+
 // Full-batch MomentumSGD epochs on one gathered batch with the step-size
 // safeguard (pb_adaptation.h); appends the loss before the first epoch and
 // after each to `loss`. Returns the number of halvings. The rate is restored
 // on return (the caller's optimiser keeps its configured rate).
 int fit(HadynetParams<float>& params, MomentumSgd<float>& sgd, const WindowBatch<float>& batch,
-        const Matrix<float>& y, int epochs, std::vector<double>& loss) {
-  HadynetNetwork<float> net;
-  HadynetGrads<float> grads;
-  Matrix<float> d_y;
+        const Matrix<float>& y, const AdaptOptions& options, std::vector<double>& loss) {
+  ChunkedObjective objective(batch, y, options.windows_per_pass);
   const double base_lr = sgd.options().lr;
   int halvings = 0;
   const std::size_t first = loss.size();
-  double current = static_cast<double>(mse_loss(net.forward(params, batch, BnMode::kEval), y, &d_y));
+  double current = objective.loss(params);
   loss.push_back(current);
-  for (int e = 0; e < epochs; ++e) {
-    net.backward(params, d_y, grads);  // at `params`: the last forward was there
+  for (int e = 0; e < options.epochs; ++e) {
+    const HadynetGrads<float>& grads = objective.gradient(params);
     // The reference: the largest of the last kSafeguardWindow losses of this call.
     const std::size_t from = std::max(first, loss.size() - std::min<std::size_t>(loss.size() - first, kSafeguardWindow));
     const double reference = *std::max_element(loss.begin() + static_cast<long>(from), loss.end());
     const auto kept = params.pb;  // the PB before this epoch's step
     while (true) {
-      sgd.step(params, grads.params);
-      const double trial = static_cast<double>(mse_loss(net.forward(params, batch, BnMode::kEval), y, &d_y));
+      sgd.step(params, grads.params);  // loss() below leaves the gradient as it is
+      const double trial = objective.loss(params);
       if (std::isfinite(trial) && trial <= reference) {
         current = trial;
         break;
@@ -51,7 +127,7 @@ int fit(HadynetParams<float>& params, MomentumSgd<float>& sgd, const WindowBatch
       params.pb = kept;
       sgd.reset_momentum();
       if (halvings == kMaxHalvings) {  // no step keeps the loss down: stay
-        current = static_cast<double>(mse_loss(net.forward(params, batch, BnMode::kEval), y, &d_y));
+        current = objective.loss(params);
         break;
       }
       ++halvings;
@@ -93,7 +169,7 @@ AdaptResult adapt_pb(const HadynetModel& model, const WindowDataset& data, std::
   Matrix<float> y;
   data.gather(ids, batch, y);
   AdaptResult result;
-  result.halvings = fit(params, sgd, single_state(std::move(batch)), y, options.epochs, result.loss);
+  result.halvings = fit(params, sgd, single_state(std::move(batch)), y, options, result.loss);
   result.pb = params.pb.row(0).transpose();
   return result;
 }
@@ -166,7 +242,7 @@ bool OnlinePbAdapter::push(const Eigen::VectorXd& y, const Eigen::VectorXd& u) {
     }
   }
   std::vector<double> loss;
-  fit(params_, sgd_, batch, target, options_.adapt.epochs, loss);
+  fit(params_, sgd_, batch, target, options_.adapt, loss);
   pb_ = params_.pb.row(0).transpose();
   last_loss_ = loss.back();
   return true;

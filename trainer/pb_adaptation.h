@@ -28,10 +28,20 @@ namespace hadynet::trainer {
 inline constexpr int kSafeguardWindow = 10;  // losses the step test looks back over (~ 1 / (1 - momentum))
 inline constexpr int kMaxHalvings = 30;      // 2^-30 of the rate: below float resolution of any PB step
 
+// A fit of at most this many windows (every fit in the suite and the
+// benchmarks) runs in one pass, as before passes were bounded; at 10 steps
+// and 64 units a pass takes about 0.6 GB.
+inline constexpr int kDefaultWindowsPerPass = 8192;
+
 struct AdaptOptions {
   int epochs = 20;        // paper: N_epoch^update = 20 (online: 3)
   double lr = 1.0;        // MomentumSGD step; see docs/trainer.md for how it was chosen
   double momentum = 0.9;  // MomentumSGD momentum (Chainer's default)
+  // Windows per forward/backward pass: the activations grow with windows x
+  // steps, so a fit over more windows sums the losses and PB gradients of
+  // chunks of this many (the same full-batch step, up to float rounding),
+  // and its memory does not grow with the logs' length.
+  int windows_per_pass = kDefaultWindowsPerPass;
 };
 
 struct AdaptResult {

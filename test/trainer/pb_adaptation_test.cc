@@ -70,6 +70,30 @@ TEST_F(PbAdaptation, BatchFitFromAStalePbLowersTheLoss) {
   EXPECT_TRUE(bit_identical(model().params, before));
 }
 
+// A fit over more windows than one pass holds (AdaptOptions::windows_per_pass)
+// runs over chunks and must take the same full-batch steps: here 7 passes of
+// at most 5 of the 34 windows against one pass. Tolerance: the chunks sum the loss
+// and the PB gradient in another order (float32 rounding, ~1e-7 relative per
+// sum) and 20 momentum steps carry it on; 1e-4 relative on the losses and
+// 1e-3 absolute on the PB (values of order 1) cover that, while one epoch
+// more or less, or a gradient weighted wrongly by chunk, moves the loss by
+// percents (observed: the loss falls 3.4x over the 20 epochs).
+TEST_F(PbAdaptation, AFitInChunksTakesTheFullBatchSteps) {
+  ASSERT_GT(ids_.size(), 30u);
+  AdaptOptions one_pass, chunks;
+  one_pass.windows_per_pass = static_cast<int>(ids_.size());
+  chunks.windows_per_pass = 5;
+  const AdaptResult a = adapt_pb(model(), data_, ids_, pb_of(0), one_pass);
+  const AdaptResult b = adapt_pb(model(), data_, ids_, pb_of(0), chunks);
+  ASSERT_EQ(a.loss.size(), b.loss.size());
+  for (std::size_t e = 0; e < a.loss.size(); ++e) EXPECT_NEAR(b.loss[e], a.loss[e], 1e-4 * a.loss[e]) << "epoch " << e;
+  EXPECT_LT((a.pb - b.pb).cwiseAbs().maxCoeff(), 1e-3);
+  EXPECT_EQ(a.halvings, b.halvings);
+  AdaptOptions bad;
+  bad.windows_per_pass = 0;
+  EXPECT_THROW(adapt_pb(model(), data_, ids_, pb_of(0), bad), std::invalid_argument);
+}
+
 TEST_F(PbAdaptation, ZeroEpochsAndErrors) {
   const Eigen::VectorXf start = pb_of(1);
   const AdaptResult r = adapt_pb(model(), data_, ids_, start, AdaptOptions{0, 1.0, 0.9});
