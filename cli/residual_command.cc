@@ -48,15 +48,12 @@ void print_summary(const rs::Analysis& a, const std::string& pb_choice, bool fix
   std::printf("\n%ld hypotheses tested; top of the ranking:\n", a.attribution.tested);
   for (std::size_t i = 0; i < a.attribution.ranked.size() && i < 10; ++i) {
     const auto& r = a.attribution.ranked[i];
+    char null_part[64] = "";  // with a calibrated null: what the hypothesis explains there, and its excess
     if (a.attribution.null)
-      std::printf("  %c %-62s explained %6.3f (std %.4f, null %.4f: %.2f x clean)  p(Holm) %.2g  %s\n",
-                  r.significant ? '*' : ' ', r.label.c_str(), r.explained, r.explained_std, r.null_explained_std,
-                  r.excess_share, r.p_adjusted,
-                  rs::hypothesis_status(r, a.attribution.options));
-    else
-      std::printf("  %c %-62s explained %6.3f (std %.4f)  p(Holm) %.2g  %s\n", r.significant ? '*' : ' ',
-                  r.label.c_str(), r.explained, r.explained_std, r.p_adjusted,
-                  rs::hypothesis_status(r, a.attribution.options));
+      std::snprintf(null_part, sizeof null_part, ", null %.4f: %.2f x clean", r.null_explained_std, r.excess_share);
+    std::printf("  %c %-62s explained %6.3f (std %.4f%s)  p(Holm) %.2g  %s\n", r.significant ? '*' : ' ',
+                r.label.c_str(), r.explained, r.explained_std, null_part, r.p_adjusted,
+                rs::hypothesis_status(r, a.attribution.options));
   }
   std::printf("\nverdict: %s\n", a.verdict.c_str());
   if (a.attribution.winner() && !fixing)

@@ -77,12 +77,11 @@ class ChunkedObjective {
       net_.backward(params, d_y_, grads_);  // at `params`: the last forward was there
       return grads_;
     }
-    Matrix<float> pb_sum;
+    Matrix<float> pb_sum = Matrix<float>::Zero(params.pb.rows(), params.pb.cols());
     for (std::size_t i = 0; i < chunks_.size(); ++i) {
       mse_loss(net_.forward(params, chunks_[i], BnMode::kEval), targets_[i], &d_y_);
       net_.backward(params, d_y_, grads_);
-      const Matrix<float> weighted = static_cast<float>(weights_[i]) * grads_.params.pb;
-      pb_sum = i == 0 ? weighted : Matrix<float>(pb_sum + weighted);
+      pb_sum += static_cast<float>(weights_[i]) * grads_.params.pb;
     }
     grads_.params.pb = pb_sum;
     return grads_;

@@ -108,16 +108,16 @@ namespace {
 constexpr int kWindowChunk = 256;
 
 // Predictions of windows [first, first + count) of `data`, laid out as
-// predict_windows() documents for `count` windows.
-Eigen::MatrixXd predict_window_range(const HadynetModel& model, const WindowDataset& data, const Eigen::VectorXf& pb,
-                                     int first, int count) {
+// predict_windows() documents for `count` windows. `net` is reused across
+// chunks (its buffers keep their size).
+Eigen::MatrixXd predict_window_range(HadynetNetwork<float>& net, const HadynetModel& model, const WindowDataset& data,
+                                     const Eigen::VectorXf& pb, int first, int count) {
   std::vector<int> ids(static_cast<std::size_t>(count));
   std::iota(ids.begin(), ids.end(), first);
   WindowBatch<float> batch;
   Matrix<float> target;
   data.gather(ids, batch, target);
   batch.pb = pb.replicate(1, count);
-  HadynetNetwork<float> net;
   Eigen::MatrixXd y = net.forward(model.params, batch, BnMode::kEval).cast<double>();
   y = (y.array().colwise() * model.norm.y.std.array()).colwise() + model.norm.y.mean.array();
   apply_output_clips(model, y);
@@ -131,9 +131,10 @@ Eigen::MatrixXd predict_windows(const HadynetModel& model, const LogSequence& se
   const WindowDataset data({seq}, {0}, model.layout, model.norm, steps);
   const int B = data.size();
   Eigen::MatrixXd out(model.params.dims.y, static_cast<Eigen::Index>(B) * steps);
+  HadynetNetwork<float> net;
   for (int first = 0; first < B; first += kWindowChunk) {
     const int count = std::min(kWindowChunk, B - first);
-    const Eigen::MatrixXd y = predict_window_range(model, data, pb, first, count);
+    const Eigen::MatrixXd y = predict_window_range(net, model, data, pb, first, count);
     for (int k = 0; k < steps; ++k)
       out.middleCols(static_cast<Eigen::Index>(k) * B + first, count) = y.middleCols(static_cast<Eigen::Index>(k) * count, count);
   }
@@ -234,13 +235,14 @@ HorizonMetrics horizon_metrics(const HadynetModel& model, const ResidualData& da
   m.horizon = horizon;
   Eigen::MatrixXd sum_y = Eigen::MatrixXd::Zero(ny, horizon), sum_yy = sum_y, sum_ee = sum_y;
   // Window by window chunk, so memory does not grow with the log's length.
+  HadynetNetwork<float> net;
   for (const auto& log : data.logs) {
     const WindowDataset windows({log.seq}, {0}, model.layout, model.norm, horizon);
     const int B = windows.size();
     m.samples += B;
     for (int first = 0; first < B; first += kWindowChunk) {
       const int count = std::min(kWindowChunk, B - first);
-      const Eigen::MatrixXd y_hat = predict_window_range(model, windows, log.pb, first, count);
+      const Eigen::MatrixXd y_hat = predict_window_range(net, model, windows, log.pb, first, count);
       for (int k = 0; k < horizon; ++k) {
         // Window b starts at row b + 1 and predicts row b + 1 + k + 1 at step k.
         const Eigen::MatrixXd y_phys = log.seq.y.middleCols(first + k + 2, count);
