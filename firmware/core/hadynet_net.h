@@ -169,21 +169,7 @@ class HadynetNet {
   void backward_step(const StepTrace<M>& trace, const Grad (&dh)[kH], Grad (&dc)[kH],
                      Grad (&du)[kU], Grad* dh_prev) noexcept {
     Grad dgates[kGates];
-    for (int j = 0; j < kH; ++j) {
-      const Value i = trace.gates[j], f = trace.gates[kH + j], g = trace.gates[2 * kH + j],
-                  o = trace.gates[3 * kH + j], tc = trace.tanh_c[j];
-      // h' = o tanh(c'): do = dh tanh(c'), dc' += dh o tanh'(c').
-      const Grad d_o = N::template grad_mul<kFracOut>(dh[j], tc);
-      const Grad dcj = N::grad_add(
-          dc[j], N::grad_mul_q15(N::template grad_mul<kFracOut>(dh[j], o), N::tanh_slope(tc)));
-      // c' = f c + i g.
-      dgates[j] = N::grad_mul_q15(N::template grad_mul<kFracOut>(dcj, g), N::sigmoid_slope(i));
-      dgates[kH + j] =
-          N::grad_mul_q15(N::template grad_mul<M::kFracC>(dcj, trace.c_prev[j]), N::sigmoid_slope(f));
-      dgates[2 * kH + j] = N::grad_mul_q15(N::template grad_mul<kFracOut>(dcj, i), N::tanh_slope(g));
-      dgates[3 * kH + j] = N::grad_mul_q15(d_o, N::sigmoid_slope(o));
-      dc[j] = N::template grad_mul<kFracOut>(dcj, f);
-    }
+    gate_gradients(trace, dh, dc, dgates);
     // The chain rule runs on real values: a gradient's raw value is its real
     // value times one constant; products with a Q(F) operand divide by 2^F
     // (grad_mul<F>, transposed_matvec<F>), so the constant never changes.
@@ -195,16 +181,68 @@ class HadynetNet {
       const NetworkWeights<M>& kw = t_->weights;
       kernels::dot_rows_q15_i32(kw.ih_u_t[0], kGates, kU, dgates, kGates, scratch_);
       for (int k = 0; k < kU; ++k) du[k] = N::grad_add(du[k], fixed::requantize_i32<M::kFracLstmW, 0>(scratch_[k]));
-      if (dh_prev != nullptr) {
-        kernels::dot_cols_packed_q15_i32(kw.hh.data, kw.hh.kCols, kGates, dgates, kH, scratch_);
-        for (int j = 0; j < kH; ++j) dh_prev[j] = fixed::requantize_i32<M::kFracLstmW, 0>(scratch_[j]);
-      }
     } else {
       Grad du_step[kU];
       N::template transposed_matvec<M::kFracLstmW>(t_->weights.ih, dgates, kU, du_step, scratch_);
       for (int k = 0; k < kU; ++k) du[k] = N::grad_add(du[k], du_step[k]);
-      if (dh_prev != nullptr) {
-        N::template transposed_matvec<M::kFracLstmW>(t_->weights.hh, dgates, kH, dh_prev, scratch_);
+    }
+    if (dh_prev != nullptr) hidden_gradient(dgates, dh_prev);
+  }
+
+  // The same step of back-propagation for the PB instead of the command
+  // (PB adaptation, pb_adapter.h): adds dL/dp of this step (the PB enters
+  // every step through W_ih's last kPb columns) to dpb, and writes dh_prev /
+  // dc as backward_step.
+  void backward_step_pb(const StepTrace<M>& trace, const Grad (&dh)[kH], Grad (&dc)[kH],
+                        Grad (&dpb)[kPb], Grad* dh_prev) noexcept {
+    Grad dgates[kGates];
+    gate_gradients(trace, dh, dc, dgates);
+    if constexpr (N::kFixed) {
+      const auto& ih = t_->weights.ih;
+      if constexpr (kU % 8 == 0) {
+        // The PB columns start a chunk of the packed matrix: the packed
+        // kernel reads them from that chunk on (packed_index is linear in it).
+        kernels::dot_cols_packed_q15_i32(ih.data + (kU / 8) * 16, ih.kCols, kGates, dgates, kPb, scratch_);
+      } else {
+        for (int i = 0; i < kPb; ++i) scratch_[i] = 0;
+        for (int r = 0; r < kGates; ++r)
+          for (int i = 0; i < kPb; ++i)
+            scratch_[i] += std::int64_t{ih.data[kernels::packed_index(ih.kCols, r, kU + i)]} * dgates[r];
+      }
+      for (int i = 0; i < kPb; ++i)
+        dpb[i] = N::grad_add(dpb[i], fixed::requantize_i32<M::kFracLstmW, 0>(scratch_[i]));
+    } else {
+      for (int i = 0; i < kPb; ++i) scratch_[i] = 0;
+      for (int r = 0; r < kGates; ++r) {
+        if (dgates[r] == 0) continue;
+        for (int i = 0; i < kPb; ++i) scratch_[i] += t_->weights.ih[r][kU + i] * dgates[r];
+      }
+      for (int i = 0; i < kPb; ++i) dpb[i] += scratch_[i];
+    }
+    if (dh_prev != nullptr) hidden_gradient(dgates, dh_prev);
+  }
+
+  // dL/dp through the encoder, h_0 = ReLU(W_enc [x ; p] + b): adds
+  // W_enc[:, kX:]^T (dh0 where h0 > 0) to dpb. h0 is the encoder's output
+  // (save() right after encode()); dh0 the gradient reaching it.
+  void backward_encoder_pb(const Value (&h0)[kH], const Grad (&dh0)[kH], Grad (&dpb)[kPb]) noexcept {
+    for (int i = 0; i < kPb; ++i) scratch_[i] = 0;
+    for (int r = 0; r < kH; ++r) {
+      if (!(h0[r] > 0) || dh0[r] == 0) continue;  // ReLU: no gradient where it is off
+      for (int i = 0; i < kPb; ++i) {
+        if constexpr (N::kFixed) {
+          const auto& enc = t_->weights.enc;
+          scratch_[i] += std::int64_t{enc.data[kernels::packed_index(enc.kCols, r, kX + i)]} * dh0[r];
+        } else {
+          scratch_[i] += t_->weights.enc[r][kX + i] * dh0[r];
+        }
+      }
+    }
+    for (int i = 0; i < kPb; ++i) {
+      if constexpr (N::kFixed) {
+        dpb[i] = N::grad_add(dpb[i], fixed::requantize_i32<M::kFracEncW, 0>(scratch_[i]));
+      } else {
+        dpb[i] += scratch_[i];
       }
     }
   }
@@ -243,6 +281,38 @@ class HadynetNet {
   const Value (&cell() const noexcept)[kH] { return c_; }
 
  private:
+  // dL/d(gate pre-activations) of the step `trace` from dh and dc after it;
+  // dc becomes dL/dc before the step.
+  void gate_gradients(const StepTrace<M>& trace, const Grad (&dh)[kH], Grad (&dc)[kH],
+                      Grad (&dgates)[kGates]) const noexcept {
+    for (int j = 0; j < kH; ++j) {
+      const Value i = trace.gates[j], f = trace.gates[kH + j], g = trace.gates[2 * kH + j],
+                  o = trace.gates[3 * kH + j], tc = trace.tanh_c[j];
+      // h' = o tanh(c'): do = dh tanh(c'), dc' += dh o tanh'(c').
+      const Grad d_o = N::template grad_mul<kFracOut>(dh[j], tc);
+      const Grad dcj = N::grad_add(
+          dc[j], N::grad_mul_q15(N::template grad_mul<kFracOut>(dh[j], o), N::tanh_slope(tc)));
+      // c' = f c + i g.
+      dgates[j] = N::grad_mul_q15(N::template grad_mul<kFracOut>(dcj, g), N::sigmoid_slope(i));
+      dgates[kH + j] =
+          N::grad_mul_q15(N::template grad_mul<M::kFracC>(dcj, trace.c_prev[j]), N::sigmoid_slope(f));
+      dgates[2 * kH + j] = N::grad_mul_q15(N::template grad_mul<kFracOut>(dcj, i), N::tanh_slope(g));
+      dgates[3 * kH + j] = N::grad_mul_q15(d_o, N::sigmoid_slope(o));
+      dc[j] = N::template grad_mul<kFracOut>(dcj, f);
+    }
+  }
+
+  // dh_prev = W_hh^T dgates (dL/dh before the step).
+  void hidden_gradient(const Grad (&dgates)[kGates], Grad* dh_prev) noexcept {
+    if constexpr (N::kFixed) {
+      const NetworkWeights<M>& kw = t_->weights;
+      kernels::dot_cols_packed_q15_i32(kw.hh.data, kw.hh.kCols, kGates, dgates, kH, scratch_);
+      for (int j = 0; j < kH; ++j) dh_prev[j] = fixed::requantize_i32<M::kFracLstmW, 0>(scratch_[j]);
+    } else {
+      N::template transposed_matvec<M::kFracLstmW>(t_->weights.hh, dgates, kH, dh_prev, scratch_);
+    }
+  }
+
   // q15: h as the packed kernels read it, kH values then zeros up to a
   // multiple of 8 (they meet the packed matrices' zero columns): h_ itself,
   // or a copy in `buffer` if kH is not a multiple of 8.
@@ -260,7 +330,8 @@ class HadynetNet {
   Value pb_[kPb] = {};
   Value h_[kH] = {};
   Value c_[kH] = {};
-  typename N::GradAcc scratch_[kH > kU ? kH : kU] = {};
+  static constexpr int kScratch = kH > kU ? (kH > kPb ? kH : kPb) : (kU > kPb ? kU : kPb);
+  typename N::GradAcc scratch_[kScratch] = {};
 };
 
 }  // namespace hadynet::firmware

@@ -12,6 +12,12 @@
 // Entering control mode takes the next frame's y as the reference y_ref.
 // A model with a sensor model or derived inputs (sensor_stage.h) sees every
 // frame in its own frame, and its prediction is reported as measured.
+// PB adaptation (pb_adapter.h) runs beside the modes when switched on: every
+// frame goes into its ring, and in observe and detect each period spends
+// its budget on PB updates after the period's own work; in control it
+// pauses (the stabiliser takes the period; frames are still kept). The
+// result reports the adapted PB's nearest trained states (recognition);
+// use_adapted_pb() makes it the active PB.
 #ifndef HADYNET_FIRMWARE_CORE_HADYNET_RUNTIME_H_
 #define HADYNET_FIRMWARE_CORE_HADYNET_RUNTIME_H_
 
@@ -21,6 +27,7 @@
 #include "firmware/core/detector.h"
 #include "firmware/core/grasp_stabilizer.h"
 #include "firmware/core/hadynet_net.h"
+#include "firmware/core/pb_adapter.h"
 #include "firmware/core/sensor_stage.h"
 
 namespace hadynet::firmware {
@@ -46,6 +53,11 @@ struct StepResult {
   bool contact = false;
   bool command_valid = false;
   float command[M::kU] = {};  // u_t, physical
+  // PB adaptation (when switched on): steps taken so far, and the nearest
+  // trained states of the adapted PB (valid once a step has been taken).
+  bool adapt_valid = false;
+  std::uint32_t adapt_updates = 0;
+  PbRecognition recognition;
 };
 
 template <GeneratedModel M>
@@ -74,6 +86,8 @@ class HadynetRuntime {
     boundary_ = B(tensors);
     sensor_ = SensorStage<M>(tensors);
     net_ = HadynetNet<M>(tensors);
+    adapter_.use_model(tensors);
+    adapting_ = false;
     init_pb();
     reset();
   }
@@ -84,6 +98,7 @@ class HadynetRuntime {
     history_.clear();
     sensor_.reset();
     reference_pending_ = true;
+    adapter_.begin_segment();
     const float zero_u[M::kU] = {};
     boundary_.u_to_model(zero_u, hold_);
     stabilizer_.reset(hold_);
@@ -107,6 +122,21 @@ class HadynetRuntime {
   // Active PB from standardised real values (saturated into the format).
   void set_pb(const float (&pb)[M::kPb]) noexcept { B::real_to_in(pb, pb_); }
   const Value (&pb() const noexcept)[M::kPb] { return pb_; }
+
+  // PB adaptation on (starting from the active PB, with the frames it
+  // already holds) or off (the adapted PB is kept, frames are not).
+  void set_adapting(bool on) noexcept {
+    if (on && !adapting_) adapter_.restart(pb_);
+    adapting_ = on;
+  }
+  bool adapting() const noexcept { return adapting_; }
+  const PbAdapter<M>& adapter() const noexcept { return adapter_; }
+  bool set_adapt_settings(const typename PbAdapter<M>::Settings& s) noexcept { return adapter_.set_settings(s); }
+  // The adapted PB becomes the active PB (detection, control); adaptation
+  // goes on from it.
+  void use_adapted_pb() noexcept {
+    for (int i = 0; i < M::kPb; ++i) pb_[i] = adapter_.pb()[i];
+  }
 
   typename GraspStabilizer<M>::Settings& control_settings() noexcept {
     return stabilizer_.settings();
@@ -158,6 +188,14 @@ class HadynetRuntime {
         out.command_valid = true;
       }
     }
+
+    if (adapting_) {
+      adapter_.push(y_frame, u_frame);
+      if (mode_ != Mode::kControl) adapter_.work(net_);
+      out.adapt_updates = adapter_.updates();
+      out.adapt_valid = out.adapt_updates > 0;
+      if (out.adapt_valid) out.recognition = adapter_.recognize();
+    }
     return out;
   }
 
@@ -180,6 +218,8 @@ class HadynetRuntime {
   typename Det::History history_{};
   HadynetNet<M> net_;
   GraspStabilizer<M> stabilizer_{};
+  bool adapting_ = false;
+  PbAdapter<M> adapter_{*t_};
 };
 
 }  // namespace hadynet::firmware
