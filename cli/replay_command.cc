@@ -81,8 +81,12 @@ int run_replay(int argc, char** argv) {
               "log's own commands keep driving the replay). Bit-identical across runs.\n"
               "--target qemu runs the same log through a firmware image in QEMU instead, and\n"
               "--target serial/tcp through a device on a serial port or socket, frame by frame over\n"
-              "the link protocol (docs/protocol.md); the device must run this build's model.",
-              "LOG --out CSV [options]");
+              "the link protocol (docs/protocol.md); the device must run this build's model.\n"
+              "--adapt switches the firmware's PB adaptation on (docs/firmware.md, \"Adapting the PB on\n"
+              "the device\"): the CSV gains the adapted PB and its nearest trained states per row. Several\n"
+              "LOGs run one after the other through one device, reset between them (a new recording;\n"
+              "the PB and its adaptation carry over, as when the grasped object changes).",
+              "LOG... --out CSV [options]");
   opt.value("target", "hostsim|qemu|serial|tcp", "where the firmware runs", "hostsim");
   opt.value("image", "ELF", "firmware image for --target qemu", HADYNET_DEFAULT_QEMU_IMAGE);
   opt.value("machine", "NAME", "QEMU machine for --target qemu (mps2-an386, netduinoplus2)", "mps2-an386");
@@ -101,6 +105,9 @@ int run_replay(int argc, char** argv) {
             "(default: the detection PB)");
   opt.value("control-epochs", "N", "stabiliser epochs (default: the model's)");
   opt.value("control-truncation", "K", "stabiliser truncation depth K (default: the model's)");
+  opt.flag("adapt", "adapt the PB on the device from the first row, starting from the active PB (--target hostsim)");
+  opt.value("adapt-stride", "N", "--adapt: an epoch runs every N-th window (default: the firmware's)");
+  opt.value("adapt-budget", "N", "--adapt: windows run per period (default: the firmware's)");
   opt.value("plot", "PNG", "draw d and the commands");
   opt.flag("info", "print the compiled model's identity and sizes and exit");
   if (!opt.parse(argc, argv)) return 2;
@@ -123,9 +130,24 @@ int run_replay(int argc, char** argv) {
                 info.control_truncation);
     return 0;
   }
-  if (opt.positional().size() != 1 || !opt.has("out")) {
-    std::fprintf(stderr, "hadynet replay: need exactly one LOG and --out CSV (see --help)\n");
+  if (opt.positional().empty() || !opt.has("out")) {
+    std::fprintf(stderr, "hadynet replay: need a LOG and --out CSV (see --help)\n");
     return 2;
+  }
+  ro.adapt = opt.has("adapt");
+  if (!ro.adapt && (opt.has("adapt-stride") || opt.has("adapt-budget"))) {
+    std::fprintf(stderr, "hadynet replay: --adapt-stride and --adapt-budget need --adapt\n");
+    return 2;
+  }
+  if (opt.has("adapt-stride")) {
+    const auto v = opt.get_int("adapt-stride", 1, 200);
+    if (!v) return 2;
+    ro.adapt_window_stride = static_cast<int>(*v);
+  }
+  if (opt.has("adapt-budget")) {
+    const auto v = opt.get_int("adapt-budget", 1, 200);
+    if (!v) return 2;
+    ro.adapt_windows_per_period = static_cast<int>(*v);
   }
   const std::string mode = opt.get("mode");
   if (mode == "observe") {
@@ -225,8 +247,9 @@ int run_replay(int argc, char** argv) {
                    target.c_str());
       return 2;
     }
-    const datalog::LogTable log = datalog::read_log(log_path);
-    const hostsim::ReplayResult r = hostsim::replay_log(log, log_path, ro);
+    std::vector<datalog::LogTable> logs;
+    for (const std::string& path : opt.positional()) logs.push_back(datalog::read_log(path));
+    const hostsim::ReplayResult r = hostsim::replay_logs(logs, opt.positional(), ro);
     {
       std::ofstream out(opt.get("out"), std::ios::binary);
       out << hostsim::format_replay_csv(r);
@@ -242,9 +265,26 @@ int run_replay(int argc, char** argv) {
       }
       commands += st.command_valid ? 1 : 0;
     }
+    const std::string what = logs.size() == 1 ? log_path : std::to_string(logs.size()) + " logs";
     std::printf("%s: %zu rows (%s), d on %d rows, contact on %d (%.1f%%), max d %.3g, %d commands -> %s\n",
-                log_path.c_str(), r.steps.size(), numeric.c_str(), distances, flagged,
+                what.c_str(), r.steps.size(), numeric.c_str(), distances, flagged,
                 distances ? 100.0 * flagged / distances : 0.0, d_max, commands, opt.get("out").c_str());
+    if (r.adapt && !r.steps.empty()) {
+      for (std::size_t k = 0; k < logs.size(); ++k) {
+        const std::size_t last = k + 1 < r.log_first_step.size() ? r.log_first_step[k + 1] - 1 : r.steps.size() - 1;
+        const hostsim::ReplayStep& st = r.steps[last];
+        if (st.recognized_state < 0) {
+          std::printf("  %s: adapted PB: no step yet (%u)\n", opt.positional()[k].c_str(), st.adapt_updates);
+          continue;
+        }
+        std::printf("  %s: adapted PB after %u steps: nearest %s (distance %.3g), other object %s (%.3g)\n",
+                    opt.positional()[k].c_str(), st.adapt_updates,
+                    r.state_names[static_cast<std::size_t>(st.recognized_state)].c_str(),
+                    static_cast<double>(st.recognized_distance),
+                    st.other_state >= 0 ? r.state_names[static_cast<std::size_t>(st.other_state)].c_str() : "-",
+                    static_cast<double>(st.other_distance));
+      }
+    }
     if (opt.has("plot")) {
       const std::string err = replay_plot(r, info, std::filesystem::path(log_path).filename().string() + " (" +
                                                        numeric + ")", opt.get("plot"));

@@ -46,12 +46,26 @@ class HostDevice {
   explicit HostDevice(const ReplayOptions& opt) : rt_(std::make_unique<firmware::HadynetRuntime<M>>()) {
     if (opt.control_epochs >= 0) rt_->control_settings().epochs = opt.control_epochs;
     if (opt.control_truncation >= 1) rt_->control_settings().truncation = opt.control_truncation;
+    if (opt.adapt) {
+      typename firmware::PbAdapter<M>::Settings s = rt_->adapter().settings();
+      if (opt.adapt_window_stride > 0) s.window_stride = opt.adapt_window_stride;
+      if (opt.adapt_windows_per_period > 0) s.windows_per_period = opt.adapt_windows_per_period;
+      if (!rt_->set_adapt_settings(s)) throw std::invalid_argument("PB adaptation: invalid stride or budget");
+    }
   }
+  void set_adapting(bool on) { rt_->set_adapting(on); }
+  void reset() { rt_->reset(); }
   void set_pb(const float (&pb)[M::kPb]) { rt_->set_pb(pb); }
   bool set_pb_state(int state) { return rt_->set_pb_state(state); }
   void set_mode(firmware::Mode mode) { rt_->set_mode(mode); }
   firmware::StepResult<M> step(const firmware::SensorFrame<M>& frame, ReplayStep& s) {
     const firmware::StepResult<M> r = rt_->step(frame);
+    if (rt_->adapting()) {
+      s.adapted_pb.resize(M::kPb);
+      for (int i = 0; i < M::kPb; ++i)
+        s.adapted_pb[static_cast<std::size_t>(i)] =
+            firmware::Numerics<M>::template to_real<M::kFracIn>(rt_->adapter().pb()[i]);
+    }
     if (r.command_valid) {
       s.loss_initial = firmware::GraspStabilizer<M>::loss_value(rt_->stabilizer().loss_initial());
       s.loss_final = firmware::GraspStabilizer<M>::loss_value(rt_->stabilizer().loss_final());
@@ -72,6 +86,7 @@ class LinkDevice {
   LinkDevice(tools::ByteStream& stream, const ReplayOptions& opt) : session_(stream) {
     if (opt.control_epochs >= 0 || opt.control_truncation >= 1)
       throw std::invalid_argument("stabiliser settings cannot be changed over the link");
+    if (opt.adapt) throw std::invalid_argument("PB adaptation is not yet switched on over the link: use --target hostsim");
     session_.connect();
     const link::InfoReply info = session_.info();
     if (info.model_hash != M::kModelHash || info.numeric != (firmware::kIsFixed<M> ? 0 : 1))
@@ -84,6 +99,8 @@ class LinkDevice {
     return true;
   }
   void set_mode(firmware::Mode mode) { session_.set_mode(mode); }
+  void set_adapting(bool) {}
+  void reset() { session_.reset(); }
   firmware::StepResult<M> step(const firmware::SensorFrame<M>& frame, ReplayStep&) { return session_.step(frame); }
 
  private:
@@ -91,9 +108,8 @@ class LinkDevice {
 };
 
 template <class M, class Device>
-ReplayResult replay_on(Device& device, const datalog::LogTable& log, const std::string& file,
-                       const ReplayOptions& opt) {
-  const CompiledModelInfo info = info_of<M>();
+void replay_one(Device& device, const datalog::LogTable& log, const std::string& file, const ReplayOptions& opt,
+                ReplayResult& result) {
   const ChannelBinding binding = bind_channels<M>(log.columns, log.columns, file, "column", "column");
   const auto t_col = log.column_index("t");
   std::vector<std::size_t> signal_cols = binding.y;
@@ -101,23 +117,7 @@ ReplayResult replay_on(Device& device, const datalog::LogTable& log, const std::
     if (c != ChannelBinding::kComputed) signal_cols.push_back(c);
   datalog::check_magnitudes(log, signal_cols, datalog::kMaxSignalMagnitude, file,
                             "the firmware's boundary is float32 (docs/input-limits.md)");
-  if (!opt.pb.empty()) {
-    if (static_cast<int>(opt.pb.size()) != M::kPb)
-      throw std::invalid_argument("PB has " + std::to_string(opt.pb.size()) + " values, the model " +
-                                  std::to_string(M::kPb));
-    float pb[M::kPb];
-    for (int i = 0; i < M::kPb; ++i) pb[i] = opt.pb[static_cast<std::size_t>(i)];
-    device.set_pb(pb);
-  } else if (opt.pb_state >= 0 && !device.set_pb_state(opt.pb_state)) {
-    throw std::invalid_argument("PB state " + std::to_string(opt.pb_state) + " is not in the model's table (" +
-                                std::to_string(M::kStates) + " states)");
-  }
-  device.set_mode(opt.mode);
-
-  ReplayResult result;
-  result.y_names = info.y_names;
-  result.u_names = info.u_names;
-  result.steps.reserve(log.rows());
+  result.log_first_step.push_back(result.steps.size());
   firmware::SensorFrame<M> frame{};
   for (std::size_t row = 0; row < log.rows(); ++row) {
     if (opt.control_from >= 0 && row == static_cast<std::size_t>(opt.control_from))
@@ -136,13 +136,50 @@ ReplayResult replay_on(Device& device, const datalog::LogTable& log, const std::
     s.contact = r.contact;
     s.command_valid = r.command_valid;
     s.command.assign(r.command, r.command + M::kU);
+    s.adapt_updates = r.adapt_updates;
+    if (r.adapt_valid && r.recognition.valid) {
+      s.recognized_state = r.recognition.state;
+      s.recognized_distance = r.recognition.distance;
+      s.other_state = r.recognition.other_state;
+      s.other_distance = r.recognition.other_distance;
+    }
     result.steps.push_back(std::move(s));
+  }
+}
+
+template <class M, class Device>
+ReplayResult replay_on(Device& device, const std::vector<datalog::LogTable>& logs,
+                       const std::vector<std::string>& files, const ReplayOptions& opt) {
+  const CompiledModelInfo info = info_of<M>();
+  if (!opt.pb.empty()) {
+    if (static_cast<int>(opt.pb.size()) != M::kPb)
+      throw std::invalid_argument("PB has " + std::to_string(opt.pb.size()) + " values, the model " +
+                                  std::to_string(M::kPb));
+    float pb[M::kPb];
+    for (int i = 0; i < M::kPb; ++i) pb[i] = opt.pb[static_cast<std::size_t>(i)];
+    device.set_pb(pb);
+  } else if (opt.pb_state >= 0 && !device.set_pb_state(opt.pb_state)) {
+    throw std::invalid_argument("PB state " + std::to_string(opt.pb_state) + " is not in the model's table (" +
+                                std::to_string(M::kStates) + " states)");
+  }
+  device.set_mode(opt.mode);
+  if (opt.adapt) device.set_adapting(true);  // from the active PB
+
+  ReplayResult result;
+  result.y_names = info.y_names;
+  result.u_names = info.u_names;
+  result.state_names = info.state_names;
+  result.adapt = opt.adapt;
+  for (std::size_t i = 0; i < logs.size(); ++i) {
+    if (i > 0) device.reset();  // a new recording
+    replay_one<M>(device, logs[i], files[i], opt, result);
   }
   return result;
 }
 
 template <class M>
-ReplayResult replay_with(const datalog::LogTable& log, const std::string& file, const ReplayOptions& opt) {
+ReplayResult replay_with(const std::vector<datalog::LogTable>& log, const std::vector<std::string>& file,
+                         const ReplayOptions& opt) {
   switch (opt.target) {
     case ReplayTarget::kQemu: {
       tools::QemuProcess qemu({"qemu-system-arm", opt.qemu_machine, opt.qemu_image, false, opt.qemu_log, opt.qemu_loads});
@@ -173,9 +210,15 @@ CompiledModelInfo compiled_model_info(firmware::Numeric numeric) {
   return numeric == firmware::Numeric::kQ15 ? info_of<model_q15::Model>() : info_of<model_f32::Model>();
 }
 
+ReplayResult replay_logs(const std::vector<datalog::LogTable>& logs, const std::vector<std::string>& files,
+                         const ReplayOptions& options) {
+  if (logs.size() != files.size() || logs.empty()) throw std::invalid_argument("replay: one file name per log");
+  return options.numeric == firmware::Numeric::kQ15 ? replay_with<model_q15::Model>(logs, files, options)
+                                                : replay_with<model_f32::Model>(logs, files, options);
+}
+
 ReplayResult replay_log(const datalog::LogTable& log, const std::string& file, const ReplayOptions& options) {
-  return options.numeric == firmware::Numeric::kQ15 ? replay_with<model_q15::Model>(log, file, options)
-                                                : replay_with<model_f32::Model>(log, file, options);
+  return replay_logs({log}, {file}, options);
 }
 
 std::string format_replay_csv(const ReplayResult& result) {
@@ -183,8 +226,22 @@ std::string format_replay_csv(const ReplayResult& result) {
   for (const auto& n : result.y_names) s += ",est_" + n;
   s += ",distance_valid,d,contact,command_valid";
   for (const auto& n : result.u_names) s += ",cmd_" + n;
-  s += ",loss_initial,loss_final\n";
-  for (const auto& st : result.steps) {
+  s += ",loss_initial,loss_final";
+  const std::size_t pb_size = result.steps.empty() ? 0 : result.steps.front().adapted_pb.size();
+  if (result.adapt) {
+    s += ",log,adapt_updates";
+    for (std::size_t i = 0; i < pb_size; ++i) s += ",pb_" + std::to_string(i);
+    s += ",recognized,distance,other,other_distance";
+  }
+  s += '\n';
+  const auto state_name = [&](int k) {
+    return k >= 0 && static_cast<std::size_t>(k) < result.state_names.size() ? result.state_names[static_cast<std::size_t>(k)]
+                                                                            : std::string();
+  };
+  std::size_t log = 0;
+  for (std::size_t step = 0; step < result.steps.size(); ++step) {
+    const ReplayStep& st = result.steps[step];
+    while (log + 1 < result.log_first_step.size() && result.log_first_step[log + 1] <= step) ++log;
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.9g", st.time);
     s += buf;
@@ -197,6 +254,14 @@ std::string format_replay_csv(const ReplayResult& result) {
     for (float v : st.command) append_float(s, v);
     append_float(s, st.loss_initial);
     append_float(s, st.loss_final);
+    if (result.adapt) {
+      s += "," + std::to_string(log) + "," + std::to_string(st.adapt_updates);
+      for (float v : st.adapted_pb) append_float(s, v);
+      s += "," + state_name(st.recognized_state);
+      append_float(s, st.recognized_distance);
+      s += "," + state_name(st.other_state);
+      append_float(s, st.other_distance);
+    }
     s += '\n';
   }
   return s;

@@ -30,6 +30,9 @@ struct ReplayOptions {
   std::vector<float> pb;       // explicit standardised PB; overrides pb_state if non-empty
   int control_epochs = -1;     // -1: the model's default
   int control_truncation = -1; // -1: the model's default
+  bool adapt = false;          // PB adaptation on from the first row (firmware/core/pb_adapter.h)
+  int adapt_window_stride = -1;       // -1: the firmware's default
+  int adapt_windows_per_period = -1;  // -1: the firmware's default
   ReplayTarget target = ReplayTarget::kHostSim;
   std::string qemu_image;      // firmware ELF (target qemu); its model must be the compiled-in one
   std::string qemu_machine = "mps2-an386";
@@ -51,11 +54,21 @@ struct ReplayStep {
   std::vector<float> command;  // u_t from the stabiliser
   double loss_initial = 0.0;   // stabiliser: L of the warm start
   double loss_final = 0.0;     // stabiliser: L of the adopted sequence
+  // PB adaptation (options.adapt): steps taken, the adapted PB (standardised)
+  // and its nearest trained states (-1: none yet).
+  std::uint32_t adapt_updates = 0;
+  std::vector<float> adapted_pb;
+  int recognized_state = -1;
+  float recognized_distance = 0.0f;
+  int other_state = -1;
+  float other_distance = 0.0f;
 };
 
 struct ReplayResult {
-  std::vector<std::string> y_names, u_names;
+  std::vector<std::string> y_names, u_names, state_names;
+  bool adapt = false;  // the steps carry the adaptation's columns
   std::vector<ReplayStep> steps;
+  std::vector<std::size_t> log_first_step;  // index of each log's first step (replay_logs)
 };
 
 // What the compiled-in generated model is (for --help, info and checks).
@@ -78,9 +91,16 @@ CompiledModelInfo compiled_model_info(firmware::Numeric numeric);
 // the stabiliser's losses are not reported (0).
 ReplayResult replay_log(const datalog::LogTable& log, const std::string& file,
                         const ReplayOptions& options);
+// Several logs through one device, one after the other: the device is reset
+// between them (a new recording: no window or history spans two logs), its
+// PB, mode and adaptation carry over (an object change mid-stream).
+ReplayResult replay_logs(const std::vector<datalog::LogTable>& logs, const std::vector<std::string>& files,
+                         const ReplayOptions& options);
 
-// CSV: t, valid flags, y_est_<y>..., d, contact, u_<u>..., losses; floats
-// with 9 significant digits (float round trip).
+// CSV: t, valid flags, y_est_<y>..., d, contact, u_<u>..., losses, and with
+// adaptation: log, adapt_updates, pb_0.., recognized (state name), distance,
+// other (nearest state of another object), other_distance; floats with 9
+// significant digits (float round trip).
 std::string format_replay_csv(const ReplayResult& result);
 
 }  // namespace hadynet::hostsim

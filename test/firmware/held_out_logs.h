@@ -31,8 +31,8 @@ inline const datalog::LogTable& held_out_table(const std::string& object, const 
   auto it = cache.find(key);
   if (it == cache.end()) {
     plant::ExperimentSpec spec;
-    spec.object = *plant::parse_object(object);
-    spec.motion = *plant::parse_motion(motion);
+    spec.object = plant::parse_object(object).value();
+    spec.motion = plant::parse_motion(motion).value();
     spec.init_id = 3;
     spec.steps = steps;
     spec.seed = 1;

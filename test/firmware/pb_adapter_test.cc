@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "hadynet_model_q15.h"
 #include "test/firmware/held_out_logs.h"
 #include "trainer/pb_adaptation.h"
+#include "trainer/recognition.h"
 #include "trainer/window_dataset.h"
 
 namespace hadynet {
@@ -97,7 +99,7 @@ float max_abs(const std::vector<float>& v) {
 // a step of rate 0.05, exact to ~1e-6).
 TEST(PbAdapter, WindowGradientEqualsTheTrainers) {
   for (const char* object : {"Cylinder", "Hammer"}) {
-    const trainer::LogSequence seq = test::held_out_sequence(object, "Random2");
+    const trainer::LogSequence seq = test::held_out_sequence(object, "random2");
     for (int state : {0, 4}) {
       float loss_fw = 0, loss_tr = 0;
       const std::vector<float> g_fw = firmware_window_gradient<F>(seq, state, &loss_fw);
@@ -118,7 +120,7 @@ TEST(PbAdapter, WindowGradientEqualsTheTrainers) {
 // adaptation"), losses within 1 %.
 TEST(PbAdapter, FixedPointGradientFollowsTheFloatOne) {
   for (const char* object : {"Cylinder", "Hammer", "None"}) {
-    const trainer::LogSequence seq = test::held_out_sequence(object, "Random2");
+    const trainer::LogSequence seq = test::held_out_sequence(object, "random2");
     for (int state : {0, 4, 9}) {
       float loss_q = 0, loss_f = 0;
       const std::vector<float> g_q = firmware_window_gradient<Q>(seq, state, &loss_q);
@@ -132,6 +134,74 @@ TEST(PbAdapter, FixedPointGradientFollowsTheFloatOne) {
       EXPECT_LT(std::sqrt(diff / norm), 0.05) << object << " state " << state;
       EXPECT_NEAR(loss_q, loss_f, 0.01 * loss_f) << object << " state " << state;
     }
+  }
+}
+
+}  // namespace
+}  // namespace hadynet
+
+namespace hadynet {
+namespace {
+
+// The mean window loss of `seq` under PB `pb` (standardised), by the trainer.
+double trainer_loss(const trainer::LogSequence& seq, const Eigen::VectorXf& pb) {
+  const trainer::HadynetModel& model = test::build_model();
+  const trainer::WindowDataset data({seq}, {0}, model.layout, model.norm, F::kTrainSteps);
+  std::vector<int> ids(static_cast<std::size_t>(data.size()));
+  for (int i = 0; i < data.size(); ++i) ids[static_cast<std::size_t>(i)] = i;
+  return trainer::adapt_pb(model, data, ids, pb, {0, 1.0, 0.9}).loss.front();
+}
+
+template <class M>
+Eigen::VectorXf real_pb(const typename M::Value (&pb)[M::kPb]) {
+  Eigen::VectorXf p(M::kPb);
+  for (int i = 0; i < M::kPb; ++i) p(i) = firmware::Numerics<M>::template to_real<M::kFracIn>(pb[i]);
+  return p;
+}
+
+// Streams `seq` through a runtime adapting in detect mode; returns the adapted PB.
+int g_stride = 1;
+template <class M>
+Eigen::VectorXf runtime_adapt(const trainer::LogSequence& seq, int* updates, int* recognized) {
+  auto rt = std::make_unique<firmware::HadynetRuntime<M>>();
+  typename firmware::PbAdapter<M>::Settings s;
+  s.window_stride = g_stride;
+  EXPECT_TRUE(rt->set_adapt_settings(s));
+  rt->set_mode(firmware::Mode::kDetect);
+  rt->set_adapting(true);
+  firmware::StepResult<M> out;
+  for (int t = 0; t < seq.steps(); ++t) {
+    firmware::SensorFrame<M> f{};
+    for (int i = 0; i < M::kY; ++i) f.y[i] = static_cast<float>(seq.y(i, t));
+    if (t > 0)
+      for (int i = 0; i < M::kU; ++i) f.u_prev[i] = static_cast<float>(seq.u(i, t - 1));
+    out = rt->step(f);
+  }
+  *updates = static_cast<int>(out.adapt_updates);
+  *recognized = out.recognition.valid ? out.recognition.state : -1;
+  return real_pb<M>(rt->adapter().pb());
+}
+
+TEST(PbAdapterExplore, StreamLowersTheErrorOfAReinitialisedHand) {
+  const trainer::HadynetModel& model = test::build_model();
+  if (const char* e = std::getenv("STRIDE")) g_stride = std::atoi(e);
+  for (const char* object : {"Cylinder", "Hammer", "None", "Ball"}) {
+    const trainer::LogSequence stream = test::held_out_sequence(object, "random2", 400);
+    const trainer::LogSequence eval = test::held_out_sequence(object, "random1", 150);
+    const Eigen::VectorXf stale = real_pb<F>(firmware::kCompiledTensors<F>.detect_pb);
+    int uq = 0, uf = 0, rq = -1, rf = -1;
+    const Eigen::VectorXf pq = runtime_adapt<Q>(stream, &uq, &rq);
+    const Eigen::VectorXf pf = runtime_adapt<F>(stream, &uf, &rf);
+    Eigen::VectorXf pt = stale;
+    if (std::getenv("ONLINE")) {
+      trainer::OnlinePbAdapter online(model, stale, {});
+      for (int t = 0; t < stream.steps(); ++t) online.push(stream.y.col(t), stream.u.col(t));
+      pt = online.pb();
+    }
+    std::printf("%s: loss stale %.4f  q15 %.4f (%d steps, state %d)  f32 %.4f (%d, %d)  trainer online %.4f (%s)  |q-f| %.3f |f-t| %.3f\n",
+                object, trainer_loss(eval, stale), trainer_loss(eval, pq), uq, rq, trainer_loss(eval, pf), uf, rf,
+                trainer_loss(eval, pt), model.states[static_cast<std::size_t>(trainer::nearest_pb(model, pt).state)].name.c_str(),
+                (pq - pf).norm(), (pf - pt).norm());
   }
 }
 
