@@ -17,6 +17,7 @@
 #include "cli/trainer_inputs.h"
 #include "trainer/model_file.h"
 #include "trainer/pb_adaptation.h"
+#include "trainer/recognition.h"
 
 namespace hadynet::cli {
 
@@ -32,7 +33,7 @@ int run_online(const trainer::HadynetModel& model, const std::vector<trainer::Lo
   }
   std::fprintf(csv, "log,t_step,windows,loss");
   for (int i = 0; i < model.params.dims.pb; ++i) std::fprintf(csv, ",p%d", i);
-  std::fprintf(csv, "\n");
+  std::fprintf(csv, ",nearest,distance\n");
   std::vector<Eigen::VectorXf> trajectory;
   std::vector<MarkedPb> finals;
   trainer::OnlinePbAdapter adapter(model, start, options);
@@ -43,7 +44,10 @@ int run_online(const trainer::HadynetModel& model, const std::vector<trainer::Lo
       std::fprintf(csv, "%s,%d,%d,%.6g", seq.file.c_str(), t, adapter.windows(), adapter.last_loss());
       for (Eigen::Index i = 0; i < adapter.pb().size(); ++i)
         std::fprintf(csv, ",%.6g", static_cast<double>(adapter.pb()(i)));
-      std::fprintf(csv, "\n");
+      const trainer::NearestPb nearest = trainer::nearest_pb(model, adapter.pb());
+      std::fprintf(csv, ",%s,%.6g\n",
+                   nearest.state < 0 ? "" : model.states[static_cast<std::size_t>(nearest.state)].name.c_str(),
+                   nearest.distance);
       trajectory.push_back(adapter.pb());
     }
     finals.push_back({(seq.object.empty() ? seq.state : seq.object) + " (end of log)", adapter.pb()});

@@ -163,6 +163,12 @@ class GraspStabilizer {
     }
   }
 
+  // The rollout traces are scratch of one plan() call: between calls another
+  // user may borrow them (the runtime lends them to PB adaptation, which
+  // never runs in the same period), kScratchTraces entries.
+  static constexpr int kScratchTraces = 2 * kHorizon;
+  StepTrace<M>* scratch_traces() noexcept { return trace_[0]; }
+
   // Diagnostics of the last plan().
   Loss loss_initial() const noexcept { return loss_initial_; }  // warm start's L
   Loss loss_final() const noexcept { return loss_final_; }      // adopted sequence's L

@@ -191,7 +191,7 @@ class HadynetRuntime {
 
     if (adapting_) {
       adapter_.push(y_frame, u_frame);
-      if (mode_ != Mode::kControl) adapter_.work(net_);
+      if (mode_ != Mode::kControl) adapter_.work(net_, adapt_traces());
       out.adapt_updates = adapter_.updates();
       out.adapt_valid = out.adapt_updates > 0;
       if (out.adapt_valid) out.recognition = adapter_.recognize();
@@ -208,6 +208,22 @@ class HadynetRuntime {
     }
   }
 
+  // PB adaptation's back-propagation traces: the stabiliser's rollout
+  // traces (scratch of plan(); adaptation never runs in control mode), or
+  // its own if the stabiliser's horizon holds too few.
+  static constexpr bool kBorrowTraces = GraspStabilizer<M>::kScratchTraces >= M::kTrainSteps;
+  struct OwnTraces {
+    StepTrace<M> t[M::kTrainSteps];
+  };
+  struct NoTraces {};
+  StepTrace<M>* adapt_traces() noexcept {
+    if constexpr (kBorrowTraces) {
+      return stabilizer_.scratch_traces();
+    } else {
+      return own_traces_.t;
+    }
+  }
+
   const ModelTensors<M>* t_;
   B boundary_;
   Mode mode_ = Mode::kDetect;
@@ -220,6 +236,7 @@ class HadynetRuntime {
   GraspStabilizer<M> stabilizer_{};
   bool adapting_ = false;
   PbAdapter<M> adapter_{*t_};
+  [[no_unique_address]] std::conditional_t<kBorrowTraces, NoTraces, OwnTraces> own_traces_{};
 };
 
 }  // namespace hadynet::firmware

@@ -154,14 +154,15 @@ class PbAdapter {
   void push(const float (&y)[kY], const float (&u_prev)[kU]) noexcept {
     const int s = slot(frames_);
     for (int i = 0; i < kY; ++i) y_[s][i] = y[i];
-    for (int i = 0; i < kU; ++i) u_[s][i] = u_prev[i];
+    Boundary<M>(*t_).u_to_model(u_prev, u_[s]);
     segment_of_[s] = segment_first_;
     ++frames_;
   }
 
   // Spends one period's budget on the current epoch (starting one if enough
-  // windows are held). `net`'s state is overwritten. True if the PB changed.
-  bool work(HadynetNet<M>& net) noexcept {
+  // windows are held). `net`'s state is overwritten; `traces` (kSteps
+  // entries) is scratch of this call. True if the PB changed.
+  bool work(HadynetNet<M>& net, StepTrace<M>* traces) noexcept {
     bool changed = false;
     for (int budget = settings_.windows_per_period; budget > 0;) {
       if (!in_epoch_ && !start_epoch()) break;
@@ -169,7 +170,7 @@ class PbAdapter {
         changed = finish_epoch() || changed;
         continue;
       }
-      run_window(net, next_++);
+      run_window(net, traces, next_++);
       --budget;
       if (!seek_valid()) changed = finish_epoch() || changed;
     }
@@ -289,7 +290,7 @@ class PbAdapter {
 
   // Forward and back-propagation through time of window a under pb_:
   // adds its loss and dL/dp to the epoch's sums.
-  void run_window(HadynetNet<M>& net, std::uint32_t a) noexcept {
+  void run_window(HadynetNet<M>& net, StepTrace<M>* trace, std::uint32_t a) noexcept {
     const Boundary<M> boundary(*t_);
     Value x[kX];
     boundary.x_from_frames(y_[slot(a + 1)], y_[slot(a)], x);
@@ -301,10 +302,9 @@ class PbAdapter {
     [[maybe_unused]] std::int64_t max_abs = 0;
     for (int k = 0; k < kSteps; ++k) {
       const int f = slot(a + 2 + static_cast<std::uint32_t>(k));
-      Value u[kU], target[kY];
-      boundary.u_to_model(u_[f], u);
+      Value target[kY];
       boundary.y_to_model(y_[f], target);
-      net.step(u, y_est, &trace_[k]);
+      net.step(u_[f], y_est, &trace[k]);
       for (int i = 0; i < kY; ++i) {
         if constexpr (kFixed) {
           const std::int32_t e = std::int32_t{y_est[i]} - target[i];
@@ -341,7 +341,7 @@ class PbAdapter {
         }
       }
       net.backward_decoder(dy, dh);
-      net.backward_step_pb(trace_[k], dh, dc, dpb, dh_prev);
+      net.backward_step_pb(trace[k], dh, dc, dpb, dh_prev);
       for (int j = 0; j < kH; ++j) dh[j] = dh_prev[j];
     }
     net.backward_encoder_pb(h0.h, dh, dpb);
@@ -506,9 +506,10 @@ class PbAdapter {
 
   const ModelTensors<M>* t_;
   Settings settings_{};
-  // Frames, physical (the model's frame), by frame number modulo kRingFrames.
+  // Frames by frame number modulo kRingFrames: y physical (the model's
+  // frame; x's changes need it), the command standardised (as the net reads it).
   float y_[kRingFrames][kY] = {};
-  float u_[kRingFrames][kU] = {};
+  Value u_[kRingFrames][kU] = {};
   std::uint32_t segment_of_[kRingFrames] = {};  // first frame of the frame's segment
   std::uint32_t frames_ = 0;                    // frames pushed so far
   std::uint32_t segment_first_ = 0;
@@ -537,8 +538,7 @@ class PbAdapter {
   Loss common_now_ = 0, common_base_ = 0;
   int common_count_ = 0;
   Wide grad_sum_[kPb] = {};  // q15: Q(kGradAccFrac)
-  // One window's back-propagation buffers.
-  StepTrace<M> trace_[kSteps] = {};
+  // One window's errors (its traces are the caller's).
   std::conditional_t<kFixed, std::int32_t, float> error_[kSteps][kY] = {};
 };
 

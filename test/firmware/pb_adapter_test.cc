@@ -51,6 +51,7 @@ template <class M>
 std::vector<float> firmware_window_gradient(const trainer::LogSequence& seq, int state, float* loss) {
   auto adapter = std::make_unique<PbAdapter<M, 1>>();
   auto net = std::make_unique<HadynetNet<M>>();
+  std::vector<firmware::StepTrace<M>> traces(M::kTrainSteps);
   typename PbAdapter<M, 1>::Settings s;
   s.start_windows = 1;
   s.windows_per_period = 1;
@@ -58,7 +59,7 @@ std::vector<float> firmware_window_gradient(const trainer::LogSequence& seq, int
   adapter->restart(firmware::kCompiledTensors<M>.pb_table[state]);
   for (int t = 0; t < M::kTrainSteps + 2; ++t) push_frame<M>(*adapter, seq, t);
   EXPECT_EQ(adapter->windows_held(), 1);
-  EXPECT_TRUE(adapter->work(*net));
+  EXPECT_TRUE(adapter->work(*net, traces.data()));
   EXPECT_EQ(adapter->updates(), 1u);
   float g[M::kPb];
   adapter->last_gradient(g);
