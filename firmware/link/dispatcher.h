@@ -122,6 +122,21 @@ class LinkDispatcher {
         payload_size = encode_period_result<M>(loop_.latest(), payload);
         break;
       }
+      case MessageType::kAdapt: {
+        AdaptRequest q;
+        if (const Status s = decode_adapt(f.payload, q); !s.ok()) return refuse(s);
+        typename firmware::PbAdapter<M>::Settings settings = runtime_.adapter().settings();
+        if (q.window_stride != 0) settings.window_stride = q.window_stride;
+        if (q.windows_per_period != 0) settings.windows_per_period = q.windows_per_period;
+        if (!firmware::PbAdapter<M>::valid(settings))
+          return refuse({ErrorCode::kBadValue, "adapt: stride or windows per period out of range"});
+        runtime_.set_adapt_settings(settings);
+        if (q.action == AdaptAction::kOn) runtime_.set_adapting(true);
+        if (q.action == AdaptAction::kOff) runtime_.set_adapting(false);
+        if (q.action == AdaptAction::kAdopt) runtime_.use_adapted_pb();
+        payload_size = encode_adapt_status<M>(adapt_status_of(runtime_), payload);
+        break;
+      }
       default:  // is_request_type() admits no other type
         return error_reply(ErrorCode::kUnknownType, f.sequence, "unknown message type", reply);
     }

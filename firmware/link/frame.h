@@ -50,6 +50,7 @@ enum class MessageType : std::uint8_t {
   kMuscleState = 0x06,         // the host's half of the autonomous loop's frame
   kTare = 0x07,                // loadcell offsets
   kPeriodResultRequest = 0x08,  // the autonomous loop's latest period record
+  kAdapt = 0x09,                // PB adaptation on/off/adopt, its status
   kError = 0x7F,  // reply to any request that was not executed
   kInfo = 0x81,
   kStepResult = 0x82,
@@ -59,12 +60,13 @@ enum class MessageType : std::uint8_t {
   kMuscleStateAck = 0x86,
   kTareAck = 0x87,
   kPeriodResult = 0x88,
+  kAdaptStatus = 0x89,
 };
 inline constexpr std::uint8_t kReplyBit = 0x80;  // reply type = request type | kReplyBit
 
 constexpr bool is_request_type(std::uint8_t type) noexcept {
   return type >= static_cast<std::uint8_t>(MessageType::kInfoRequest) &&
-         type <= static_cast<std::uint8_t>(MessageType::kPeriodResultRequest);
+         type <= static_cast<std::uint8_t>(MessageType::kAdapt);
 }
 constexpr MessageType reply_type_of(MessageType request) noexcept {
   return static_cast<MessageType>(static_cast<std::uint8_t>(request) | kReplyBit);

@@ -102,6 +102,11 @@ class LinkClient {
     return request(MessageType::kTare, encode_tare(action, payload()), wire);
   }
 
+  // PB adaptation: on, off, adopt the adapted PB, or its status (reply 0x89).
+  std::size_t adapt(const AdaptRequest& q, std::span<std::uint8_t> wire) noexcept {
+    return request(MessageType::kAdapt, encode_adapt(q, payload()), wire);
+  }
+
   // The autonomous loop's latest period record (reply 0x88).
   std::size_t period_result_request(std::span<std::uint8_t> wire) noexcept {
     return request(MessageType::kPeriodResultRequest, 0, wire);

@@ -33,6 +33,7 @@ inline constexpr std::size_t kSetPbStatePayload = 1 + 2;
 inline constexpr std::size_t kErrorPayloadMax = 1 + 2 + 1 + kMaxReason;
 inline constexpr std::size_t kTarePayload = 1;
 inline constexpr std::size_t kMuscleStateAckPayload = 4;
+inline constexpr std::size_t kAdaptPayload = 3;
 
 // Payload sizes (bytes) for model M; the build fails if M is too large for
 // version-1 frames.
@@ -41,13 +42,15 @@ struct PayloadSizes {
   static constexpr std::size_t kSensorFrame = 4 * (M::kY + M::kU);
   static constexpr std::size_t kStepResult = 1 + 4 * M::kY + 4 + 4 * M::kU;
   static constexpr std::size_t kSetPbValues = 1 + 4 * M::kPb;
+  static constexpr std::size_t kAdaptStatus = 1 + 4 + 4 + 2 + 1 + 1 + 4 + 2 + 4 + 2 + 4 + 4 * M::kPb;
   // The autonomous loop's messages (channel_layout.h: kMuscleY observed
   // channels that are not loadcells, kLoadcells loadcells).
   static constexpr std::size_t kMuscleState = 4 * (app::ChannelLayout<M>::kMuscleY + M::kU);
   static constexpr std::size_t kTareAck = 4 * app::ChannelLayout<M>::kLoadcells;
   static constexpr std::size_t kPeriodResult =
       4 + 4 + 1 + 2 + 4 + 4 + 4 + 4 * (app::ChannelLayout<M>::kLoadcells + 1 + M::kY + M::kU);
-  static_assert(kSensorFrame <= kMaxPayload && kStepResult <= kMaxPayload && kSetPbValues <= kMaxPayload,
+  static_assert(kSensorFrame <= kMaxPayload && kStepResult <= kMaxPayload && kSetPbValues <= kMaxPayload &&
+                    kAdaptStatus <= kMaxPayload,
                 "the model's messages exceed the protocol's kMaxPayload");
   static_assert(kMuscleState <= kMaxPayload && kTareAck <= kMaxPayload && kPeriodResult <= kMaxPayload,
                 "the model's messages exceed the protocol's kMaxPayload");
@@ -401,6 +404,129 @@ constexpr bool decode_period_result(std::span<const std::uint8_t> in, app::Perio
   for (float& v : r.command) v = rd.f32();
   return rd.ok() && mode <= static_cast<std::uint8_t>(firmware::Mode::kControl) &&
          (r.flags & ~app::kRecordKnownFlags) == 0;
+}
+
+// ---- 0x09 adapt: action u8, window stride u8, windows per period u8
+// (0: keep). 0x89 adapt status: below.
+
+enum class AdaptAction : std::uint8_t {
+  kStatus = 0,  // change nothing (but the settings given)
+  kOn = 1,      // adaptation on, from the active PB (no change if already on)
+  kOff = 2,     // adaptation off; the adapted PB is kept
+  kAdopt = 3,   // the adapted PB becomes the active PB (detection, control)
+};
+
+struct AdaptRequest {
+  AdaptAction action = AdaptAction::kStatus;
+  std::uint8_t window_stride = 0;       // 0: keep
+  std::uint8_t windows_per_period = 0;  // 0: keep
+};
+
+constexpr std::size_t encode_adapt(const AdaptRequest& q, std::span<std::uint8_t> out) noexcept {
+  ByteWriter w(out);
+  w.u8(static_cast<std::uint8_t>(q.action));
+  w.u8(q.window_stride);
+  w.u8(q.windows_per_period);
+  return w.ok() ? w.size() : 0;
+}
+
+// Checks size and action; the settings' ranges are the adapter's (the
+// dispatcher refuses what PbAdapter::valid refuses).
+constexpr Status decode_adapt(std::span<const std::uint8_t> in, AdaptRequest& q) noexcept {
+  if (in.size() != kAdaptPayload) return {ErrorCode::kBadPayloadLength, "adapt: wrong size"};
+  if (in[0] > static_cast<std::uint8_t>(AdaptAction::kAdopt)) return {ErrorCode::kBadValue, "adapt: unknown action"};
+  q.action = static_cast<AdaptAction>(in[0]);
+  q.window_stride = in[1];
+  q.windows_per_period = in[2];
+  return {};
+}
+
+inline constexpr std::uint16_t kNoState = 0xFFFF;
+
+// The adaptation's state as the 0x89 reply carries it: on u8, updates u32
+// (steps taken), rejected u32 (steps the safeguard undid), windows u16
+// (held), stride u8, windows per period u8, loss f32 (mean squared error of
+// the last epoch, standardised), state u16 (nearest PB-table row of the
+// adapted PB; 0xFFFF before the first step or without a table), distance
+// f32, other u16 (nearest row of another object; 0xFFFF none), other
+// distance f32, pb[kPb] f32 (the adapted PB, standardised).
+template <firmware::GeneratedModel M>
+struct AdaptStatus {
+  std::uint8_t on = 0;
+  std::uint32_t updates = 0;
+  std::uint32_t rejected = 0;
+  std::uint16_t windows = 0;
+  std::uint8_t window_stride = 0;
+  std::uint8_t windows_per_period = 0;
+  float loss = 0.0f;
+  std::uint16_t state = kNoState;
+  float distance = 0.0f;
+  std::uint16_t other_state = kNoState;
+  float other_distance = 0.0f;
+  float pb[M::kPb] = {};
+};
+
+template <firmware::GeneratedModel M>
+AdaptStatus<M> adapt_status_of(const firmware::HadynetRuntime<M>& runtime) noexcept {
+  const firmware::PbAdapter<M>& a = runtime.adapter();
+  AdaptStatus<M> s;
+  s.on = runtime.adapting() ? 1 : 0;
+  s.updates = a.updates();
+  s.rejected = a.rejected();
+  s.windows = static_cast<std::uint16_t>(a.windows_held());
+  s.window_stride = static_cast<std::uint8_t>(a.settings().window_stride);
+  s.windows_per_period = static_cast<std::uint8_t>(a.settings().windows_per_period);
+  s.loss = a.last_loss();
+  if (a.updates() > 0) {
+    const firmware::PbRecognition r = a.recognize();
+    if (r.valid) {
+      s.state = static_cast<std::uint16_t>(r.state);
+      s.distance = r.distance;
+      if (r.other_state >= 0) {
+        s.other_state = static_cast<std::uint16_t>(r.other_state);
+        s.other_distance = r.other_distance;
+      }
+    }
+  }
+  for (int i = 0; i < M::kPb; ++i) s.pb[i] = firmware::Numerics<M>::template to_real<M::kFracIn>(a.pb()[i]);
+  return s;
+}
+
+template <firmware::GeneratedModel M>
+constexpr std::size_t encode_adapt_status(const AdaptStatus<M>& s, std::span<std::uint8_t> out) noexcept {
+  ByteWriter w(out);
+  w.u8(s.on);
+  w.u32(s.updates);
+  w.u32(s.rejected);
+  w.u16(s.windows);
+  w.u8(s.window_stride);
+  w.u8(s.windows_per_period);
+  w.f32(s.loss);
+  w.u16(s.state);
+  w.f32(s.distance);
+  w.u16(s.other_state);
+  w.f32(s.other_distance);
+  for (const float v : s.pb) w.f32(v);
+  return w.ok() ? w.size() : 0;
+}
+
+template <firmware::GeneratedModel M>
+constexpr bool decode_adapt_status(std::span<const std::uint8_t> in, AdaptStatus<M>& s) noexcept {
+  if (in.size() != PayloadSizes<M>::kAdaptStatus) return false;
+  ByteReader rd(in);
+  s.on = rd.u8();
+  s.updates = rd.u32();
+  s.rejected = rd.u32();
+  s.windows = rd.u16();
+  s.window_stride = rd.u8();
+  s.windows_per_period = rd.u8();
+  s.loss = rd.f32();
+  s.state = rd.u16();
+  s.distance = rd.f32();
+  s.other_state = rd.u16();
+  s.other_distance = rd.f32();
+  for (float& v : s.pb) v = rd.f32();
+  return rd.ok() && s.on <= 1;
 }
 
 // ---- 0x7F error: code u8, offending sequence number u16, reason (u8 length + ASCII)

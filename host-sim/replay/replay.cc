@@ -39,6 +39,21 @@ CompiledModelInfo info_of() {
   return info;
 }
 
+// The adaptation's columns of a replayed step from the device's status.
+template <class M>
+void fill_adapt(const link::AdaptStatus<M>& a, ReplayStep& s) {
+  s.adapt_updates = a.updates;
+  s.adapted_pb.assign(a.pb, a.pb + M::kPb);
+  if (a.state != link::kNoState) {
+    s.recognized_state = a.state;
+    s.recognized_distance = a.distance;
+  }
+  if (a.other_state != link::kNoState) {
+    s.other_state = a.other_state;
+    s.other_distance = a.other_distance;
+  }
+}
+
 // The firmware compiled into this program.
 template <class M>
 class HostDevice {
@@ -46,26 +61,21 @@ class HostDevice {
   explicit HostDevice(const ReplayOptions& opt) : rt_(std::make_unique<firmware::HadynetRuntime<M>>()) {
     if (opt.control_epochs >= 0) rt_->control_settings().epochs = opt.control_epochs;
     if (opt.control_truncation >= 1) rt_->control_settings().truncation = opt.control_truncation;
-    if (opt.adapt) {
-      typename firmware::PbAdapter<M>::Settings s = rt_->adapter().settings();
-      if (opt.adapt_window_stride > 0) s.window_stride = opt.adapt_window_stride;
-      if (opt.adapt_windows_per_period > 0) s.windows_per_period = opt.adapt_windows_per_period;
-      if (!rt_->set_adapt_settings(s)) throw std::invalid_argument("PB adaptation: invalid stride or budget");
-    }
   }
-  void set_adapting(bool on) { rt_->set_adapting(on); }
+  void start_adapting(const ReplayOptions& opt) {
+    typename firmware::PbAdapter<M>::Settings s = rt_->adapter().settings();
+    if (opt.adapt_window_stride > 0) s.window_stride = opt.adapt_window_stride;
+    if (opt.adapt_windows_per_period > 0) s.windows_per_period = opt.adapt_windows_per_period;
+    if (!rt_->set_adapt_settings(s)) throw std::invalid_argument("PB adaptation: invalid stride or budget");
+    rt_->set_adapting(true);
+  }
   void reset() { rt_->reset(); }
   void set_pb(const float (&pb)[M::kPb]) { rt_->set_pb(pb); }
   bool set_pb_state(int state) { return rt_->set_pb_state(state); }
   void set_mode(firmware::Mode mode) { rt_->set_mode(mode); }
   firmware::StepResult<M> step(const firmware::SensorFrame<M>& frame, ReplayStep& s) {
     const firmware::StepResult<M> r = rt_->step(frame);
-    if (rt_->adapting()) {
-      s.adapted_pb.resize(M::kPb);
-      for (int i = 0; i < M::kPb; ++i)
-        s.adapted_pb[static_cast<std::size_t>(i)] =
-            firmware::Numerics<M>::template to_real<M::kFracIn>(rt_->adapter().pb()[i]);
-    }
+    if (rt_->adapting()) fill_adapt<M>(link::adapt_status_of(*rt_), s);
     if (r.command_valid) {
       s.loss_initial = firmware::GraspStabilizer<M>::loss_value(rt_->stabilizer().loss_initial());
       s.loss_final = firmware::GraspStabilizer<M>::loss_value(rt_->stabilizer().loss_final());
@@ -86,7 +96,6 @@ class LinkDevice {
   LinkDevice(tools::ByteStream& stream, const ReplayOptions& opt) : session_(stream) {
     if (opt.control_epochs >= 0 || opt.control_truncation >= 1)
       throw std::invalid_argument("stabiliser settings cannot be changed over the link");
-    if (opt.adapt) throw std::invalid_argument("PB adaptation is not yet switched on over the link: use --target hostsim");
     session_.connect();
     const link::InfoReply info = session_.info();
     if (info.model_hash != M::kModelHash || info.numeric != (firmware::kIsFixed<M> ? 0 : 1))
@@ -99,12 +108,26 @@ class LinkDevice {
     return true;
   }
   void set_mode(firmware::Mode mode) { session_.set_mode(mode); }
-  void set_adapting(bool) {}
+  void start_adapting(const ReplayOptions& opt) {
+    link::AdaptRequest q;
+    q.action = link::AdaptAction::kOn;
+    q.window_stride = static_cast<std::uint8_t>(opt.adapt_window_stride > 0 ? opt.adapt_window_stride : 0);
+    q.windows_per_period =
+        static_cast<std::uint8_t>(opt.adapt_windows_per_period > 0 ? opt.adapt_windows_per_period : 0);
+    session_.adapt(q);
+    adapting_ = true;
+  }
   void reset() { session_.reset(); }
-  firmware::StepResult<M> step(const firmware::SensorFrame<M>& frame, ReplayStep&) { return session_.step(frame); }
+  // The step result, and with adaptation on its status (a second exchange).
+  firmware::StepResult<M> step(const firmware::SensorFrame<M>& frame, ReplayStep& s) {
+    const firmware::StepResult<M> r = session_.step(frame);
+    if (adapting_) fill_adapt<M>(session_.adapt({}), s);
+    return r;
+  }
 
  private:
   tools::LinkSession<M> session_;
+  bool adapting_ = false;
 };
 
 template <class M, class Device>
@@ -136,13 +159,6 @@ void replay_one(Device& device, const datalog::LogTable& log, const std::string&
     s.contact = r.contact;
     s.command_valid = r.command_valid;
     s.command.assign(r.command, r.command + M::kU);
-    s.adapt_updates = r.adapt_updates;
-    if (r.adapt_valid && r.recognition.valid) {
-      s.recognized_state = r.recognition.state;
-      s.recognized_distance = r.recognition.distance;
-      s.other_state = r.recognition.other_state;
-      s.other_distance = r.recognition.other_distance;
-    }
     result.steps.push_back(std::move(s));
   }
 }
@@ -163,7 +179,7 @@ ReplayResult replay_on(Device& device, const std::vector<datalog::LogTable>& log
                                 std::to_string(M::kStates) + " states)");
   }
   device.set_mode(opt.mode);
-  if (opt.adapt) device.set_adapting(true);  // from the active PB
+  if (opt.adapt) device.start_adapting(opt);  // from the active PB
 
   ReplayResult result;
   result.y_names = info.y_names;

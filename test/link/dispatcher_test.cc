@@ -112,6 +112,56 @@ void check_steps_match_runtime(int frames, int control_from) {
 TEST(LinkDispatcher, StepResultsAreBitIdenticalToTheRuntimeQ15) { check_steps_match_runtime<Q>(24, 12); }
 TEST(LinkDispatcher, StepResultsAreBitIdenticalToTheRuntimeF32) { check_steps_match_runtime<F>(12, 9); }
 
+// PB adaptation over the link (0x09): switched on with settings, its status
+// after every frame bit-identical to a runtime adapting directly; adopt
+// makes the adapted PB the active one; off stops it.
+TEST(LinkDispatcher, AdaptStatusFollowsTheRuntime) {
+  ZeroedDevice<Q> dev;
+  auto direct = std::make_unique<firmware::HadynetRuntime<Q>>();
+  LinkClient<Q> client;
+  const auto adapt = [&](AdaptRequest q) {
+    const std::uint16_t seq = client.next_sequence();
+    const Bytes reply = dev.send_one(wire_of([&](auto w) { return client.adapt(q, w); }));
+    Reply r;
+    expect_reply(reply, MessageType::kAdaptStatus, seq, &r);
+    client.accept(reply);
+    AdaptStatus<Q> status;
+    EXPECT_TRUE(decode_adapt_status<Q>(r.payload, status));
+    std::uint8_t expected[PayloadSizes<Q>::kAdaptStatus];
+    EXPECT_EQ(encode_adapt_status<Q>(adapt_status_of(*direct), expected), r.payload.size());
+    EXPECT_EQ(std::memcmp(expected, r.payload.data(), r.payload.size()), 0) << "status differs from the runtime's";
+    return status;
+  };
+  // Every 8th window, 2 per period: the first step comes a few periods after
+  // the 100th window.
+  typename firmware::PbAdapter<Q>::Settings settings = direct->adapter().settings();
+  settings.window_stride = 8;
+  settings.windows_per_period = 2;
+  ASSERT_TRUE(direct->set_adapt_settings(settings));
+  direct->set_adapting(true);
+  AdaptStatus<Q> status = adapt({AdaptAction::kOn, 8, 2});
+  EXPECT_EQ(status.on, 1);
+  EXPECT_EQ(status.window_stride, 8);
+  EXPECT_EQ(status.windows_per_period, 2);
+  const int frames = 100 + Q::kTrainSteps + 2 + 24;
+  for (int t = 0; t < frames; ++t) {
+    const firmware::SensorFrame<Q> frame = synthetic_frame<Q>(t);
+    const std::uint16_t seq = client.next_sequence();
+    const Bytes reply = dev.send_one(wire_of([&](auto w) { return client.sensor_frame(frame, w); }));
+    expect_reply(reply, MessageType::kStepResult, seq);
+    client.accept(reply);
+    direct->step(frame);
+    status = adapt({});
+  }
+  EXPECT_GT(status.updates, 0u) << "no adaptation step in " << frames << " frames";
+  EXPECT_NE(status.state, kNoState);
+  adapt({AdaptAction::kAdopt, 0, 0});
+  direct->use_adapted_pb();
+  EXPECT_EQ(std::memcmp(dev->runtime.pb(), direct->adapter().pb(), sizeof(direct->adapter().pb())), 0);
+  direct->set_adapting(false);
+  EXPECT_EQ(adapt({AdaptAction::kOff, 0, 0}).on, 0);
+}
+
 TEST(LinkDispatcher, SetPbByStateAndByValues) {
   ZeroedDevice<Q> dev;
   LinkClient<Q> client;

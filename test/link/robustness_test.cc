@@ -174,7 +174,7 @@ TEST_F(LinkRobustness, OversizeFrames) {
 }
 
 TEST_F(LinkRobustness, UnknownTypes) {
-  for (int type : {0x00, 0x09, 0x42, 0x7E, 0x7F, 0x80, 0x81, 0x82, 0x85, 0x86, 0x88, 0xFF}) {
+  for (int type : {0x00, 0x0A, 0x42, 0x7E, 0x7F, 0x80, 0x81, 0x82, 0x85, 0x86, 0x88, 0x89, 0xFF}) {
     expect_rejected({"type " + std::to_string(type), encode_wire(frame(static_cast<std::uint8_t>(type), {})),
                      ErrorCode::kUnknownType, true});
   }
@@ -208,6 +208,9 @@ TEST_F(LinkRobustness, BadPayloadLengths) {
       {"set PB empty", 0x03, {}},
       {"set PB state too long", 0x03, {0x00, 0x01, 0x00, 0x00}},
       {"set PB values short", 0x03, short_pb},
+      {"adapt empty", 0x09, {}},
+      {"adapt two bytes", 0x09, {0x01, 0x00}},
+      {"adapt four bytes", 0x09, {0x01, 0x00, 0x00, 0x00}},
   };
   for (const BadRequest& c : cases) {
     // Built now: the expected sequence number advances after each case.
@@ -233,6 +236,9 @@ TEST_F(LinkRobustness, BadValues) {
       {"PB kind 2", 0x03, {0x02, 0x00, 0x00}},
       {"mode 3", 0x04, {0x03}},
       {"mode 255", 0x04, {0xFF}},
+      {"adapt action 4", 0x09, {0x04, 0x00, 0x00}},
+      {"adapt stride beyond the windows held", 0x09, {0x01, 0xFF, 0x00}},
+      {"adapt windows per period beyond the windows held", 0x09, {0x01, 0x00, 0xFF}},
   };
   for (const BadRequest& c : cases) {
     expect_rejected({c.name, encode_wire(frame(c.type, c.payload)), ErrorCode::kBadValue, true});

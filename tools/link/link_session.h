@@ -69,6 +69,12 @@ class LinkSession {
     transact(client_.set_pb_state(state, wire_), link::MessageType::kSetPbAck);
   }
   void set_pb(const float (&values)[M::kPb]) { transact(client_.set_pb(values, wire_), link::MessageType::kSetPbAck); }
+  link::AdaptStatus<M> adapt(const link::AdaptRequest& q) {
+    const link::Reply r = transact(client_.adapt(q, wire_), link::MessageType::kAdaptStatus);
+    link::AdaptStatus<M> status;
+    if (!link::decode_adapt_status<M>(r.payload, status)) throw LinkError(stream_.name() + ": malformed adapt status");
+    return status;
+  }
   firmware::StepResult<M> step(const firmware::SensorFrame<M>& frame) {
     const link::Reply r = transact(client_.sensor_frame(frame, wire_), link::MessageType::kStepResult);
     firmware::StepResult<M> result;
