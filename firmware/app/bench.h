@@ -19,6 +19,9 @@
 //                 exactly MacCount::period_control
 //   control       a control-mode period with the default settings (may stop
 //                 early; same MAC denominator, so it reads as <= the above)
+//   adapt         a detect-mode period with PB adaptation running its full
+//                 budget (PbAdapter::Settings::windows_per_period windows),
+//                 MacCount::period_adapt
 #ifndef HADYNET_FIRMWARE_APP_BENCH_H_
 #define HADYNET_FIRMWARE_APP_BENCH_H_
 
@@ -79,6 +82,21 @@ class Bench {
     ticks = 0;
     for (int k = 0; k < kReps; ++k) ticks += timed_step(runtime, frames);
     report("control", kReps, ticks, Macs::period_control);
+
+    // Adaptation: frames until the first epoch starts (no work before), then
+    // periods that each run the full budget of windows.
+    runtime.reset();
+    runtime.set_mode(firmware::Mode::kDetect);
+    runtime.set_adapting(true);
+    const int start_frames = runtime.adapter().settings().start_windows + M::kTrainSteps + 1;
+    for (int k = 0; k < start_frames; ++k) {
+      frames.next(frame);
+      (void)runtime.step(frame);
+    }
+    ticks = 0;
+    for (int k = 0; k < kReps; ++k) ticks += timed_step(runtime, frames);
+    report("adapt", kReps, ticks, Macs::period_adapt(runtime.adapter().settings().windows_per_period));
+    runtime.set_adapting(false);
 
     line.clear();
     line << "checksum value=";

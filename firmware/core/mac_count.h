@@ -1,7 +1,7 @@
 // Multiply-accumulate counts of the core's jobs for a generated model: the
 // denominators of the benchmarks' instructions-per-MAC and MACs-per-second
-// figures. Counted from the algorithms in hadynet_net.h, detector.h and
-// grasp_stabilizer.h (matrix-vector products only; element-wise gate
+// figures. Counted from the algorithms in hadynet_net.h, detector.h,
+// grasp_stabilizer.h and pb_adapter.h (matrix-vector products only; element-wise gate
 // arithmetic, activations and the loss are a few per unit and not counted).
 #ifndef HADYNET_FIRMWARE_CORE_MAC_COUNT_H_
 #define HADYNET_FIRMWARE_CORE_MAC_COUNT_H_
@@ -53,6 +53,15 @@ struct MacCount {
   static constexpr long control_default = control(M::kControlEpochs, M::kControlTruncation);
   // The firmware's period in control mode: detection plus the stabiliser.
   static constexpr long period_control = detect + control_default;
+
+  // PB adaptation (pb_adapter.h), one window: encode and N_train steps
+  // forward; back through every step to the PB (W_ih[:, U:]^T), to h
+  // (W_hh^T, down to h_0) and the decoder, then the encoder's PB columns.
+  static constexpr long backward_pb = kGates * M::kPb;
+  static constexpr long adapt_window =
+      encode + M::kTrainSteps * (step + backward_decoder + backward_pb + backward_h) + kH * M::kPb;
+  // A detect-mode period that also runs `windows` adaptation windows.
+  static constexpr long period_adapt(int windows) { return detect + windows * adapt_window; }
 };
 
 }  // namespace hadynet::firmware

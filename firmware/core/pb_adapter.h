@@ -90,10 +90,12 @@ class PbAdapter {
   static constexpr int kGradAccFrac = 32;
   static constexpr int kMasterFrac = M::kFracIn + 16;
   static constexpr int kMaxHalvings = 30;  // as the trainer's safeguard
+  // f32: the largest error a window counts (standardised units), q15's y range at kFracY = 9.
+  static constexpr float kMaxError = 64.0f;
 
   struct Settings {
     int start_windows = 100;     // windows held before the first epoch (paper: N_thre^online)
-    int windows_per_period = 8;  // windows run per work() call: the period's budget
+    int windows_per_period = 4;  // windows run per work() call: the period's budget (docs/firmware.md)
     // An epoch runs every window_stride-th of the newest windows (those
     // whose first frame is a multiple of it): neighbouring windows share
     // all but one of their steps, so this keeps the frames and nearly the
@@ -313,7 +315,10 @@ class PbAdapter {
           const std::int64_t abs_e = e < 0 ? -std::int64_t{e} : e;
           if (abs_e > max_abs) max_abs = abs_e;
         } else {
-          const float e = y_est[i] - target[i];
+          // As q15 saturates: an error beyond +-kMaxError standardised units
+          // counts as that much; a non-finite one (a NaN or infinite frame) as none.
+          float e = y_est[i] - target[i];
+          e = e > kMaxError ? kMaxError : (e < -kMaxError ? -kMaxError : (e == e ? e : 0.0f));
           error_[k][i] = e;
           window_loss += e * e;
         }
@@ -345,6 +350,11 @@ class PbAdapter {
       for (int j = 0; j < kH; ++j) dh[j] = dh_prev[j];
     }
     net.backward_encoder_pb(h0.h, dh, dpb);
+    if constexpr (!kFixed) {
+      // A window whose forward pass met non-finite inputs adds no gradient.
+      for (int i = 0; i < kPb; ++i)
+        if (!std::isfinite(dpb[i])) return;
+    }
     for (int i = 0; i < kPb; ++i) {
       if constexpr (kFixed) {
         // dpb's raw value is its real value times 2^(kFracY - shift).

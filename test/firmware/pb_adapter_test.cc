@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -136,6 +137,40 @@ TEST(PbAdapter, FixedPointGradientFollowsTheFloatOne) {
       EXPECT_NEAR(loss_q, loss_f, 0.01 * loss_f) << object << " state " << state;
     }
   }
+}
+
+// Garbage frames (NaN, infinities, 1e30) while adapting, from the first
+// window on: the PB, its loss and its recognition stay finite in both
+// numerics, and the q15 build never overflows (UBSan in the debug preset).
+template <class M>
+void adapt_on_garbage() {
+  auto rt = std::make_unique<firmware::HadynetRuntime<M>>();
+  typename PbAdapter<M>::Settings s;
+  s.start_windows = 1;
+  s.windows_per_period = 2;
+  ASSERT_TRUE(rt->set_adapt_settings(s));
+  rt->set_adapting(true);
+  const float garbage[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(), -1e30f,
+                           1e30f, 0.0f, -std::numeric_limits<float>::infinity()};
+  firmware::SensorFrame<M> frame{};
+  for (int t = 0; t < 3 * M::kTrainSteps; ++t) {
+    for (int i = 0; i < M::kY; ++i) frame.y[i] = garbage[(t + i) % 6];
+    for (int i = 0; i < M::kU; ++i) frame.u_prev[i] = garbage[(t + 2 * i) % 6];
+    const auto r = rt->step(frame);
+    if (r.adapt_valid) {
+      EXPECT_TRUE(r.recognition.valid);
+      EXPECT_TRUE(std::isfinite(r.recognition.distance) && std::isfinite(r.recognition.other_distance));
+    }
+    for (int i = 0; i < M::kPb; ++i)
+      EXPECT_TRUE(std::isfinite(firmware::Numerics<M>::template to_real<M::kFracIn>(rt->adapter().pb()[i])));
+    EXPECT_TRUE(std::isfinite(rt->adapter().last_loss()));
+  }
+  EXPECT_GT(rt->adapter().updates(), 0u);
+}
+
+TEST(PbAdapter, GarbageFramesNeverOverflowOrGiveNaN) {
+  adapt_on_garbage<Q>();
+  adapt_on_garbage<F>();
 }
 
 }  // namespace
