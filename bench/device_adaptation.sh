@@ -66,12 +66,15 @@ run_job() {
   case "$kind" in
     q15 | f32)
       local csv="$d/$tag/$name.$kind.csv"
-      [[ -f "$csv" ]] || "$hadynet" replay "${device_args[@]}" --numeric "$kind" --out "$csv.tmp" "$@" >/dev/null &&
-        mv "$csv.tmp" "$csv" ;;
+      if [[ ! -f "$csv" ]]; then
+        "$hadynet" replay "${device_args[@]}" --numeric "$kind" --out "$csv.tmp" "$@" >/dev/null && mv "$csv.tmp" "$csv"
+      fi ;;
     trainer)
       local csv="$d/trainer/$name.csv"
-      [[ -f "$csv" ]] || "$hadynet" adapt "$model" "$@" --online --start "$start_state" --csv "$csv.tmp" \
-        >/dev/null 2>&1 && mv "$csv.tmp" "$csv" ;;
+      if [[ ! -f "$csv" ]]; then
+        "$hadynet" adapt "$model" "$@" --online --start "$start_state" --csv "$csv.tmp" >/dev/null 2>&1 &&
+          mv "$csv.tmp" "$csv"
+      fi ;;
   esac
 }
 export -f run_job

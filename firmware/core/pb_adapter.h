@@ -100,7 +100,7 @@ class PbAdapter {
     // whose first frame is a multiple of it): neighbouring windows share
     // all but one of their steps, so this keeps the frames and nearly the
     // loss of the full set at a fraction of the cost (more steps per second).
-    int window_stride = 1;
+    int window_stride = 8;  // chosen on validation zeroings (docs/firmware.md)
     float lr = 1.0f;             // MomentumSGD rate (the trainer's default), 0 < lr < 16
     float momentum = 0.9f;       // 0 <= momentum < 1
   };
