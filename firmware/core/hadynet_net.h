@@ -1,6 +1,7 @@
 // Stateful, step-by-step HADYNET forward pass of a generated model
-// (docs/method.md, "Network"), in the model's numerics (q15 or f32), plus the input
-// gradient (back-propagation through time) the grasp stabiliser needs.
+// (docs/method.md, "Network"), in the model's numerics (q15 or f32), plus the
+// back-propagation through time the grasp stabiliser (to the commands) and
+// PB adaptation (to the PB, pb_adapter.h) need.
 //
 //   encode:  h_0 = ReLU(W_enc' [x ; p] + b_enc')   (batch norm folded by codegen), c_0 = 0
 //   step:    [i f g o] = act(W_ih [u ; p] + W_hh h + b),  c' = f c + i g,  h' = o tanh(c')
