@@ -1,6 +1,6 @@
 // hadynet link: talk to a device running the firmware over its serial link
 // (docs/protocol.md): a serial port, a TCP socket (e.g. QEMU's serial) or a
-// QEMU machine started for the purpose. Actions: info, reset, mode, pb.
+// QEMU machine started for the purpose. Actions: info, reset, mode, pb, adapt.
 // Streaming a log through a device is `hadynet replay --target ...`.
 #include <cstdio>
 #include <cstdlib>
@@ -97,6 +97,38 @@ int act(tools::ByteStream& stream, const std::vector<std::string>& action) {
     std::printf("%s: PB set (%d values)\n", stream.name().c_str(), M::kPb);
     return 0;
   }
+  if (what == "adapt" && action.size() == 2) {
+    link::AdaptRequest q;
+    if (action[1] == "on") {
+      q.action = link::AdaptAction::kOn;
+    } else if (action[1] == "off") {
+      q.action = link::AdaptAction::kOff;
+    } else if (action[1] == "adopt") {
+      q.action = link::AdaptAction::kAdopt;
+    } else if (action[1] != "status") {
+      std::fprintf(stderr, "hadynet link: adapt must be on, off, adopt or status\n");
+      return 2;
+    }
+    const link::AdaptStatus<M> a = session.adapt(q);
+    std::printf("%s: PB adaptation %s, %u steps (%u undone), %u windows held, stride %u, %u windows per period, "
+                "loss %.4g\n",
+                stream.name().c_str(), a.on ? "on" : "off", a.updates, a.rejected, a.windows, a.window_stride,
+                a.windows_per_period, static_cast<double>(a.loss));
+    const bool same_model = session.info().model_hash == M::kModelHash;
+    const auto name = [&](std::uint16_t k) {
+      return same_model && k < M::kStates ? std::string(M::kStateNames[k]) : "row " + std::to_string(k);
+    };
+    if (a.state != link::kNoState) {
+      std::printf("nearest trained state %s (distance %.3g); nearest other object %s (%.3g)\n", name(a.state).c_str(),
+                  static_cast<double>(a.distance),
+                  a.other_state != link::kNoState ? name(a.other_state).c_str() : "-",
+                  static_cast<double>(a.other_distance));
+    }
+    std::printf("adapted PB:");
+    for (const float v : a.pb) std::printf(" %.4g", static_cast<double>(v));
+    std::printf("\n");
+    return 0;
+  }
   std::fprintf(stderr, "hadynet link: unknown action (see --help)\n");
   return 2;
 }
@@ -110,6 +142,9 @@ int run_link(int argc, char** argv) {
               "  reset                   clear the history and the plan (mode and PB stay)\n"
               "  mode observe|detect|control\n"
               "  pb STATE|v1,..,vP       the active PB: a state of the PB table or standardised values\n"
+              "  adapt on|off|adopt|status  the device's own PB adaptation (docs/firmware.md): on from the\n"
+              "                          active PB, off, adopt (the adapted PB becomes the active one), or\n"
+              "                          its status: steps, the adapted PB and the nearest trained states\n"
               "Every action first sends a reset, which also resynchronises the sequence numbers. To\n"
               "stream a log through the device use `hadynet replay LOG --target serial|tcp|qemu`.",
               "(--device PATH | --tcp HOST:PORT | --qemu ELF) ACTION [ARG]");
