@@ -80,7 +80,8 @@ int run_adapt(int argc, char** argv) {
   opt.value("start-windows", "N", "online: windows before the first update", "100");
   opt.value("max-windows", "N", "online: newest windows kept", "200");
   opt.value("online-epochs", "N", "online: epochs per update", "3");
-  opt.value("csv", "FILE", "online: write the PB trajectory here instead of stdout");
+  opt.value("csv", "FILE", "online: write the PB trajectory here instead of stdout (per update: log, t_step, windows,\n"
+            "loss, p0.., the nearest trained state and its distance)");
   opt.value("plot", "PNG", "online: draw the trajectory on the PB map");
   opt.value("json", "FILE", "offline: write the results as JSON");
   if (!opt.parse(argc, argv)) return 2;
