@@ -67,6 +67,9 @@ struct PbRecognition {
   float other_distance = 0.0f;
 };
 
+// kMaxWindowsT: windows an epoch covers (the paper: 200). The default
+// Settings need at least 8 (stride 8, budget 4); a smaller adapter (tests)
+// sets its own.
 template <GeneratedModel M, int kMaxWindowsT = 200>
 class PbAdapter {
  public:

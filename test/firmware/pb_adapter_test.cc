@@ -55,6 +55,7 @@ std::vector<float> firmware_window_gradient(const trainer::LogSequence& seq, int
   typename PbAdapter<M, 1>::Settings s;
   s.start_windows = 1;
   s.windows_per_period = 1;
+  s.window_stride = 1;
   EXPECT_TRUE(adapter->set_settings(s));
   adapter->restart(firmware::kCompiledTensors<M>.pb_table[state]);
   for (int t = 0; t < M::kTrainSteps + 2; ++t) push_frame<M>(*adapter, seq, t);
