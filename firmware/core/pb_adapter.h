@@ -172,7 +172,11 @@ class PbAdapter {
     for (int budget = settings_.windows_per_period; budget > 0;) {
       if (!in_epoch_ && !start_epoch()) break;
       if (!seek_valid()) {
+        // No window (left) on the stride: an epoch that ran none ends the
+        // period (a new snapshot would be the same until frames arrive).
+        const bool ran = windows_run_ > 0;
         changed = finish_epoch() || changed;
+        if (!ran) break;
         continue;
       }
       run_window(net, traces, next_++);

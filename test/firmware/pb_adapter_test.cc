@@ -177,6 +177,31 @@ void adapt_on_garbage() {
   EXPECT_GT(rt->adapter().updates(), 0u);
 }
 
+// An epoch whose snapshot holds no window on the stride (here the only
+// window starts at frame 1, the stride is 8) runs nothing and work()
+// returns: no endless loop of empty epochs, and later windows still run.
+TEST(PbAdapter, AnEpochWithoutWindowsOnTheStrideEndsThePeriod) {
+  auto adapter = std::make_unique<PbAdapter<Q>>();
+  auto net = std::make_unique<HadynetNet<Q>>();
+  std::vector<firmware::StepTrace<Q>> traces(Q::kTrainSteps);
+  typename PbAdapter<Q>::Settings s;
+  s.start_windows = 1;
+  s.windows_per_period = 4;
+  s.window_stride = 8;
+  ASSERT_TRUE(adapter->set_settings(s));
+  adapter->restart(firmware::kCompiledTensors<Q>.pb_table[0]);
+  const trainer::LogSequence seq = test::held_out_sequence("Cylinder", "random2");
+  push_frame<Q>(*adapter, seq, 0);
+  adapter->begin_segment();  // window 0 would span the boundary: the first window starts at frame 1
+  for (int t = 1; t < Q::kTrainSteps + 3; ++t) push_frame<Q>(*adapter, seq, t);
+  ASSERT_EQ(adapter->windows_held(), 1);
+  EXPECT_FALSE(adapter->work(*net, traces.data()));  // returns (the test would hang otherwise)
+  EXPECT_EQ(adapter->updates(), 0u);
+  for (int t = Q::kTrainSteps + 3; t < Q::kTrainSteps + 12; ++t) push_frame<Q>(*adapter, seq, t);
+  EXPECT_TRUE(adapter->work(*net, traces.data()));  // window 8 is on the stride
+  EXPECT_GE(adapter->updates(), 1u);  // (an epoch of one window: one step per window of the budget)
+}
+
 TEST(PbAdapter, GarbageFramesNeverOverflowOrGiveNaN) {
   adapt_on_garbage<Q>();
   adapt_on_garbage<F>();
