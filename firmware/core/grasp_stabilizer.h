@@ -260,11 +260,9 @@ class GraspStabilizer {
         }
       }
       if (max_abs == 0) return false;
-      const int shift = bit_length(max_abs) - (kGradFracBits + 1);  // max -> [2^20, 2^21)
+      const int shift = grad_scale_shift(max_abs);  // max -> [2^20, 2^21)
       for (int k = 0; k < kHorizon; ++k)
-        for (int i = 0; i < kY; ++i)
-          dy_[k][i] = static_cast<std::int32_t>(shift >= 0 ? fixed::rounding_shift_right(raw[k][i], shift)
-                                                           : raw[k][i] * (std::int64_t{1} << -shift));
+        for (int i = 0; i < kY; ++i) dy_[k][i] = grad_scaled(raw[k][i], shift);
     } else {
       bool any = false;
       for (int k = 0; k < kHorizon; ++k) {
@@ -279,15 +277,6 @@ class GraspStabilizer {
     }
     backward(net, slot);
     return normalise();
-  }
-
-  static int bit_length(std::int64_t v) noexcept {  // v > 0
-    int n = 0;
-    while (v > 0) {
-      v >>= 1;
-      ++n;
-    }
-    return n;
   }
 
   // g_[k] = dL/du_k over the traced rollout in `slot`.

@@ -8,6 +8,7 @@
 #ifndef HADYNET_FIRMWARE_CORE_NUMERICS_H_
 #define HADYNET_FIRMWARE_CORE_NUMERICS_H_
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <type_traits>
@@ -27,6 +28,20 @@ inline constexpr bool kIsFixed = M::kNumeric == Numeric::kQ15;
 // largest entry is 1.0 (see grasp_stabilizer.h). 2^20 leaves 11 bits of
 // headroom for growth through the network before saturation.
 inline constexpr int kGradFracBits = 20;
+
+// Number of bits of v > 0 (floor(log2 v) + 1).
+constexpr int bit_length(std::int64_t v) noexcept {
+  return static_cast<int>(std::bit_width(static_cast<std::uint64_t>(v)));
+}
+
+// The q15 loss-gradient scaling shared by the stabiliser and PB
+// adaptation: the right shift that brings the largest magnitude max_abs
+// (> 0) into [2^kGradFracBits, 2^(kGradFracBits + 1)) ...
+constexpr int grad_scale_shift(std::int64_t max_abs) noexcept { return bit_length(max_abs) - (kGradFracBits + 1); }
+// ... and v scaled by it (rounded; a negative shift is a left shift), as an int32 gradient.
+constexpr std::int32_t grad_scaled(std::int64_t v, int shift) noexcept {
+  return static_cast<std::int32_t>(shift >= 0 ? fixed::rounding_shift_right(v, shift) : v * (std::int64_t{1} << -shift));
+}
 
 template <GeneratedModel M>
 struct Numerics {

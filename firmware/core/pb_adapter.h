@@ -288,15 +288,6 @@ class PbAdapter {
     return next_ <= last_;
   }
 
-  static int bit_length(std::int64_t v) noexcept {  // v > 0
-    int n = 0;
-    while (v > 0) {
-      v >>= 1;
-      ++n;
-    }
-    return n;
-  }
-
   // Forward and back-propagation through time of window a under pb_:
   // adds its loss and dL/dp to the epoch's sums.
   void run_window(HadynetNet<M>& net, StepTrace<M>* trace, std::uint32_t a) noexcept {
@@ -339,15 +330,13 @@ class PbAdapter {
     int shift = 0;
     if constexpr (kFixed) {
       if (max_abs == 0) return;  // a perfect fit: no gradient
-      shift = bit_length(max_abs) - (kGradFracBits + 1);
+      shift = grad_scale_shift(max_abs);
     }
     Grad dy[kY], dh[kH] = {}, dc[kH] = {}, dh_prev[kH], dpb[kPb] = {};
     for (int k = kSteps - 1; k >= 0; --k) {
       for (int i = 0; i < kY; ++i) {
         if constexpr (kFixed) {
-          const std::int64_t e = error_[k][i];
-          dy[i] = static_cast<std::int32_t>(shift >= 0 ? fixed::rounding_shift_right(e, shift)
-                                                       : e * (std::int64_t{1} << -shift));
+          dy[i] = grad_scaled(error_[k][i], shift);
         } else {
           dy[i] = error_[k][i];
         }
