@@ -199,19 +199,22 @@ class HadynetNet {
     Grad dgates[kGates];
     gate_gradients(trace, dh, dc, dgates);
     if constexpr (N::kFixed) {
+      // dgates as block floating point, for the PB columns and W_hh^T.
+      const BlockGrad<kGates> block(dgates);
       const auto& ih = t_->weights.ih;
       if constexpr (kU % 8 == 0) {
         // The PB columns start a chunk of the packed matrix: the packed
         // kernel reads them from that chunk on (packed_index is linear in it).
-        kernels::dot_cols_packed_q15_i32(ih.data + (kU / 8) * 16, ih.kCols, kGates, dgates, kPb, scratch_);
+        kernels::dot_cols_packed_q15(ih.data + (kU / 8) * 16, ih.kCols, kGates, block.mantissa, kPb, scratch_);
       } else {
         for (int i = 0; i < kPb; ++i) scratch_[i] = 0;
         for (int r = 0; r < kGates; ++r)
           for (int i = 0; i < kPb; ++i)
-            scratch_[i] += std::int64_t{ih.data[kernels::packed_index(ih.kCols, r, kU + i)]} * dgates[r];
+            scratch_[i] += std::int64_t{ih.data[kernels::packed_index(ih.kCols, r, kU + i)]} * block.mantissa[r];
       }
       for (int i = 0; i < kPb; ++i)
-        dpb[i] = N::grad_add(dpb[i], fixed::requantize_i32<M::kFracLstmW, 0>(scratch_[i]));
+        dpb[i] = N::grad_add(dpb[i], fixed::requantize_i32<M::kFracLstmW, 0>(block.scaled(scratch_[i])));
+      if (dh_prev != nullptr) hidden_gradient(block, dh_prev);
     } else {
       for (int i = 0; i < kPb; ++i) scratch_[i] = 0;
       for (int r = 0; r < kGates; ++r) {
@@ -219,8 +222,8 @@ class HadynetNet {
         for (int i = 0; i < kPb; ++i) scratch_[i] += t_->weights.ih[r][kU + i] * dgates[r];
       }
       for (int i = 0; i < kPb; ++i) dpb[i] += scratch_[i];
+      if (dh_prev != nullptr) hidden_gradient(dgates, dh_prev);
     }
-    if (dh_prev != nullptr) hidden_gradient(dgates, dh_prev);
   }
 
   // dL/dp through the encoder, h_0 = ReLU(W_enc [x ; p] + b): adds
@@ -253,8 +256,9 @@ class HadynetNet {
     Grad d[kH];
     if constexpr (N::kFixed) {
       const auto& dec = t_->weights.dec;
-      kernels::dot_cols_packed_q15_i32(dec.data, dec.kCols, kY, dy, kH, scratch_);
-      for (int j = 0; j < kH; ++j) d[j] = fixed::requantize_i32<M::kFracDecW, 0>(scratch_[j]);
+      const BlockGrad<kY> block(dy);
+      kernels::dot_cols_packed_q15(dec.data, dec.kCols, kY, block.mantissa, kH, scratch_);
+      for (int j = 0; j < kH; ++j) d[j] = fixed::requantize_i32<M::kFracDecW, 0>(block.scaled(scratch_[j]));
     } else {
       N::template transposed_matvec<M::kFracDecW>(t_->weights.dec, dy, kH, d, scratch_);
     }
@@ -303,15 +307,34 @@ class HadynetNet {
     }
   }
 
+  // q15: n gradients as block floating point (numerics.h, grad_block_q15),
+  // as the packed W^T kernel reads them: int16 mantissas, an odd count
+  // padded with a zero, and the exponent.
+  template <int n>
+  struct BlockGrad {
+    alignas(4) std::int16_t mantissa[n + n % 2];  // word-aligned: the kernels read pairs
+    int shift;
+    explicit BlockGrad(const Grad (&g)[n]) noexcept : shift(grad_block_q15(g, n, mantissa)) {
+      if constexpr (n % 2 != 0) mantissa[n] = 0;
+    }
+    // A sum over mantissas back at the gradients' scale (exact).
+    std::int64_t scaled(std::int64_t sum) const noexcept { return sum * (std::int64_t{1} << shift); }
+  };
+
   // dh_prev = W_hh^T dgates (dL/dh before the step).
   void hidden_gradient(const Grad (&dgates)[kGates], Grad* dh_prev) noexcept {
     if constexpr (N::kFixed) {
-      const NetworkWeights<M>& kw = t_->weights;
-      kernels::dot_cols_packed_q15_i32(kw.hh.data, kw.hh.kCols, kGates, dgates, kH, scratch_);
-      for (int j = 0; j < kH; ++j) dh_prev[j] = fixed::requantize_i32<M::kFracLstmW, 0>(scratch_[j]);
+      hidden_gradient(BlockGrad<kGates>(dgates), dh_prev);
     } else {
       N::template transposed_matvec<M::kFracLstmW>(t_->weights.hh, dgates, kH, dh_prev, scratch_);
     }
+  }
+  void hidden_gradient(const BlockGrad<kGates>& block, Grad* dh_prev) noexcept
+    requires N::kFixed
+  {
+    const NetworkWeights<M>& kw = t_->weights;
+    kernels::dot_cols_packed_q15(kw.hh.data, kw.hh.kCols, kGates, block.mantissa, kH, scratch_);
+    for (int j = 0; j < kH; ++j) dh_prev[j] = fixed::requantize_i32<M::kFracLstmW, 0>(block.scaled(scratch_[j]));
   }
 
   // q15: h as the packed kernels read it, kH values then zeros up to a

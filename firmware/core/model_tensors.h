@@ -32,7 +32,7 @@ namespace hadynet::firmware {
 // The network's matrices. q15: packed for the forward kernel
 // (kernels/dot_q15.h), plus W_ih's command columns transposed (dL/du along
 // contiguous rows); W^T g of the other matrices is computed from the packed
-// copies (kernels::dot_cols_packed_q15_i32). f32: row-major as generated.
+// copies (kernels::dot_cols_packed_q15). f32: row-major as generated.
 template <GeneratedModel M, bool kFixed = (M::kNumeric == Numeric::kQ15)>
 struct NetworkWeights;
 

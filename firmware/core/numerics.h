@@ -43,6 +43,30 @@ constexpr std::int32_t grad_scaled(std::int64_t v, int shift) noexcept {
   return static_cast<std::int32_t>(shift >= 0 ? fixed::rounding_shift_right(v, shift) : v * (std::int64_t{1} << -shift));
 }
 
+// Gradients as the backward kernels read them (kernels::dot_cols_packed_q15):
+// block floating point, int16 mantissas out[i] = saturate_i16(round(g[i] /
+// 2^s)) of n int32 gradients with one exponent s >= 0, returned: the
+// smallest s for which the largest |g| has at most 15 bits. s = 0 (exact)
+// while every |g| < 2^15; otherwise each mantissa is within half an LSB of
+// g / 2^s, 2^-15 of the largest. The caller multiplies the kernel's sums by
+// 2^s (exact in int64: |sum| < 2^46 for < 2^16 rows, s <= 17).
+inline int grad_block_q15(const std::int32_t* g, int n, std::int16_t* out) noexcept {
+  std::int64_t max_abs = 0;
+  for (int i = 0; i < n; ++i) {
+    const std::int64_t a = g[i] < 0 ? -std::int64_t{g[i]} : std::int64_t{g[i]};
+    if (a > max_abs) max_abs = a;
+  }
+  const int s = bit_length(max_abs) > 15 ? bit_length(max_abs) - 15 : 0;
+  if (s == 0) {
+    for (int i = 0; i < n; ++i) out[i] = static_cast<std::int16_t>(g[i]);
+    return 0;
+  }
+  // fixed::rounding_shift_right, written as (g + half - [g < 0]) >> s.
+  const std::int64_t half = std::int64_t{1} << (s - 1);
+  for (int i = 0; i < n; ++i) out[i] = fixed::saturate_i16((g[i] + half - (g[i] < 0 ? 1 : 0)) >> s);
+  return s;
+}
+
 template <GeneratedModel M>
 struct Numerics {
   using Value = typename M::Value;

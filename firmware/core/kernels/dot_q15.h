@@ -80,7 +80,7 @@ void sigmoid_q15_block(std::int16_t* v, int n) noexcept;
 void tanh_q15_block(std::int16_t* v, int n) noexcept;
 
 // ---------------------------------------------------------------------------
-// Backward: products with int32 gradients
+// Backward: products with gradients
 // ---------------------------------------------------------------------------
 
 // acc[r] = sum_{c < cols} w[r * stride + c] * x[c] for r < rows: a row-major
@@ -95,11 +95,15 @@ void dot_cols_q15_i32(const std::int16_t* w, int stride, int rows, const std::in
                       std::int64_t* acc) noexcept;
 
 // acc[c] = sum_{r < rows} W(r, c) * g[r] for c < cols, W a packed matrix
-// (`w` = PackedMatrix::data, `padded_cols` = its kCols): W^T g from the
-// forward kernel's own storage, so a model keeps one copy of each matrix
-// (the model image's flash budget, docs/model-update.md).
-void dot_cols_packed_q15_i32(const std::int16_t* w, int padded_cols, int rows, const std::int32_t* g, int cols,
-                             std::int64_t* acc) noexcept;
+// (`w` = PackedMatrix::data, `padded_cols` = its kCols) and g int16: W^T g
+// from the forward kernel's own storage, so a model keeps one copy of each
+// matrix (the model image's flash budget, docs/model-update.md). The
+// gradients arrive as block floating point (numerics.h, grad_block_q15):
+// int16 mantissas and one exponent the caller applies to the sums. g holds
+// rows + rows % 2 entries: an odd count's last pair reads one more, which
+// meets the packed matrix's zero padding row (any value).
+void dot_cols_packed_q15(const std::int16_t* w, int padded_cols, int rows, const std::int16_t* g, int cols,
+                         std::int64_t* acc) noexcept;
 
 }  // namespace hadynet::kernels
 

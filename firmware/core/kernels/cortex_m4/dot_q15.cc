@@ -33,9 +33,16 @@
 // of g and eight SMLALD into two accumulators: 11 instructions per 8 MACs;
 // sum = 2^16 sum_h + sum_l.
 //
-// dot_cols_q15_i32 (W^T g from W itself, the small decoder matrix): SMLAL
-// (32 x 32 + 64) per product, four columns per row of W sharing the load of
-// g[r], eight rows unrolled: about 2.56 instructions per MAC.
+// dot_cols_q15_i32 (W^T g from a row-major W): SMLAL (32 x 32 + 64) per
+// product, four columns per row of W sharing the load of g[r], eight rows
+// unrolled: about 2.56 instructions per MAC.
+//
+// dot_cols_packed_q15 (W^T g from the packed forward matrix, g int16 block
+// floating point): a transposed product needs pairs along the rows, which
+// the packed order does not hold in one word, so SMLALD does not apply;
+// SMLAL<x><y> takes the int16 halves of W and g straight from their words
+// (no unpacking, no split of g): per row pair one word of g, one LDRD of
+// each row's four columns, eight SMLAL<x><y>: 12 instructions per 8 MACs.
 //
 // Shapes outside the fast paths (column counts not a multiple of 8, odd
 // strides, unaligned rows or vectors, out-of-range shifts, gradients near
@@ -102,6 +109,13 @@ extern const char hadynet_split_end[];
 // out[j] = sum_{r < rows} w[r * stride + j] g[r] for j = 0..3; rows >= 1.
 void hadynet_dot_cols4(const std::int16_t* w, int stride_bytes, const std::int32_t* g, int rows,
                        std::int64_t* out) noexcept;
+
+// out[j] = sum over the `pairs` row pairs p (pairs >= 1) of
+// W(2p, j) g[2p] + W(2p + 1, j) g[2p + 1] for j = 0..3, w pointing at
+// W(0, j0) of a packed matrix (row 2p + 1 sixteen bytes after row 2p, pairs
+// stride_bytes apart); w and g word-aligned.
+void hadynet_dot_cols4_q15(const std::int16_t* w, int stride_bytes, const std::int16_t* g, int pairs,
+                           std::int64_t* out) noexcept;
 }
 
 // The structs are the layout the assembly reads (kernel_layout.h).
@@ -156,11 +170,6 @@ bool fast_term(const MatvecTerm& t) noexcept {
   return t.cols % 8 == 0 && t.cols <= kMvpMaxCols && word_aligned(t.w) && word_aligned(t.x) && t.shift >= 0 &&
          t.shift <= 31;
 }
-
-// g's even and odd rows for dot_cols_packed_q15_i32 (static, as g_split).
-inline constexpr int kPackedColsMaxRows = 1024;
-alignas(8) std::int32_t g_even[kPackedColsMaxRows / 2];
-alignas(8) std::int32_t g_odd[kPackedColsMaxRows / 2];
 
 // The split of g for hadynet_dot_rows_split (static: the firmware is
 // single-threaded and nothing here is reentrant).
@@ -263,26 +272,26 @@ void dot_cols_q15_i32(const std::int16_t* w, int stride, int rows, const std::in
   if (c < cols) reference::dot_cols_q15_i32(w + c, stride, rows, g, cols - c, acc + c);  // the last cols % 4
 }
 
-// W^T g on a packed matrix: a pair's two rows sit 8 elements apart and
-// pairs 2 * padded_cols apart, so the even rows and the odd rows are each a
-// row-major matrix with that stride; hadynet_dot_cols4 runs over each with
-// g's even or odd entries, four columns (inside one chunk of eight) at a time.
-void dot_cols_packed_q15_i32(const std::int16_t* w, int padded_cols, int rows, const std::int32_t* g, int cols,
-                             std::int64_t* acc) noexcept {
-  if (rows <= 1 || rows > kPackedColsMaxRows || cols % 4 != 0 || !word_aligned(w)) {
-    reference::dot_cols_packed_q15_i32(w, padded_cols, rows, g, cols, acc);
+// W^T g on a packed matrix with int16 g: four columns (inside one chunk of
+// eight) at a time over every row pair (hadynet_dot_cols4_q15); the last
+// cols % 4 columns by the reference.
+void dot_cols_packed_q15(const std::int16_t* w, int padded_cols, int rows, const std::int16_t* g, int cols,
+                         std::int64_t* acc) noexcept {
+  if (rows <= 0 || !word_aligned(w) || !word_aligned(g)) {
+    reference::dot_cols_packed_q15(w, padded_cols, rows, g, cols, acc);
     return;
   }
-  const int even_rows = (rows + 1) / 2, odd_rows = rows / 2;
-  for (int i = 0; i < even_rows; ++i) g_even[i] = g[2 * i];
-  for (int i = 0; i < odd_rows; ++i) g_odd[i] = g[2 * i + 1];
   const int stride_bytes = 2 * 2 * padded_cols;
-  for (int c = 0; c < cols; c += 4) {
-    const std::int16_t* first = w + packed_index(padded_cols, 0, c);
-    std::int64_t odd[4];
-    hadynet_dot_cols4(first, stride_bytes, g_even, even_rows, acc + c);
-    hadynet_dot_cols4(first + 8, stride_bytes, g_odd, odd_rows, odd);
-    for (int j = 0; j < 4; ++j) acc[c + j] += odd[j];
+  int c = 0;
+  for (; c + 4 <= cols; c += 4)
+    hadynet_dot_cols4_q15(w + packed_index(padded_cols, 0, c), stride_bytes, g, (rows + 1) / 2, acc + c);
+  if (c < cols) {
+    // The last cols % 4 (< 4) columns by the reference, from the start of
+    // their chunk (packed_index is linear in whole chunks): at most 7 columns.
+    std::int64_t rest[8];
+    const int chunk = c / 8 * 8;
+    reference::dot_cols_packed_q15(w + packed_index(padded_cols, 0, chunk), padded_cols, rows, g, cols - chunk, rest);
+    for (int j = c; j < cols; ++j) acc[j] = rest[j - chunk];
   }
 }
 

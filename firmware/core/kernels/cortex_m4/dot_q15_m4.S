@@ -12,6 +12,33 @@
         .error  "an unrolled block is not the size kernel_layout.h says"
         .endif
         .endm
+@ Zeroes the four 64-bit accumulators r6:r7, r8:r9, r10:r11, r12:lr.
+        .macro  HADYNET_ZERO_ACC4
+        mov     r6, #0
+        mov     r7, #0
+        mov     r8, #0
+        mov     r9, #0
+        mov     r10, #0
+        mov     r11, #0
+        mov     r12, #0
+        mov     lr, #0
+        .endm
+
+@ Enters an 8-block unrolled body that starts at local label 1 (forward) so
+@ that its first pass runs only `rem` = count % 8 blocks (all 8 if rem is 0;
+@ then it branches to local label 3, placed right before label 1). rem in
+@ r4 (a low register, for CBZ); clobbers r4, r5.
+        .macro  HADYNET_ENTER_REMAINDER block_bytes
+        cbz     r4, 3f
+        rsb     r4, r4, #8
+        mov     r5, #\block_bytes
+        mul     r4, r4, r5
+        adr.w   r5, 1f
+        add     r4, r4, r5
+        orr     r4, r4, #1
+        bx      r4
+        .endm
+
         .syntax unified
         .thumb
         .text
@@ -275,27 +302,13 @@ hadynet_split_end:
         .p2align 2
 hadynet_dot_cols4:
         push    {r4-r11, lr}
-        mov     r6, #0
-        mov     r7, #0
-        mov     r8, #0
-        mov     r9, #0
-        mov     r10, #0
-        mov     r11, #0
-        mov     r12, #0
-        mov     lr, #0
+        HADYNET_ZERO_ACC4
         @ Enter the 8-row body so that the first pass does rows % 8 rows
         @ (8 if rows % 8 == 0); r3 becomes the number of passes.
         and     r4, r3, #7
         adds    r3, r3, #7
         lsrs    r3, r3, #3
-        cbz     r4, 3f
-        rsb     r4, r4, #8
-        mov     r5, #HADYNET_COLS_ROW_BYTES
-        mul     r4, r4, r5
-        adr.w   r5, 1f
-        add     r4, r4, r5
-        orr     r4, r4, #1
-        bx      r4
+        HADYNET_ENTER_REMAINDER HADYNET_COLS_ROW_BYTES
 3:
 1:
         .rept   8
@@ -311,3 +324,60 @@ hadynet_dot_cols4:
         strd    r12, lr, [r4, #24]
         pop     {r4-r11, pc}
         .size   hadynet_dot_cols4, . - hadynet_dot_cols4
+
+@ ---------------------------------------------------------------------------
+@ hadynet_dot_cols4_q15(w, stride_bytes, g, pairs, out)
+@ Four columns of W^T g on a packed matrix with int16 g: per row pair, one
+@ word of g (g[2p] low, g[2p + 1] high), one LDRD of each row's four
+@ columns (the pair's second row 16 bytes after its first) and eight
+@ SMLAL<x><y>, each one 16 x 16 product into a 64-bit accumulator, halves
+@ chosen in the instruction: twelve 32-bit instructions (48 bytes) per row
+@ pair, 1.5 per MAC.
+@   r0 W pointer, r1 stride in bytes, r2 g pointer, r3 g word, r4-r5 W
+@   words, r6:r7, r8:r9, r10:r11, r12:lr accumulators; g's end on the stack.
+        .macro  HADYNET_COLS4_Q15_PAIR
+        ldr.w   r3, [r2], #4
+        ldrd    r4, r5, [r0]
+        smlalbb r6, r7, r4, r3
+        smlaltb r8, r9, r4, r3
+        smlalbb r10, r11, r5, r3
+        smlaltb r12, lr, r5, r3
+        ldrd    r4, r5, [r0, #16]
+        smlalbt r6, r7, r4, r3
+        smlaltt r8, r9, r4, r3
+        smlalbt r10, r11, r5, r3
+        smlaltt r12, lr, r5, r3
+        add.w   r0, r0, r1
+        .endm
+
+        .global hadynet_dot_cols4_q15
+        .type   hadynet_dot_cols4_q15, %function
+        .thumb_func
+        .p2align 2
+hadynet_dot_cols4_q15:
+        push    {r4-r11, lr}
+        and     r4, r3, #7                      @ pairs % 8
+        add     r3, r2, r3, lsl #2              @ g's end
+        sub     sp, sp, #8
+        str     r3, [sp]
+        HADYNET_ZERO_ACC4
+        @ Enter the 8-pair body so that the first pass does pairs % 8 pairs
+        @ (8 if pairs % 8 == 0).
+        HADYNET_ENTER_REMAINDER HADYNET_COLS_Q15_PAIR_BYTES
+3:
+1:
+        .rept   8
+        HADYNET_COLS4_Q15_PAIR
+        .endr
+        HADYNET_CHECK_BLOCKS 1b, ., 8, HADYNET_COLS_Q15_PAIR_BYTES
+        ldr     r3, [sp]
+        cmp     r2, r3
+        bne     1b
+        add     sp, sp, #8
+        ldr     r4, [sp, #36]                   @ out (fifth argument)
+        strd    r6, r7, [r4]
+        strd    r8, r9, [r4, #8]
+        strd    r10, r11, [r4, #16]
+        strd    r12, lr, [r4, #24]
+        pop     {r4-r11, pc}
+        .size   hadynet_dot_cols4_q15, . - hadynet_dot_cols4_q15

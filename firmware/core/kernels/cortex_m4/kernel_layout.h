@@ -47,4 +47,7 @@
 /* hadynet_dot_cols4: one row of four columns, 10 32-bit instructions. */
 #define HADYNET_COLS_ROW_BYTES 40
 
+/* hadynet_dot_cols4_q15: one row pair of four columns, 12 32-bit instructions. */
+#define HADYNET_COLS_Q15_PAIR_BYTES 48
+
 #endif /* HADYNET_FIRMWARE_CORE_KERNELS_CORTEX_M4_KERNEL_LAYOUT_H_ */

@@ -25,9 +25,9 @@ void dot_cols_q15_i32(const std::int16_t* w, int stride, int rows, const std::in
   reference::dot_cols_q15_i32(w, stride, rows, g, cols, acc);
 }
 
-void dot_cols_packed_q15_i32(const std::int16_t* w, int padded_cols, int rows, const std::int32_t* g, int cols,
-                             std::int64_t* acc) noexcept {
-  reference::dot_cols_packed_q15_i32(w, padded_cols, rows, g, cols, acc);
+void dot_cols_packed_q15(const std::int16_t* w, int padded_cols, int rows, const std::int16_t* g, int cols,
+                         std::int64_t* acc) noexcept {
+  reference::dot_cols_packed_q15(w, padded_cols, rows, g, cols, acc);
 }
 
 }  // namespace hadynet::kernels

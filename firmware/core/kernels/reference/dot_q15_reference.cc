@@ -78,8 +78,8 @@ void dot_cols_q15_i32(const std::int16_t* w, int stride, int rows, const std::in
   }
 }
 
-void dot_cols_packed_q15_i32(const std::int16_t* w, int padded_cols, int rows, const std::int32_t* g, int cols,
-                             std::int64_t* acc) noexcept {
+void dot_cols_packed_q15(const std::int16_t* w, int padded_cols, int rows, const std::int16_t* g, int cols,
+                         std::int64_t* acc) noexcept {
   for (int c = 0; c < cols; ++c) acc[c] = 0;
   for (int r = 0; r < rows; ++r) {
     const std::int64_t gr = g[r];

@@ -21,8 +21,8 @@ void dot_rows_q15_i32(const std::int16_t* w, int stride, int rows, const std::in
                       std::int64_t* acc) noexcept;
 void dot_cols_q15_i32(const std::int16_t* w, int stride, int rows, const std::int32_t* g, int cols,
                       std::int64_t* acc) noexcept;
-void dot_cols_packed_q15_i32(const std::int16_t* w, int padded_cols, int rows, const std::int32_t* g, int cols,
-                             std::int64_t* acc) noexcept;
+void dot_cols_packed_q15(const std::int16_t* w, int padded_cols, int rows, const std::int16_t* g, int cols,
+                         std::int64_t* acc) noexcept;
 
 }  // namespace hadynet::kernels::reference
 
