@@ -53,11 +53,26 @@ void print_line(const app::PeriodRecord<M>& r) {
   add(app::kRecordOverrun, "overrun");
   double norm = 0;
   for (int i = 0; i < M::kU; ++i) norm += static_cast<double>(r.command[i]) * r.command[i];
-  std::printf("period %8u  seq %8u  %-7s  d %s  contact %-3s  |u| %s  %s\n", r.period, r.sequence, mode_word(r.mode),
+  // The on-device recognition: the adapted PB's nearest trained state,
+  // its distance and the nearest other object's (docs/firmware.md).
+  std::string object;
+  if (r.has(app::kRecordRecognition)) {
+    char text[160];
+    if (r.other_object_state == app::kRecordNoOtherObject) {
+      std::snprintf(text, sizeof text, "  object %s %.2f", M::kStateNames[r.recognized_state],
+                    static_cast<double>(r.recognized_distance));
+    } else {
+      std::snprintf(text, sizeof text, "  object %s %.2f (next %s %.2f)", M::kStateNames[r.recognized_state],
+                    static_cast<double>(r.recognized_distance), M::kStateNames[r.other_object_state],
+                    static_cast<double>(r.other_object_distance));
+    }
+    object = text;
+  }
+  std::printf("period %8u  seq %8u  %-7s  d %s  contact %-3s  |u| %s  %s%s\n", r.period, r.sequence, mode_word(r.mode),
               r.has(app::kRecordDistanceValid) ? (std::to_string(r.d).substr(0, 8)).c_str() : "   -    ",
               r.has(app::kRecordContact) ? "yes" : "no",
               r.has(app::kRecordCommandValid) ? std::to_string(std::sqrt(norm)).substr(0, 7).c_str() : "   -   ",
-              flags.empty() ? "ok" : flags.c_str());
+              flags.empty() ? "ok" : flags.c_str(), object.c_str());
   std::fflush(stdout);
 }
 

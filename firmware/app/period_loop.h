@@ -102,6 +102,16 @@ class PeriodLoop {
       for (int i = 0; i < M::kY; ++i) r.prediction[i] = out.prediction[i];
       r.d = out.d;
       for (int i = 0; i < M::kU; ++i) r.command[i] = out.command[i];
+      r.adapt_updates = out.adapt_updates;
+      if (out.adapt_valid && out.recognition.valid) {
+        r.flags |= kRecordRecognition;
+        r.recognized_state = static_cast<std::uint16_t>(out.recognition.state);
+        r.recognized_distance = out.recognition.distance;
+        r.other_object_state = out.recognition.other_state < 0
+                                   ? kRecordNoOtherObject
+                                   : static_cast<std::uint16_t>(out.recognition.other_state);
+        r.other_object_distance = out.recognition.other_distance;
+      }
     }
     record_ = r;
     return record_;

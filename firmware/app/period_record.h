@@ -20,7 +20,10 @@
 //     (records since it arrived).
 //   * prediction, d, contact and command are the runtime's StepResult of that
 //     step, bit for bit (the same as a host-driven sensor frame 0x02 with the
-//     same data); fields whose valid flag is clear are 0.
+//     same data); fields whose valid flag is clear are 0. So are the
+//     adaptation's count and recognition (StepResult::adapt_updates,
+//     recognition): pushed with every record, where the link's adapt status
+//     (0x89) has them only on request.
 //   * kRecordOverrun: this period's work (from the period boundary to the end
 //     of the step) took longer than one period (0.2 s); `overruns` counts such
 //     periods since start. `missed_periods` is board::overrun_periods(): the
@@ -48,7 +51,11 @@ inline constexpr std::uint16_t kRecordStaleMuscleState = 1u << 5;  // stepped wi
 inline constexpr std::uint16_t kRecordNoMuscleState = 1u << 6;     // none received: not stepped
 inline constexpr std::uint16_t kRecordNoLoadcells = 1u << 7;       // no loadcell reading: not stepped
 inline constexpr std::uint16_t kRecordOverrun = 1u << 8;           // this period's work exceeded 0.2 s
-inline constexpr std::uint16_t kRecordKnownFlags = (1u << 9) - 1;
+inline constexpr std::uint16_t kRecordRecognition = 1u << 9;       // the adapted PB named a trained state
+inline constexpr std::uint16_t kRecordKnownFlags = (1u << 10) - 1;
+
+// PeriodRecord::other_object_state when every PB-table row names one object.
+inline constexpr std::uint16_t kRecordNoOtherObject = 0xFFFF;
 
 template <firmware::GeneratedModel M>
 struct PeriodRecord {
@@ -66,6 +73,15 @@ struct PeriodRecord {
   float d = 0.0f;                      // Mahalanobis distance, standardised units
   float prediction[M::kY] = {};        // y_est_t, physical (log units)
   float command[M::kU] = {};           // u_t, physical
+  // On-device PB adaptation (docs/firmware.md), from the same step. With
+  // kRecordRecognition: the adapted PB's nearest PB-table row and the
+  // nearest row naming another object (kRecordNoOtherObject: none), with
+  // their distances (standardised PB units); without it these four are 0.
+  std::uint32_t adapt_updates = 0;         // PB updates since adaptation began (0: off or none yet)
+  std::uint16_t recognized_state = 0;      // row of the model's PB table (its state name)
+  float recognized_distance = 0.0f;
+  std::uint16_t other_object_state = 0;
+  float other_object_distance = 0.0f;
 
   constexpr bool has(std::uint16_t flag) const noexcept { return (flags & flag) != 0; }
 };

@@ -48,7 +48,7 @@ struct PayloadSizes {
   static constexpr std::size_t kMuscleState = 4 * (app::ChannelLayout<M>::kMuscleY + M::kU);
   static constexpr std::size_t kTareAck = 4 * app::ChannelLayout<M>::kLoadcells;
   static constexpr std::size_t kPeriodResult =
-      4 + 4 + 1 + 2 + 4 + 4 + 4 + 4 * (app::ChannelLayout<M>::kLoadcells + 1 + M::kY + M::kU);
+      4 + 4 + 1 + 2 + 4 + 4 + 4 + 4 * (app::ChannelLayout<M>::kLoadcells + 1 + M::kY + M::kU) + 4 + 2 + 4 + 2 + 4;
   static_assert(kSensorFrame <= kMaxPayload && kStepResult <= kMaxPayload && kSetPbValues <= kMaxPayload &&
                     kAdaptStatus <= kMaxPayload,
                 "the model's messages exceed the protocol's kMaxPayload");
@@ -365,7 +365,9 @@ constexpr bool decode_tare_ack(std::span<const std::uint8_t> in,
 // ---- 0x08 period result request: empty. 0x88 period result: the loop's
 // latest app::PeriodRecord, fields in its order: sequence u32, period u32,
 // mode u8, flags u16, muscle_state_age u32, overruns u32, missed_periods u32,
-// loadcells_N[kLoadcells] f32, d f32, prediction[kY] f32, command[kU] f32.
+// loadcells_N[kLoadcells] f32, d f32, prediction[kY] f32, command[kU] f32,
+// adapt_updates u32, recognized_state u16, recognized_distance f32,
+// other_object_state u16, other_object_distance f32.
 
 template <firmware::GeneratedModel M>
 constexpr std::size_t encode_period_result(const app::PeriodRecord<M>& r, std::span<std::uint8_t> out) noexcept {
@@ -381,10 +383,16 @@ constexpr std::size_t encode_period_result(const app::PeriodRecord<M>& r, std::s
   w.f32(r.d);
   for (const float v : r.prediction) w.f32(v);
   for (const float v : r.command) w.f32(v);
+  w.u32(r.adapt_updates);
+  w.u16(r.recognized_state);
+  w.f32(r.recognized_distance);
+  w.u16(r.other_object_state);
+  w.f32(r.other_object_distance);
   return w.ok() ? w.size() : 0;
 }
 
-// False for a wrong size, an unknown mode or unknown flag bits.
+// False for a wrong size, an unknown mode, unknown flag bits or a
+// recognition naming a state the model's PB table does not have.
 template <firmware::GeneratedModel M>
 constexpr bool decode_period_result(std::span<const std::uint8_t> in, app::PeriodRecord<M>& r) noexcept {
   if (in.size() != PayloadSizes<M>::kPeriodResult) return false;
@@ -402,8 +410,17 @@ constexpr bool decode_period_result(std::span<const std::uint8_t> in, app::Perio
   r.d = rd.f32();
   for (float& v : r.prediction) v = rd.f32();
   for (float& v : r.command) v = rd.f32();
+  r.adapt_updates = rd.u32();
+  r.recognized_state = rd.u16();
+  r.recognized_distance = rd.f32();
+  r.other_object_state = rd.u16();
+  r.other_object_distance = rd.f32();
+  const bool recognition_ok =
+      !r.has(app::kRecordRecognition) ||
+      (r.recognized_state < M::kStates &&
+       (r.other_object_state < M::kStates || r.other_object_state == app::kRecordNoOtherObject));
   return rd.ok() && mode <= static_cast<std::uint8_t>(firmware::Mode::kControl) &&
-         (r.flags & ~app::kRecordKnownFlags) == 0;
+         (r.flags & ~app::kRecordKnownFlags) == 0 && recognition_ok;
 }
 
 // ---- 0x09 adapt: action u8, window stride u8, windows per period u8

@@ -17,7 +17,7 @@
 // on firmware/link for CDC; the link's messages are pure header code.)
 //
 // Sizes come from the model's compile-time shapes (the hand: kLoadcells 9,
-// kY 27, kU 8: 203 payload bytes, 4 reports per set). Pure code, shared by
+// kY 27, kU 8: 219 payload bytes, 4 reports per set). Pure code, shared by
 // the firmware (encoder) and host tools (telemetry_decoder.h).
 #ifndef HADYNET_FIRMWARE_USB_TELEMETRY_REPORT_H_
 #define HADYNET_FIRMWARE_USB_TELEMETRY_REPORT_H_
@@ -34,8 +34,9 @@
 namespace hadynet::usb {
 
 // 2: the payload became the 0x88 period result (1 was a shorter record with
-// its own flag bits).
-inline constexpr std::uint8_t kTelemetryFormatVersion = 2;
+// its own flag bits). 3: the period result gained the on-device adaptation's
+// count and recognition (16 bytes).
+inline constexpr std::uint8_t kTelemetryFormatVersion = 3;
 inline constexpr std::size_t kTelemetryReportSize = 64;
 inline constexpr std::size_t kTelemetryHeaderSize = 8;
 inline constexpr std::size_t kTelemetryPartPayload = kTelemetryReportSize - kTelemetryHeaderSize;  // 56

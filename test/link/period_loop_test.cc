@@ -130,7 +130,7 @@ TEST(ChannelLayout, FollowsTheGeneratedModelsChannelNames) {
   // The payload sizes follow: 4 (18 + 8) and 4 * 9.
   EXPECT_EQ(PayloadSizes<Q>::kMuscleState, 104u);
   EXPECT_EQ(PayloadSizes<Q>::kTareAck, 36u);
-  EXPECT_EQ(PayloadSizes<Q>::kPeriodResult, 23u + 4u * (9 + 1 + 27 + 8));
+  EXPECT_EQ(PayloadSizes<Q>::kPeriodResult, 23u + 4u * (9 + 1 + 27 + 8) + 16u);
 }
 
 TEST(ChannelLayout, SplitThenAssembleIsTheSameFrame) {
@@ -144,13 +144,14 @@ TEST(ChannelLayout, SplitThenAssembleIsTheSameFrame) {
 }
 
 // The 0x88 payload: every field at its documented offset (little-endian),
-// and the decoder refuses a wrong size, an unknown mode or unknown flag bits.
+// and the decoder refuses a wrong size, an unknown mode, unknown flag bits
+// or a recognition naming a state the PB table does not have.
 TEST(PeriodResultPayload, LayoutAndDecoderChecks) {
   app::PeriodRecord<Q> r;
   r.sequence = 0x01020304u;
   r.period = 0x05060708u;
   r.mode = Mode::kControl;
-  r.flags = app::kRecordStepped | app::kRecordOverrun;
+  r.flags = app::kRecordStepped | app::kRecordOverrun | app::kRecordRecognition;
   r.muscle_state_age = 3;
   r.overruns = 4;
   r.missed_periods = 5;
@@ -158,9 +159,14 @@ TEST(PeriodResultPayload, LayoutAndDecoderChecks) {
   r.d = 17.25f;
   for (int i = 0; i < Q::kY; ++i) r.prediction[i] = static_cast<float>(i);
   for (int i = 0; i < Q::kU; ++i) r.command[i] = -static_cast<float>(i);
+  r.adapt_updates = 0x0A0B0C0Du;
+  r.recognized_state = Q::kStates - 1;
+  r.recognized_distance = 0.125f;
+  r.other_object_state = 2;
+  r.other_object_distance = 0.75f;
   Bytes p(PayloadSizes<Q>::kPeriodResult);
   ASSERT_EQ(encode_period_result<Q>(r, p), p.size());
-  const Bytes head = {0x04, 0x03, 0x02, 0x01, 0x08, 0x07, 0x06, 0x05, 0x02, 0x10, 0x01,
+  const Bytes head = {0x04, 0x03, 0x02, 0x01, 0x08, 0x07, 0x06, 0x05, 0x02, 0x10, 0x03,
                       0x03, 0x00, 0x00, 0x00, 0x04, 0x00, 0x00, 0x00, 0x05, 0x00, 0x00, 0x00};
   EXPECT_EQ(Bytes(p.begin(), p.begin() + 23), head);
   const auto f32_at = [&](std::size_t offset) {
@@ -173,6 +179,14 @@ TEST(PeriodResultPayload, LayoutAndDecoderChecks) {
   EXPECT_EQ(f32_at(23 + 4 * kLc), 17.25f) << "d";
   EXPECT_EQ(f32_at(23 + 4 * (kLc + 1) + 4 * 26), 26.0f) << "prediction[26]";
   EXPECT_EQ(f32_at(23 + 4 * (kLc + 1 + Q::kY) + 4 * 7), -7.0f) << "command[7]";
+  constexpr std::size_t kAdapt = 23 + 4 * (kLc + 1 + Q::kY + Q::kU);
+  EXPECT_EQ(Bytes(p.begin() + kAdapt, p.begin() + kAdapt + 6),
+            (Bytes{0x0D, 0x0C, 0x0B, 0x0A, static_cast<std::uint8_t>(Q::kStates - 1), 0x00}))
+      << "adapt_updates, recognized_state";
+  EXPECT_EQ(f32_at(kAdapt + 6), 0.125f) << "recognized_distance";
+  EXPECT_EQ(p[kAdapt + 10], 2) << "other_object_state";
+  EXPECT_EQ(f32_at(kAdapt + 12), 0.75f) << "other_object_distance";
+  EXPECT_EQ(kAdapt + 16, p.size());
 
   app::PeriodRecord<Q> back;
   ASSERT_TRUE(decode_period_result<Q>(p, back));
@@ -184,8 +198,23 @@ TEST(PeriodResultPayload, LayoutAndDecoderChecks) {
   bad_mode[8] = 3;
   EXPECT_FALSE(decode_period_result<Q>(bad_mode, back));
   Bytes bad_flags = p;
-  bad_flags[10] = 0x02;  // bit 9
+  bad_flags[10] = 0x04;  // bit 10
   EXPECT_FALSE(decode_period_result<Q>(bad_flags, back));
+  Bytes bad_state = p;
+  bad_state[kAdapt + 4] = static_cast<std::uint8_t>(Q::kStates);  // one past the PB table
+  EXPECT_FALSE(decode_period_result<Q>(bad_state, back));
+  Bytes bad_other = p;
+  bad_other[kAdapt + 10] = 0xFE;
+  bad_other[kAdapt + 11] = 0xFF;  // 0xFFFE: neither a row nor "none"
+  EXPECT_FALSE(decode_period_result<Q>(bad_other, back));
+  Bytes no_other = p;
+  no_other[kAdapt + 10] = 0xFF;
+  no_other[kAdapt + 11] = 0xFF;  // kRecordNoOtherObject
+  EXPECT_TRUE(decode_period_result<Q>(no_other, back));
+  EXPECT_EQ(back.other_object_state, app::kRecordNoOtherObject);
+  Bytes unflagged = bad_state;
+  unflagged[10] = 0x01;  // recognition flag clear: the fields are not read as a state
+  EXPECT_TRUE(decode_period_result<Q>(unflagged, back));
   EXPECT_FALSE(decode_period_result<Q>(Bytes(p.begin(), p.end() - 1), back));
 }
 
@@ -225,7 +254,7 @@ TEST(ChannelLayout, TakesTheSplitFromTheNamesNotFromTheHand) {
   EXPECT_EQ(N::kLoadcells, 0);
   EXPECT_EQ(N::kMuscleY, Q::kY);
   EXPECT_EQ(PayloadSizes<NoLoadcells>::kTareAck, 0u);
-  EXPECT_EQ(PayloadSizes<NoLoadcells>::kPeriodResult, 23u + 4u * (1 + 27 + 8));
+  EXPECT_EQ(PayloadSizes<NoLoadcells>::kPeriodResult, 23u + 4u * (1 + 27 + 8) + 16u);
   using G = app::ChannelLayout<OtherBoardGroup>;  // f0..f7 on the board, fc* over the link
   EXPECT_EQ(G::kLoadcells, 8);
   EXPECT_EQ(std::string(Q::kYNames[G::kLoadcellY[0]]), "f0");
@@ -294,6 +323,59 @@ void check_loop_matches_sensor_frames(int frames, int control_from) {
     }
   }
   EXPECT_EQ(std::memcmp(&a->runtime, &b->runtime, sizeof a->runtime), 0) << "runtime bytes differ";
+}
+
+// On-device adaptation in the loop: adaptation switched on over the link
+// (0x09), the loop's record of every period carries the runtime's own
+// adaptation count and recognition, bit for bit: a runtime adapting with the
+// same settings on the same frames, stepped directly, is the reference.
+// Every 8th window, 2 per period: the first PB update comes a few periods
+// after the 100th window, so the recognition flag must appear, and stay.
+TEST(PeriodLoop, RecordsCarryTheAdaptingRuntimesRecognition) {
+  ZeroedDevice<Q> a;
+  LinkClient<Q> ca;
+  Bytes storage;
+  auto direct = std::make_unique<firmware::HadynetRuntime<Q>>();
+  typename firmware::PbAdapter<Q>::Settings settings = direct->adapter().settings();
+  settings.window_stride = 8;
+  settings.windows_per_period = 2;
+  ASSERT_TRUE(direct->set_adapt_settings(settings));
+  direct->set_adapting(true);
+  exchange(a, ca, wire_of([&](auto w) { return ca.adapt({AdaptAction::kOn, 8, 2}, w); }), MessageType::kAdaptStatus,
+           storage);
+  const int frames = 100 + Q::kTrainSteps + 2 + 24;
+  int first_recognition = -1;
+  for (int t = 0; t < frames; ++t) {
+    const firmware::SensorFrame<Q> frame = synthetic_frame<Q>(t);
+    app::MuscleState<Q> muscle;
+    Reading<Q> reading;
+    split<Q>(frame, muscle, reading);
+    exchange(a, ca, wire_of([&](auto w) { return ca.muscle_state(muscle, w); }), MessageType::kMuscleStateAck,
+             storage);
+    a->link.loop().run_period(reading, 0);
+    a->link.loop().end_period(10, 100);
+    const app::PeriodRecord<Q> record = request_record(a, ca);
+    const firmware::StepResult<Q> want = direct->step(frame);
+    expect_record_is_step<Q>(record, want, t);
+    EXPECT_EQ(record.adapt_updates, want.adapt_updates) << t;
+    const bool named = want.adapt_valid && want.recognition.valid;
+    ASSERT_EQ(record.has(app::kRecordRecognition), named) << t;
+    if (!named) {
+      EXPECT_EQ(record.recognized_state, 0) << t;
+      EXPECT_EQ(record.other_object_state, 0) << t;
+      EXPECT_EQ(record.recognized_distance, 0.0f) << t;
+      continue;
+    }
+    if (first_recognition < 0) first_recognition = t;
+    EXPECT_EQ(record.recognized_state, want.recognition.state) << t;
+    EXPECT_EQ(std::memcmp(&record.recognized_distance, &want.recognition.distance, sizeof(float)), 0) << t;
+    EXPECT_EQ(record.other_object_state, want.recognition.other_state < 0 ? app::kRecordNoOtherObject
+                                                                          : want.recognition.other_state)
+        << t;
+    EXPECT_EQ(std::memcmp(&record.other_object_distance, &want.recognition.other_distance, sizeof(float)), 0) << t;
+  }
+  EXPECT_GE(first_recognition, 100) << "no PB update before the 100th window";
+  EXPECT_LT(first_recognition, frames - 1) << "no recognition in " << frames << " periods";
 }
 
 TEST(PeriodLoop, MuscleStatesAndLoadcellsMatchSensorFramesBitForBitQ15) {

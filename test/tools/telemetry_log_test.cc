@@ -37,12 +37,14 @@ app::PeriodRecord<Q> record(std::uint32_t period) {
 
 TEST(TelemetryLog, ColumnsAreTheModelsNames) {
   const auto& c = Log::columns();
-  ASSERT_EQ(c.size(), 1u + Layout::kLoadcells + 4 + Q::kY + Q::kU);
+  ASSERT_EQ(c.size(), 1u + Layout::kLoadcells + 4 + Q::kY + Q::kU + 5);
   EXPECT_EQ(c[0], "t");
   EXPECT_EQ(c[1], Q::kYNames[Layout::kLoadcellY[0]]);
   EXPECT_EQ(c[1 + Layout::kLoadcells], "aux_d");
   EXPECT_EQ(c[1 + Layout::kLoadcells + 4], std::string("aux_pred_") + Q::kYNames[0]);
-  EXPECT_EQ(c.back(), std::string("aux_cmd_") + Q::kUNames[Q::kU - 1]);
+  EXPECT_EQ(c[Layout::kLoadcells + 4 + Q::kY + Q::kU], std::string("aux_cmd_") + Q::kUNames[Q::kU - 1]);
+  EXPECT_EQ(c[c.size() - 5], "aux_adapt_updates");
+  EXPECT_EQ(c.back(), "aux_other_object_distance");
 }
 
 TEST(TelemetryLog, RecordsRoundTripBitForBitThroughTheWriterAndReader) {

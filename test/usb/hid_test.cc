@@ -3,7 +3,7 @@
 // with the published records bit for bit (exact, tolerance zero).
 //
 // The record is app::PeriodRecord, its payload the link's 0x88 period result
-// (203 bytes for the hand's model: kLoadcells 9, kY 27, kU 8), so a set is 4
+// (219 bytes for the hand's model: kLoadcells 9, kY 27, kU 8), so a set is 4
 // reports of 64 bytes (it was 3 with the 152-byte version-1 record); the
 // expectations are the old ones with that size.
 #include <gtest/gtest.h>

@@ -25,6 +25,11 @@ void expect_same_bits(const app::PeriodRecord<M>& got, const app::PeriodRecord<M
   EXPECT_EQ(std::memcmp(&got.d, &want.d, sizeof want.d), 0) << "d " << where;
   EXPECT_EQ(std::memcmp(got.prediction, want.prediction, sizeof want.prediction), 0) << "prediction " << where;
   EXPECT_EQ(std::memcmp(got.command, want.command, sizeof want.command), 0) << "command " << where;
+  EXPECT_EQ(got.adapt_updates, want.adapt_updates) << where;
+  EXPECT_EQ(got.recognized_state, want.recognized_state) << where;
+  EXPECT_EQ(std::memcmp(&got.recognized_distance, &want.recognized_distance, sizeof(float)), 0) << where;
+  EXPECT_EQ(got.other_object_state, want.other_object_state) << where;
+  EXPECT_EQ(std::memcmp(&got.other_object_distance, &want.other_object_distance, sizeof(float)), 0) << where;
 }
 
 }  // namespace hadynet::usb::testing

@@ -4,11 +4,11 @@
 // their bit patterns, so every comparison is exact (tolerance zero), -0.0
 // and NaN payloads included.
 //
-// Version 2: the payload is the link's 0x88 period result (an
-// app::PeriodRecord with its kRecord* flags). For the hand's model
-// (kLoadcells 9, kY 27, kU 8) that is 23 + 4 (9 + 1 + 27 + 8) = 203 bytes,
-// so a set has 4 reports (56, 56, 56, 35 payload bytes) where version 1 had
-// 3 (152 bytes); the expectations below are the old ones with these sizes.
+// Version 3: the payload is the link's 0x88 period result (an
+// app::PeriodRecord with its kRecord* flags) with the on-device
+// adaptation's count and recognition. For the hand's model (kLoadcells 9,
+// kY 27, kU 8) that is 23 + 4 (9 + 1 + 27 + 8) + 16 = 219 bytes, so a set has
+// 4 reports (56, 56, 56, 51 payload bytes), as version 2 (203 bytes) had.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -51,6 +51,12 @@ app::PeriodRecord<Q> sample_record(std::uint32_t sequence) {
   r.command[0] = -0.0f;                                 // a sign bit only the bit pattern keeps
   r.prediction[5] = std::bit_cast<float>(0x7FC12345u);  // NaN payloads only the bit pattern keeps
   r.loadcells_N[8] = std::bit_cast<float>(0xFFC00001u);
+  r.flags |= app::kRecordRecognition;
+  r.adapt_updates = 0x11223344u;
+  r.recognized_state = 3;
+  r.recognized_distance = 0.375f;
+  r.other_object_state = app::kRecordNoOtherObject;
+  r.other_object_distance = 0.0f;
   return r;
 }
 
@@ -76,14 +82,14 @@ Bytes payload_of(const std::array<std::uint8_t, kSet>& reports) {
 }
 
 TEST(UsbTelemetry, TheHandsModelNeedsFourReports) {
-  // kLoadcells 9, kY 27, kU 8: 23 + 4 * (9 + 1 + 27 + 8) = 203 payload
-  // bytes, 56 per report.
+  // kLoadcells 9, kY 27, kU 8: 23 + 4 * (9 + 1 + 27 + 8) + 16 = 219
+  // payload bytes, 56 per report.
   EXPECT_EQ(kLc, 9);
   EXPECT_EQ(Q::kY, 27);
   EXPECT_EQ(Q::kU, 8);
-  EXPECT_EQ(L::kPayloadSize, 203u);
+  EXPECT_EQ(L::kPayloadSize, 219u);
   EXPECT_EQ(L::kParts, 4u);
-  EXPECT_EQ(kTelemetryFormatVersion, 2);
+  EXPECT_EQ(kTelemetryFormatVersion, 3);
 }
 
 TEST(UsbTelemetry, ReportBytesFollowTheDocumentedLayout) {
@@ -91,7 +97,9 @@ TEST(UsbTelemetry, ReportBytesFollowTheDocumentedLayout) {
   // The payload assembled by hand, docs/usb.md = docs/protocol.md 0x88:
   // sequence u32, period u32, mode u8, flags u16, muscle_state_age u32,
   // overruns u32, missed_periods u32, loadcells[kLoadcells] f32, d f32,
-  // prediction[kY] f32, command[kU] f32, little-endian, no padding.
+  // prediction[kY] f32, command[kU] f32, adapt_updates u32,
+  // recognized_state u16, recognized_distance f32, other_object_state u16,
+  // other_object_distance f32, little-endian, no padding.
   Bytes payload;
   put32(payload, r.sequence);
   put32(payload, r.period);
@@ -105,9 +113,16 @@ TEST(UsbTelemetry, ReportBytesFollowTheDocumentedLayout) {
   putf(payload, r.d);
   for (const float v : r.prediction) putf(payload, v);
   for (const float v : r.command) putf(payload, v);
-  ASSERT_EQ(payload.size(), 203u);
+  put32(payload, r.adapt_updates);
+  payload.push_back(static_cast<std::uint8_t>(r.recognized_state));
+  payload.push_back(static_cast<std::uint8_t>(r.recognized_state >> 8));
+  putf(payload, r.recognized_distance);
+  payload.push_back(static_cast<std::uint8_t>(r.other_object_state));
+  payload.push_back(static_cast<std::uint8_t>(r.other_object_state >> 8));
+  putf(payload, r.other_object_distance);
+  ASSERT_EQ(payload.size(), 219u);
   // The documented offsets of the hand's model.
-  EXPECT_EQ((Bytes{payload[8], payload[9], payload[10]}), (Bytes{0x02, 0x3F, 0x01})) << "mode 8, flags 9 (0x013F)";
+  EXPECT_EQ((Bytes{payload[8], payload[9], payload[10]}), (Bytes{0x02, 0x3F, 0x03})) << "mode 8, flags 9 (0x033F)";
   EXPECT_EQ((Bytes{payload[15], payload[16], payload[17], payload[18]}), (Bytes{0x0D, 0x0C, 0x0B, 0x0A}))
       << "overruns at 15";
   EXPECT_EQ(std::bit_cast<float>(static_cast<std::uint32_t>(payload[59] | payload[60] << 8 | payload[61] << 16 |
@@ -116,12 +131,16 @@ TEST(UsbTelemetry, ReportBytesFollowTheDocumentedLayout) {
       << "d at 59";
   EXPECT_EQ((Bytes{payload[171], payload[172], payload[173], payload[174]}), (Bytes{0, 0, 0, 0x80}))
       << "command[0] = -0.0 at 171";
+  EXPECT_EQ((Bytes{payload[203], payload[204], payload[205], payload[206], payload[207], payload[208]}),
+            (Bytes{0x44, 0x33, 0x22, 0x11, 0x03, 0x00}))
+      << "adapt_updates at 203, recognized_state at 207";
+  EXPECT_EQ((Bytes{payload[213], payload[214]}), (Bytes{0xFF, 0xFF})) << "other_object_state (none) at 213";
 
   const auto reports = encode(r);
-  const std::size_t lengths[4] = {56, 56, 56, 35};
+  const std::size_t lengths[4] = {56, 56, 56, 51};
   for (std::size_t part = 0; part < 4; ++part) {
     const std::uint8_t* rep = reports.data() + 64 * part;
-    EXPECT_EQ(rep[0], 2) << "format version";
+    EXPECT_EQ(rep[0], 3) << "format version";
     EXPECT_EQ(rep[1], part);
     EXPECT_EQ(rep[2], 4);
     EXPECT_EQ(rep[3], lengths[part]);
@@ -208,7 +227,7 @@ TEST(UsbTelemetry, DecoderRejectsMalformedReportsAndOutOfOrderParts) {
 }
 
 // A whole set whose payload decode_period_result refuses (unknown mode,
-// unknown flag bit) or whose payload sequence is not the header's is not
+// unknown flag bit, a recognized state beyond the PB table) or whose payload sequence is not the header's is not
 // delivered; its sequence number counts as dropped once a later one arrives.
 TEST(UsbTelemetry, DecoderRefusesASetWhosePayloadDoesNotDecode) {
   Decoder dec;
@@ -222,15 +241,18 @@ TEST(UsbTelemetry, DecoderRefusesASetWhosePayloadDoesNotDecode) {
   bad_mode[8 + 8] = 3;  // payload offset 8: mode
   EXPECT_EQ(feed(bad_mode), Decoder::Event::kBadReport);
   auto bad_flags = encode(sample_record(3));
-  bad_flags[8 + 10] |= 0x02;  // payload offset 9..10: flags bit 9
+  bad_flags[8 + 10] |= 0x04;  // payload offset 9..10: flags bit 10
   EXPECT_EQ(feed(bad_flags), Decoder::Event::kBadReport);
+  auto bad_state = encode(sample_record(3));
+  bad_state[3 * 64 + 8 + (207 - 3 * 56)] = static_cast<std::uint8_t>(Q::kStates);  // payload 207: recognized state
+  EXPECT_EQ(feed(bad_state), Decoder::Event::kBadReport);
   auto bad_sequence = encode(sample_record(4));
   bad_sequence[8 + 0] ^= 1;  // payload sequence 5, header 4
   EXPECT_EQ(feed(bad_sequence), Decoder::Event::kBadReport);
   EXPECT_EQ(dec.record().sequence, 1u) << "the last delivered record stays";
   ASSERT_EQ(feed(encode(sample_record(5))), Decoder::Event::kRecord);
   expect_same_bits<Q>(dec.record(), sample_record(5));
-  EXPECT_EQ(dec.stats().bad_payloads, 3u);
+  EXPECT_EQ(dec.stats().bad_payloads, 4u);
   EXPECT_EQ(dec.stats().bad_reports, 0u);
   EXPECT_EQ(dec.stats().dropped, 3u) << "2, 3 and 4 never delivered";
   EXPECT_EQ(dec.stats().records, 2u);

@@ -97,6 +97,13 @@ void expect_row(const datalog::LogTable& t, std::size_t row, std::uint32_t seque
   for (int i = 0; i < Q::kU; ++i) {
     EXPECT_EQ(static_cast<float>(col(std::string("aux_cmd_") + Q::kUNames[i])), want.command[i]) << "u " << i;
   }
+  EXPECT_EQ(col("aux_adapt_updates"), static_cast<double>(want.adapt_updates));
+  EXPECT_EQ(col("aux_recognized_state"), static_cast<double>(want.recognized_state));
+  EXPECT_EQ(static_cast<float>(col("aux_recognized_distance")), want.recognized_distance);
+  EXPECT_EQ(col("aux_other_object_state"), want.other_object_state == app::kRecordNoOtherObject
+                                               ? -1.0
+                                               : static_cast<double>(want.other_object_state));
+  EXPECT_EQ(static_cast<float>(col("aux_other_object_distance")), want.other_object_distance);
 }
 
 class CliMonitor : public ::testing::Test {

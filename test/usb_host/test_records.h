@@ -38,6 +38,14 @@ inline app::PeriodRecord<Q> record(std::uint32_t sequence) {
   if (r.has(app::kRecordCommandValid)) {
     for (int i = 0; i < Q::kU; ++i) r.command[i] = -float(i) * 0.125f;
   }
+  if (sequence % 3 != 0) {  // on-device recognition in two records of three
+    r.flags |= app::kRecordRecognition;
+    r.adapt_updates = sequence;
+    r.recognized_state = static_cast<std::uint16_t>(sequence % Q::kStates);
+    r.recognized_distance = 0.0625f * float(sequence);
+    r.other_object_state = sequence % 3 == 1 ? app::kRecordNoOtherObject : std::uint16_t{0};
+    r.other_object_distance = sequence % 3 == 1 ? 0.0f : 1.5f;
+  }
   return r;
 }
 
@@ -53,6 +61,11 @@ inline void expect_same_bits(const app::PeriodRecord<Q>& got, const app::PeriodR
   EXPECT_EQ(std::memcmp(&got.d, &want.d, sizeof want.d), 0);
   EXPECT_EQ(std::memcmp(got.prediction, want.prediction, sizeof want.prediction), 0);
   EXPECT_EQ(std::memcmp(got.command, want.command, sizeof want.command), 0);
+  EXPECT_EQ(got.adapt_updates, want.adapt_updates);
+  EXPECT_EQ(got.recognized_state, want.recognized_state);
+  EXPECT_EQ(std::memcmp(&got.recognized_distance, &want.recognized_distance, sizeof(float)), 0);
+  EXPECT_EQ(got.other_object_state, want.other_object_state);
+  EXPECT_EQ(std::memcmp(&got.other_object_distance, &want.other_object_distance, sizeof(float)), 0);
 }
 
 // The same record with prediction[0] finite (a HADYNET log cannot hold a

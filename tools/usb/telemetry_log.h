@@ -12,6 +12,12 @@
 //   aux_flags              the record's flag bits (firmware/app/period_record.h)
 //   aux_pred_<y name>      the model's prediction y_est_t, log units
 //   aux_cmd_<u name>       the stabiliser's command u_t, log units
+//   aux_adapt_updates      PB updates of the on-device adaptation (0: off)
+//   aux_recognized_state   the adapted PB's nearest PB-table row (the model's
+//                          state names index it), with the flag kRecordRecognition
+//   aux_recognized_distance  its distance, standardised PB units
+//   aux_other_object_state   the nearest row naming another object (-1: none)
+//   aux_other_object_distance  its distance
 // Fields a record does not hold (no prediction, no command) are written as 0
 // with the flag bit saying so, never invented otherwise.
 //
@@ -58,6 +64,11 @@ class TelemetryLog {
     row.push_back(static_cast<double>(r.flags));
     for (int i = 0; i < M::kY; ++i) row.push_back(r.prediction[i]);
     for (int i = 0; i < M::kU; ++i) row.push_back(r.command[i]);
+    row.push_back(static_cast<double>(r.adapt_updates));
+    row.push_back(static_cast<double>(r.recognized_state));
+    row.push_back(r.recognized_distance);
+    row.push_back(r.other_object_state == app::kRecordNoOtherObject ? -1.0 : static_cast<double>(r.other_object_state));
+    row.push_back(r.other_object_distance);
     for (const double v : row) {
       if (!std::isfinite(v)) {
         ++skipped_;
@@ -83,6 +94,8 @@ class TelemetryLog {
       c.insert(c.end(), {"aux_d", "aux_contact", "aux_mode", "aux_flags"});
       for (int i = 0; i < M::kY; ++i) c.push_back(std::string("aux_pred_") + M::kYNames[i]);
       for (int i = 0; i < M::kU; ++i) c.push_back(std::string("aux_cmd_") + M::kUNames[i]);
+      c.insert(c.end(), {"aux_adapt_updates", "aux_recognized_state", "aux_recognized_distance",
+                         "aux_other_object_state", "aux_other_object_distance"});
       return c;
     }();
     return names;
