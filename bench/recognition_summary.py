@@ -4,12 +4,13 @@
 the margin of each grasp (distance to the nearest wrong object over distance
 to the right one: > 1 right, < 1 wrong), how well `hadynet recognize`'s
 confidence word separates right from wrong (a recognition is "clear" when the
-nearest other object is at least CLEAR times as far as the recognised one;
-trainer/recognition.h) and where the objects the model never saw land (their
-two nearest known objects).
+nearest other object is at least CLEAR times as far as the recognised one, in
+the metric `hadynet recognize` used; trainer/recognition.h) and where the
+objects the model never saw land (their two nearest known objects).
 
 Usage: bench/recognition_summary.py [--clear-margin CLEAR] RECOGNIZE.json...
-  (CLEAR default 1.25, trainer::kClearRecognitionMargin)
+  (without --clear-margin: the confidence word each file holds, from
+  `hadynet recognize`'s clear margin for its metric)
 """
 import json
 import statistics
@@ -21,7 +22,7 @@ def main(args):
     if not args or args[0] in ("-h", "--help"):
         print(__doc__.strip())
         return 0 if args else 2
-    clear_margin = 1.25
+    clear_margin = None
     if args[0] == "--clear-margin":
         clear_margin = float(args[1])
         args = args[2:]
@@ -47,7 +48,8 @@ def main(args):
             all_right &= right
             d0 = by_distance[0]["distance"]
             margin = by_distance[1]["distance"] / d0 if len(by_distance) > 1 and d0 > 0 else float("inf")
-            flagged[right][0] += margin < clear_margin
+            ambiguous = r["confidence"] == "ambiguous" if clear_margin is None else margin < clear_margin
+            flagged[right][0] += ambiguous
             flagged[right][1] += 1
             per_object[r["object"]][0] += right
             per_object[r["object"]][1] += 1
@@ -72,7 +74,8 @@ def main(args):
     print(f"{'all':<10} {right:>4} of {total:<4} {all_m[0]:>12.2f} "
           f"{all_m[max(0, int(0.1 * len(all_m)) - 1)]:>6.2f} {statistics.median(all_m):>7.2f}")
     print()
-    print(f"confidence word (clear from margin {clear_margin}): "
+    source = "as hadynet recognize said" if clear_margin is None else f"clear from margin {clear_margin}"
+    print(f"confidence word ({source}): "
           f"{flagged[False][0]} of {flagged[False][1]} wrong recognitions called ambiguous; "
           f"{flagged[True][0]} of {flagged[True][1]} right ones called ambiguous "
           f"({100.0 * flagged[True][0] / max(1, flagged[True][1]):.0f} %)")

@@ -7,7 +7,8 @@
 # For each zeroing it records the six trained objects' grasps (both motions,
 # 500 rows: the paper's lengths) and Cylinder-L's, then `hadynet recognize`
 # adapts one PB per grasp (as the paper: PB only, 20 full-batch epochs) and
-# names the nearest trained PB's object. bench/recognition_summary.py prints
+# names the object (its default metric, docs/trainer.md; RECOGNIZE_ARGS="--metric
+# nearest-state" for the paper's rule). bench/recognition_summary.py prints
 # the accuracy per object, the confusion matrix, the margin (distance to the
 # nearest wrong object over distance to the right one; < 1 is a miss) and
 # where Cylinder-L lands (between Cylinder and Gripper or not).

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -25,20 +26,28 @@ namespace hadynet::cli {
 
 int run_recognize(int argc, char** argv) {
   Options opt("recognize",
-              "Recognises the grasped object: adapts one PB per dynamics state of the logs (as `adapt`), finds\n"
-              "the nearest trained PB (Euclidean) and reports that state's object, with its margin (distance\n"
-              "to the nearest other object over distance to the recognised one) and a confidence word: clear\n"
-              "from --clear-margin on, else ambiguous. When the logs name their object (metadata 'object')\n"
-              "the accuracy is printed; objects the model never saw are listed with the two nearest known\n"
-              "objects. --plot draws the PB map (ambiguous points marked '?').",
+              "Recognises the grasped object: adapts one PB per dynamics state of the logs (as `adapt`) and\n"
+              "names the nearest object in the --metric: within-object (default; the distance to each\n"
+              "object's mean trained PB measured against how the object's trained PBs spread over zeroings)\n"
+              "or nearest-state (Euclidean distance to the nearest trained PB, the paper's rule). It reports\n"
+              "the nearest trained state too, the margin (distance to the nearest other object over distance\n"
+              "to the recognised one) and a confidence word: clear from --clear-margin on, else ambiguous.\n"
+              "When the logs name their object (metadata 'object') the accuracy is printed; objects the\n"
+              "model never saw are listed with the two nearest known objects. --plot draws the PB map\n"
+              "(ambiguous points marked '?').",
               "MODEL LOG|DIR... [options]");
   add_adapt_options(opt);
   opt.value("plot", "PNG", "draw the PB map (PCA of the trained PBs) with the adapted PBs marked");
   opt.value("json", "FILE", "write the results as JSON");
+  opt.value("metric", "M",
+            "within-object or nearest-state (docs/trainer.md, \"Recognition over many zeroings\")",
+            trainer::metric_name(trainer::kDefaultRecognitionMetric));
   opt.value("clear-margin", "M",
             "margin (distance to the nearest other object / to the recognised one) from which a\n"
-            "recognition is called clear, below it ambiguous (chosen on validation zeroings; docs/trainer.md)",
-            datalog::rules::format_number(trainer::kClearRecognitionMargin));
+            "recognition is called clear, below it ambiguous (chosen on validation zeroings; docs/trainer.md;\n"
+            "default " +
+                datalog::rules::format_number(trainer::kClearWithinObjectMargin) + " within-object, " +
+                datalog::rules::format_number(trainer::kClearRecognitionMargin) + " nearest-state)");
   if (!opt.parse(argc, argv)) return 2;
   if (opt.help_requested()) return 0;
   if (opt.positional().size() < 2) {
@@ -46,7 +55,14 @@ int run_recognize(int argc, char** argv) {
     return 2;
   }
   const auto adapt = adapt_options(opt);
-  const auto clear_margin = opt.get_double("clear-margin", 1.0, 1e6);
+  trainer::RecognitionMetric metric{};
+  if (!trainer::parse_recognition_metric(opt.get("metric"), metric)) {
+    std::fprintf(stderr, "hadynet recognize: --metric: '%s' is not within-object or nearest-state\n",
+                 opt.get("metric").c_str());
+    return 2;
+  }
+  std::optional<double> clear_margin = trainer::default_clear_margin(metric);
+  if (opt.has("clear-margin")) clear_margin = opt.get_double("clear-margin", 1.0, 1e6);
   if (!clear_margin) return 2;
   if (!adapt) return 2;
   try {
@@ -59,10 +75,15 @@ int run_recognize(int argc, char** argv) {
     std::printf("%-22s %-11s %-11s %-22s %8s %6s %-9s  %s\n", "state", "true", "recognised", "nearest state",
                 "distance", "margin", "", "next objects (distance)");
     int known = 0, correct = 0;
+    bool said_fallback = false;
     std::vector<MarkedPb> marked;
     nlohmann::json results = nlohmann::json::array();
     for (const AdaptedState& a : adapted) {
-      const trainer::Recognition rec = trainer::recognize_object(model, a.result.pb, *clear_margin);
+      const trainer::Recognition rec = trainer::recognize_object(model, a.result.pb, *clear_margin, metric);
+      if (rec.metric != metric && !said_fallback) {
+        std::printf("(no object has two trained PBs, so no within-object spread: nearest-state distances)\n");
+        said_fallback = true;
+      }
       const trainer::NearestPb& nn = rec.nearest;
       const trainer::PbState& hit = model.states[static_cast<std::size_t>(nn.state)];
       const auto& objects = rec.objects_by_distance;
@@ -80,20 +101,21 @@ int run_recognize(int argc, char** argv) {
       const char* verdict = "";
       if (object_known && !a.object.empty()) {
         ++known;
-        if (hit.object == a.object) ++correct;
-        verdict = hit.object == a.object ? "" : "  WRONG";
+        if (rec.object == a.object) ++correct;
+        verdict = rec.object == a.object ? "" : "  WRONG";
       } else {
         verdict = "  (object not in the model)";
       }
       std::printf("%-22s %-11s %-11s %-22s %8.3f %6.2f %-9s  %s%s\n", a.state.c_str(), a.object.c_str(),
-                  hit.object.c_str(), hit.name.c_str(), nn.distance, rec.margin, confidence, next.c_str(), verdict);
+                  rec.object.c_str(), hit.name.c_str(), nn.distance, rec.margin, confidence, next.c_str(), verdict);
       marked.push_back({(a.object.empty() ? a.state : a.object + " (" + a.state + ")") + (rec.clear ? "" : " ?"),
                         a.result.pb});
       nlohmann::json nearest = nlohmann::json::array();
       for (const auto& [object, dist] : objects) nearest.push_back({{"object", object}, {"distance", dist}});
       results.push_back({{"state", a.state},
                          {"object", a.object},
-                         {"recognised", hit.object},
+                         {"recognised", rec.object},
+                         {"metric", trainer::metric_name(rec.metric)},
                          {"nearest_state", hit.name},
                          {"distance", nn.distance},
                          {"margin", std::isfinite(rec.margin) ? nlohmann::json(rec.margin) : nlohmann::json(nullptr)},

@@ -1,7 +1,9 @@
 #include "trainer/recognition.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <stdexcept>
 
@@ -24,19 +26,94 @@ NearestPb nearest_pb(const HadynetModel& model, const Eigen::VectorXf& pb) {
   return best;
 }
 
-Recognition recognize_object(const HadynetModel& model, const Eigen::VectorXf& pb, double clear_margin) {
-  Recognition r;
-  r.nearest = nearest_pb(model, pb);
-  r.object = model.states[static_cast<std::size_t>(r.nearest.state)].object;
-  std::map<std::string, double> best;
+const char* metric_name(RecognitionMetric metric) {
+  return metric == RecognitionMetric::kWithinObject ? "within-object" : "nearest-state";
+}
+
+bool parse_recognition_metric(const std::string& text, RecognitionMetric& metric) {
+  if (text == "nearest-state") {
+    metric = RecognitionMetric::kNearestState;
+  } else if (text == "within-object") {
+    metric = RecognitionMetric::kWithinObject;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+double default_clear_margin(RecognitionMetric metric) {
+  return metric == RecognitionMetric::kWithinObject ? kClearWithinObjectMargin : kClearRecognitionMargin;
+}
+
+namespace {
+
+// Each object's distance to pb in the within-object metric, in the order of
+// the objects' first states; empty when no object has two trained PBs.
+std::vector<std::pair<std::string, double>> within_object_distances(const HadynetModel& model,
+                                                                    const Eigen::VectorXd& pb) {
+  const RowMatrix<float>& table = model.params.pb;
+  std::vector<std::string> objects;
+  std::map<std::string, std::pair<Eigen::VectorXd, int>> sums;
   for (std::size_t k = 0; k < model.states.size(); ++k) {
     const std::string& object = model.states[k].object;
-    const auto it = best.find(object);
-    if (it == best.end() || r.nearest.distances[k] < it->second) best[object] = r.nearest.distances[k];
+    auto [it, inserted] = sums.emplace(object, std::make_pair(Eigen::VectorXd::Zero(table.cols()), 0));
+    if (inserted) objects.push_back(object);
+    it->second.first += table.row(static_cast<Eigen::Index>(k)).transpose().cast<double>();
+    ++it->second.second;
   }
-  r.objects_by_distance.assign(best.begin(), best.end());
+  const Eigen::Index dof = table.rows() - static_cast<Eigen::Index>(objects.size());
+  if (dof < 1) return {};
+  // Pooled within-object covariance, then shrunk toward its mean variance.
+  Eigen::MatrixXd within = Eigen::MatrixXd::Zero(table.cols(), table.cols());
+  for (std::size_t k = 0; k < model.states.size(); ++k) {
+    const auto& [sum, n] = sums.at(model.states[k].object);
+    const Eigen::VectorXd d = table.row(static_cast<Eigen::Index>(k)).transpose().cast<double>() - sum / n;
+    within += d * d.transpose();
+  }
+  within /= static_cast<double>(dof);
+  const double s = kWithinObjectShrinkage;
+  const double mean_variance = within.trace() / static_cast<double>(within.rows());
+  if (!(mean_variance > 0)) return {};  // every object's PBs coincide: no spread to measure
+  const Eigen::MatrixXd shrunk =
+      (1 - s) * within + s * mean_variance * Eigen::MatrixXd::Identity(within.rows(), within.cols());
+  const Eigen::LLT<Eigen::MatrixXd> llt(shrunk);  // positive definite: s > 0 and mean_variance > 0
+  std::vector<std::pair<std::string, double>> out;
+  for (const std::string& object : objects) {
+    const auto& [sum, n] = sums.at(object);
+    const Eigen::VectorXd d = pb - sum / n;
+    out.emplace_back(object, std::sqrt(std::max(0.0, d.dot(llt.solve(d)))));
+  }
+  return out;
+}
+
+}  // namespace
+
+Recognition recognize_object(const HadynetModel& model, const Eigen::VectorXf& pb, double clear_margin,
+                             RecognitionMetric metric) {
+  Recognition r;
+  r.nearest = nearest_pb(model, pb);
+  if (metric == RecognitionMetric::kWithinObject) {
+    r.objects_by_distance = within_object_distances(model, pb.cast<double>());
+  }
+  if (!r.objects_by_distance.empty()) {
+    r.metric = RecognitionMetric::kWithinObject;
+  } else {
+    r.metric = RecognitionMetric::kNearestState;
+    std::map<std::string, double> best;
+    for (std::size_t k = 0; k < model.states.size(); ++k) {
+      const std::string& object = model.states[k].object;
+      const auto it = best.find(object);
+      if (it == best.end() || r.nearest.distances[k] < it->second) best[object] = r.nearest.distances[k];
+    }
+    r.objects_by_distance.assign(best.begin(), best.end());
+  }
   std::stable_sort(r.objects_by_distance.begin(), r.objects_by_distance.end(),
                    [](const auto& a, const auto& b) { return a.second < b.second; });
+  // Nearest state: its object (the paper's rule; first among equal
+  // distances); within-object: the nearest object mean.
+  r.object = r.metric == RecognitionMetric::kNearestState
+                 ? model.states[static_cast<std::size_t>(r.nearest.state)].object
+                 : r.objects_by_distance.front().first;
   if (r.objects_by_distance.size() < 2) {
     r.margin = std::numeric_limits<double>::infinity();
   } else {
@@ -45,6 +122,10 @@ Recognition recognize_object(const HadynetModel& model, const Eigen::VectorXf& p
   }
   r.clear = r.margin >= clear_margin;
   return r;
+}
+
+Recognition recognize_object(const HadynetModel& model, const Eigen::VectorXf& pb) {
+  return recognize_object(model, pb, default_clear_margin(kDefaultRecognitionMetric), kDefaultRecognitionMetric);
 }
 
 std::vector<Eigen::VectorXf> object_mean_pbs(const HadynetModel& model) {

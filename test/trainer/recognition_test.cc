@@ -1,5 +1,6 @@
 // Object recognition from the PB (trainer/recognition.h): nearest trained
-// PB and the PCA map with deterministic axis signs.
+// PB, the two recognition metrics and the PCA map with deterministic axis
+// signs.
 #include "trainer/recognition.h"
 
 #include <gtest/gtest.h>
@@ -63,7 +64,9 @@ TEST(RecognizeObject, MarginOverTheNearestOtherObject) {
   HadynetModel m = model_with_pbs(pbs);
   m.states = {{"Ball/i0", "Ball"}, {"Ball/i1", "Ball"}, {"Hammer/i0", "Hammer"}, {"None/i0", "None"}};
   // Near the second Ball PB: 0.25 from it, sqrt(0.75^2 + 2^2) from Hammer.
-  const Recognition r = recognize_object(m, Eigen::Vector2f(0.75f, 0.0f));
+  const Recognition r =
+      recognize_object(m, Eigen::Vector2f(0.75f, 0.0f), kClearRecognitionMargin, RecognitionMetric::kNearestState);
+  EXPECT_EQ(r.metric, RecognitionMetric::kNearestState);
   EXPECT_EQ(r.object, "Ball");
   EXPECT_EQ(r.nearest.state, 1);
   ASSERT_EQ(r.objects_by_distance.size(), 3u);
@@ -74,11 +77,72 @@ TEST(RecognizeObject, MarginOverTheNearestOtherObject) {
   EXPECT_NEAR(r.margin, std::hypot(0.75, 2.0) / 0.25, 1e-12);
   EXPECT_TRUE(r.clear);
   // Half-way between Ball and Hammer (0, 1): both at distance 1, margin 1.
-  const Recognition tie = recognize_object(m, Eigen::Vector2f(0.0f, 1.0f));
+  const auto nearest_state = [&](float a, float b, double clear = kClearRecognitionMargin) {
+    return recognize_object(m, Eigen::Vector2f(a, b), clear, RecognitionMetric::kNearestState);
+  };
+  const Recognition tie = nearest_state(0.0f, 1.0f);
   EXPECT_NEAR(tie.margin, 1.0, 1e-12);
   EXPECT_FALSE(tie.clear) << "margin 1 < the clear margin";
-  EXPECT_TRUE(recognize_object(m, Eigen::Vector2f(0.0f, 1.0f), 1.0).clear) << "clear from the margin given on";
-  EXPECT_TRUE(std::isinf(recognize_object(m, Eigen::Vector2f(1.0f, 0.0f)).margin)) << "on a trained PB";
+  EXPECT_TRUE(nearest_state(0.0f, 1.0f, 1.0).clear) << "clear from the margin given on";
+  EXPECT_TRUE(std::isinf(nearest_state(1.0f, 0.0f).margin)) << "on a trained PB";
+}
+
+// The within-object metric: A's two trained PBs lie far apart along x (two
+// zeroings moved its PB along x), B's close together, 1.5 above. A query at
+// (0, 0.625) sits at A's mean, 3.06 from A's trained PBs but 0.875 from
+// B's: the paper's rule names B, the within-object metric A, because along
+// x the objects' PBs spread with re-zeroing and along y they do not.
+TEST(RecognizeObject, WithinObjectMetricDiscountsTheZeroingSpread) {
+  RowMatrix<float> pbs(4, 2);
+  pbs << -3.0f, 0.0f,  // A, zeroing 0
+      3.0f, 0.0f,      // A, zeroing 1
+      0.0f, 1.5f,      // B, zeroing 0
+      0.5f, 1.5f;      // B, zeroing 1
+  HadynetModel m = model_with_pbs(pbs);
+  m.states = {{"A/i0", "A"}, {"A/i1", "A"}, {"B/i0", "B"}, {"B/i1", "B"}};
+  const Eigen::Vector2f query(0.0f, 0.625f);
+  EXPECT_EQ(recognize_object(m, query, 1.0, RecognitionMetric::kNearestState).object, "B");
+  const Recognition r = recognize_object(m, query, 1.0, RecognitionMetric::kWithinObject);
+  EXPECT_EQ(r.metric, RecognitionMetric::kWithinObject);
+  EXPECT_EQ(r.object, "A");
+  EXPECT_EQ(r.nearest.state, 2) << "the nearest trained PB is still reported (Euclidean)";
+  // By hand: object means (0, 0) and (0.25, 1.5); pooled within-object
+  // covariance over 4 - 2 = 2 degrees of freedom diag((9 + 9 + 1/16 + 1/16) / 2, 0)
+  // = diag(9.0625, 0); shrunk by s toward the mean variance 4.53125.
+  const double s = kWithinObjectShrinkage, mean_variance = 9.0625 / 2;
+  const double vx = (1 - s) * 9.0625 + s * mean_variance, vy = s * mean_variance;
+  const double to_a = std::sqrt(0.625 * 0.625 / vy);
+  const double to_b = std::sqrt(0.25 * 0.25 / vx + 0.875 * 0.875 / vy);
+  ASSERT_EQ(r.objects_by_distance.size(), 2u);
+  // Dyadic inputs, a 2x2 Cholesky solve in double: 1e-12.
+  EXPECT_NEAR(r.objects_by_distance[0].second, to_a, 1e-12);
+  EXPECT_NEAR(r.objects_by_distance[1].second, to_b, 1e-12);
+  EXPECT_NEAR(r.margin, to_b / to_a, 1e-12);
+  EXPECT_EQ(r.clear, r.margin >= 1.0);
+  // The default is this metric with its clear margin.
+  const Recognition d = recognize_object(m, query);
+  EXPECT_EQ(d.metric, kDefaultRecognitionMetric);
+  EXPECT_EQ(d.clear, d.margin >= default_clear_margin(kDefaultRecognitionMetric));
+}
+
+// With one trained PB per object there is no within-object spread: the
+// within-object metric falls back to the nearest state and says so.
+TEST(RecognizeObject, WithoutASpreadTheWithinObjectMetricFallsBackToTheNearestState) {
+  RowMatrix<float> pbs(2, 2);
+  pbs << 0.0f, 0.0f,  //
+      2.0f, 0.0f;
+  HadynetModel m = model_with_pbs(pbs);
+  m.states = {{"A/i0", "A"}, {"B/i0", "B"}};
+  const Recognition r = recognize_object(m, Eigen::Vector2f(0.5f, 0.0f), 1.0, RecognitionMetric::kWithinObject);
+  EXPECT_EQ(r.metric, RecognitionMetric::kNearestState);
+  EXPECT_EQ(r.object, "A");
+  EXPECT_NEAR(r.margin, 1.5 / 0.5, 1e-12);
+  RecognitionMetric parsed{};
+  EXPECT_TRUE(parse_recognition_metric("within-object", parsed));
+  EXPECT_EQ(parsed, RecognitionMetric::kWithinObject);
+  EXPECT_TRUE(parse_recognition_metric(metric_name(RecognitionMetric::kNearestState), parsed));
+  EXPECT_EQ(parsed, RecognitionMetric::kNearestState);
+  EXPECT_FALSE(parse_recognition_metric("mahalanobis", parsed));
 }
 
 // Points c + s a + o b for s = -2..2 along a unit direction a, with small
