@@ -193,10 +193,13 @@ int run_monitor(int argc, char** argv) {
   Options opt("monitor",
               "Reads the firmware's HID telemetry over USB (hidapi, libusb backend): prints one line per\n"
               "control period (period, sequence, mode, d, contact, |u|, flags: stale/no-muscle-state/\n"
-              "no-loadcells/overrun), counts dropped periods from the sequence numbers, and ends on Ctrl-C\n"
-              "or after --duration with a summary. --csv writes the stream as HADYNET logs (loadcells,\n"
-              "aux_d, aux_contact, aux_mode, aux_flags, aux_pred_*, aux_cmd_*); a gap in the stream starts\n"
-              "a new log (OUT-2.csv, ...), since a log's time axis is regular.",
+              "no-loadcells/overrun; with on-device PB adaptation the recognised object and the nearest\n"
+              "other one with their distances), counts dropped periods from the sequence numbers, and ends\n"
+              "on Ctrl-C or after --duration with a summary. --csv writes the stream as HADYNET logs\n"
+              "(loadcells, aux_d, aux_contact, aux_mode, aux_flags, aux_pred_*, aux_cmd_*, aux_adapt_updates,\n"
+              "aux_recognized_state, aux_recognized_distance, aux_other_object_state (-1: none),\n"
+              "aux_other_object_distance); a gap in the stream starts a new log (OUT-2.csv, ...), since a\n"
+              "log's time axis is regular.",
               "[--serial S] [--csv OUT] [--plot PNG] [--duration S]");
   opt.value("serial", "S", "the hand's serial number (see hadynet devices); needed if several are attached");
   opt.value("csv", "OUT", "write the stream as HADYNET log(s)");
