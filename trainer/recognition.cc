@@ -47,27 +47,51 @@ double default_clear_margin(RecognitionMetric metric) {
 
 namespace {
 
+// Each object's mean trained PB (double), objects in the order of their
+// first state: the within-object metric's centres and the multi-start
+// adaptation's starts (object_mean_pbs).
+struct ObjectMeans {
+  std::vector<std::string> objects;
+  std::vector<Eigen::VectorXd> means;
+  const Eigen::VectorXd& mean_of(const std::string& object) const {
+    return means[static_cast<std::size_t>(std::find(objects.begin(), objects.end(), object) - objects.begin())];
+  }
+};
+
+ObjectMeans object_means(const HadynetModel& model) {
+  ObjectMeans out;
+  std::vector<int> counts;
+  for (std::size_t k = 0; k < model.states.size(); ++k) {
+    const std::string& object = model.states[k].object;
+    const Eigen::VectorXd pb = model.params.pb.row(static_cast<Eigen::Index>(k)).transpose().cast<double>();
+    const auto it = std::find(out.objects.begin(), out.objects.end(), object);
+    if (it == out.objects.end()) {
+      out.objects.push_back(object);
+      out.means.push_back(pb);
+      counts.push_back(1);
+    } else {
+      const auto i = static_cast<std::size_t>(it - out.objects.begin());
+      out.means[i] += pb;
+      ++counts[i];
+    }
+  }
+  for (std::size_t i = 0; i < out.means.size(); ++i) out.means[i] /= static_cast<double>(counts[i]);
+  return out;
+}
+
 // Each object's distance to pb in the within-object metric, in the order of
 // the objects' first states; empty when no object has two trained PBs.
 std::vector<std::pair<std::string, double>> within_object_distances(const HadynetModel& model,
                                                                     const Eigen::VectorXd& pb) {
   const RowMatrix<float>& table = model.params.pb;
-  std::vector<std::string> objects;
-  std::map<std::string, std::pair<Eigen::VectorXd, int>> sums;
-  for (std::size_t k = 0; k < model.states.size(); ++k) {
-    const std::string& object = model.states[k].object;
-    auto [it, inserted] = sums.emplace(object, std::make_pair(Eigen::VectorXd::Zero(table.cols()), 0));
-    if (inserted) objects.push_back(object);
-    it->second.first += table.row(static_cast<Eigen::Index>(k)).transpose().cast<double>();
-    ++it->second.second;
-  }
-  const Eigen::Index dof = table.rows() - static_cast<Eigen::Index>(objects.size());
+  const ObjectMeans means = object_means(model);
+  const Eigen::Index dof = table.rows() - static_cast<Eigen::Index>(means.objects.size());
   if (dof < 1) return {};
   // Pooled within-object covariance, then shrunk toward its mean variance.
   Eigen::MatrixXd within = Eigen::MatrixXd::Zero(table.cols(), table.cols());
   for (std::size_t k = 0; k < model.states.size(); ++k) {
-    const auto& [sum, n] = sums.at(model.states[k].object);
-    const Eigen::VectorXd d = table.row(static_cast<Eigen::Index>(k)).transpose().cast<double>() - sum / n;
+    const Eigen::VectorXd d =
+        table.row(static_cast<Eigen::Index>(k)).transpose().cast<double>() - means.mean_of(model.states[k].object);
     within += d * d.transpose();
   }
   within /= static_cast<double>(dof);
@@ -78,10 +102,9 @@ std::vector<std::pair<std::string, double>> within_object_distances(const Hadyne
       (1 - s) * within + s * mean_variance * Eigen::MatrixXd::Identity(within.rows(), within.cols());
   const Eigen::LLT<Eigen::MatrixXd> llt(shrunk);  // positive definite: s > 0 and mean_variance > 0
   std::vector<std::pair<std::string, double>> out;
-  for (const std::string& object : objects) {
-    const auto& [sum, n] = sums.at(object);
-    const Eigen::VectorXd d = pb - sum / n;
-    out.emplace_back(object, std::sqrt(std::max(0.0, d.dot(llt.solve(d)))));
+  for (std::size_t i = 0; i < means.objects.size(); ++i) {
+    const Eigen::VectorXd d = pb - means.means[i];
+    out.emplace_back(means.objects[i], std::sqrt(std::max(0.0, d.dot(llt.solve(d)))));
   }
   return out;
 }
@@ -129,22 +152,9 @@ Recognition recognize_object(const HadynetModel& model, const Eigen::VectorXf& p
 }
 
 std::vector<Eigen::VectorXf> object_mean_pbs(const HadynetModel& model) {
-  std::vector<std::string> order;
-  std::map<std::string, std::pair<Eigen::VectorXd, int>> sums;
-  for (std::size_t k = 0; k < model.states.size(); ++k) {
-    const std::string& object = model.states[k].object;
-    const Eigen::VectorXd pb = model.params.pb.row(static_cast<Eigen::Index>(k)).transpose().cast<double>();
-    auto [it, inserted] = sums.emplace(object, std::make_pair(Eigen::VectorXd::Zero(pb.size()), 0));
-    if (inserted) order.push_back(object);
-    it->second.first += pb;
-    ++it->second.second;
-  }
-  std::vector<Eigen::VectorXf> means;
-  for (const std::string& object : order) {
-    const auto& [sum, n] = sums.at(object);
-    means.push_back((sum / n).cast<float>());
-  }
-  return means;
+  std::vector<Eigen::VectorXf> out;
+  for (const Eigen::VectorXd& mean : object_means(model).means) out.push_back(mean.cast<float>());
+  return out;
 }
 
 Pca fit_pca(const Eigen::MatrixXd& points, int k) {

@@ -273,26 +273,16 @@ void dot_cols_q15_i32(const std::int16_t* w, int stride, int rows, const std::in
 }
 
 // W^T g on a packed matrix with int16 g: four columns (inside one chunk of
-// eight) at a time over every row pair (hadynet_dot_cols4_q15); the last
-// cols % 4 columns by the reference.
+// eight) at a time over every row pair (hadynet_dot_cols4_q15).
 void dot_cols_packed_q15(const std::int16_t* w, int padded_cols, int rows, const std::int16_t* g, int cols,
                          std::int64_t* acc) noexcept {
-  if (rows <= 0 || !word_aligned(w) || !word_aligned(g)) {
+  if (rows <= 0 || cols % 4 != 0 || !word_aligned(w) || !word_aligned(g)) {
     reference::dot_cols_packed_q15(w, padded_cols, rows, g, cols, acc);
     return;
   }
   const int stride_bytes = 2 * 2 * padded_cols;
-  int c = 0;
-  for (; c + 4 <= cols; c += 4)
+  for (int c = 0; c < cols; c += 4)
     hadynet_dot_cols4_q15(w + packed_index(padded_cols, 0, c), stride_bytes, g, (rows + 1) / 2, acc + c);
-  if (c < cols) {
-    // The last cols % 4 (< 4) columns by the reference, from the start of
-    // their chunk (packed_index is linear in whole chunks): at most 7 columns.
-    std::int64_t rest[8];
-    const int chunk = c / 8 * 8;
-    reference::dot_cols_packed_q15(w + packed_index(padded_cols, 0, chunk), padded_cols, rows, g, cols - chunk, rest);
-    for (int j = c; j < cols; ++j) acc[j] = rest[j - chunk];
-  }
 }
 
 }  // namespace hadynet::kernels
