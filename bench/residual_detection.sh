@@ -17,11 +17,13 @@
 # with several candidates; see bench/residual_false_positives.sh for the
 # others). With a calibrated null (--reference-seed 270, the clean sets of
 # that seed): seeds 291-300; its floor was chosen on development effect
-# logs of seeds 181-184.
+# logs of seeds 181-184. With the model's stored held-out logs as the null
+# (the default since models store them): seeds 331-340.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S]
-#   defaults: models/hand.safetensors, build/residual-detection, 10, 231, --candidates 1, no null
+#   defaults: models/hand.safetensors, build/residual-detection, 10, 231, --candidates 1, the null of
+#   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
 set -euo pipefail

@@ -17,14 +17,16 @@
 # With a calibrated null (--reference-seed): seed 11's clean sets were the
 # null and 13-16 (clean) the development logs its floor was chosen on;
 # seed 270 is the null of the measurement and 271-290 the measured sets.
-# Give others as arguments.
+# With the model's stored held-out logs as the null (the default since
+# models store them): 311-330 the measured sets. Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
 #          [--reference-seed S] [SEED...]
 #   defaults: models/hand.safetensors, build/residual-false-positives, 161..180,
 #   no rated range (the plant's datasheet: --rated-range fc=0..50 --rated-range f=0..200),
-#   no calibrated null (--reference-seed S: clean sets of the four grasps recorded with seed S
-#   are the null, `hadynet residual --reference`)
+#   the null of `hadynet residual`'s default: the held-out logs stored in the model
+#   (--reference-seed S: clean sets of the four grasps recorded with seed S are the null,
+#   `hadynet residual --reference`; --reference-seed none: no null, absolute floors)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per seed with an ETA, then the counts; OUT/summary.txt.
 set -euo pipefail

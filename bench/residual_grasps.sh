@@ -20,10 +20,16 @@ collect_residual_grasps() {
 # record_reference HADYNET OUT SEED: clean log sets of the four grasps with
 # SEED in OUT/reference, the calibrated null of `hadynet residual --reference`
 # (docs/residual.md, "A calibrated null"), and sets reference_args to the
-# options that use it. With SEED empty, reference_args is empty (no null).
+# options that use it. With SEED empty, reference_args is empty (the null is
+# the held-out logs stored in the model, if it has any); with SEED "none",
+# --reference none (no null: absolute floors).
 record_reference() {
   reference_args=()
   [[ -n "$3" ]] || return 0
+  if [[ "$3" == none ]]; then
+    reference_args=(--reference none)
+    return 0
+  fi
   rm -rf "$2/reference"
   collect_residual_grasps "$1" "$2/reference" "$3"
   reference_args=(--reference "$2/reference")

@@ -12,7 +12,8 @@
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S]
-#   defaults: models/hand.safetensors, build/residual-unknown-effect, 10, 221, no calibrated null
+#   defaults: models/hand.safetensors, build/residual-unknown-effect, 10, 221, the null of
+#   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per log set with an ETA, then the counts (OUT/summary.txt).
 set -euo pipefail

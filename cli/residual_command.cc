@@ -17,6 +17,7 @@
 #include "cli/residual_fix_report.h"
 #include "cli/residual_report.h"
 #include "datalog/log_reader.h"
+#include "trainer/held_out_logs.h"
 #include "trainer/model_file.h"
 #include "trainer/residual/analysis.h"
 #include "trainer/residual/augment.h"
@@ -28,6 +29,51 @@ namespace {
 
 namespace rs = trainer::residual;
 using nlohmann::json;
+
+// The logs of the calibrated null: the --reference logs when given (never a
+// log under test), else the held-out logs stored in the model, leaving out
+// any whose rows a log under test holds (then they are not other data).
+// `source` says where they came from, or why there are none.
+std::vector<rs::LogInput> reference_logs(const trainer::HadynetModel& model, const std::string& model_path,
+                                         const std::vector<std::string>& args, const std::vector<rs::LogInput>& inputs,
+                                         std::string* source) {
+  std::vector<rs::LogInput> reference;
+  if (!args.empty()) {
+    for (const auto& path : trainer::expand_log_paths(args)) {
+      for (const auto& in : inputs)
+        if (std::filesystem::equivalent(in.file, path))
+          throw std::invalid_argument("--reference " + path + " is also a log under test; a null must be other logs");
+      reference.push_back({datalog::read_log(path), path});
+    }
+    *source = "--reference";
+    return reference;
+  }
+  if (model.held_out_logs.empty()) {
+    *source = "the model stores no held-out logs (trained with --held-out 0 or before models stored them); "
+              "give clean logs with --reference";
+    return reference;
+  }
+  std::size_t overlapping = 0;
+  for (const auto& stored : model.held_out_logs) {
+    const std::string name = model_path + ": held-out log " + stored.name;
+    datalog::LogTable table = datalog::parse_log(stored.text, name);
+    bool in_test = false;
+    for (const auto& in : inputs) in_test = in_test || trainer::contains_rows(in.table, table);
+    if (in_test) {
+      ++overlapping;
+      continue;
+    }
+    reference.push_back({std::move(table), name});
+  }
+  *source = "the model's held-out logs: rows of its training logs no training window used";
+  if (overlapping > 0) {
+    *source += "; " + std::to_string(overlapping) + " of " + std::to_string(model.held_out_logs.size()) +
+               " left out because a log under test holds their rows";
+    if (reference.empty()) *source = "every held-out log stored in the model is part of a log under test; "
+                                     "give other clean logs with --reference";
+  }
+  return reference;
+}
 
 // The console summary: fit per channel and horizon, whiteness, the top of the ranking, the verdict.
 void print_summary(const rs::Analysis& a, const std::string& pb_choice, bool fixing) {
@@ -132,12 +178,14 @@ int run_residual(int argc, char** argv) {
   opt.value("min-explained-std", "V",
             "floor without --reference: held-out explained variance in standardised units (drop of the channel's\n"
             "1-step loss; the default was set on the hand's models)", "0.05");
-  opt.repeated("reference", "LOG|DIR",
+  opt.repeated("reference", "LOG|DIR|none",
                "clean logs of the same channels for a calibrated null: neither the model's training logs nor the\n"
                "logs under test (e.g. validation logs recorded with them). Every hypothesis is also tested there;\n"
                "an effect must then explain more than on the null by --min-excess-null times its channel's clean\n"
-               "residual level (replacing --min-explained-std), so the floors follow the model's own scale");
-  opt.value("min-excess-null", "S", "with --reference: how many times its channel's clean residual level an effect must\n"
+               "residual level (replacing --min-explained-std), so the floors follow the model's own scale.\n"
+               "Default: the held-out logs stored in the model by train (its training logs' held-out rows; any\n"
+               "whose rows are in a log under test is left out); none: no null, absolute floors");
+  opt.value("min-excess-null", "S", "with a null: how many times its channel's clean residual level an effect must\n"
                                      "explain beyond the null", num("%g", rs::kDefaultMinExcessNull));
   opt.flag("all-sources", "cross-talk sources from every observed group (default: the target's group)");
   opt.repeated("rated-range", "NAME=LOW..HIGH",
@@ -184,8 +232,10 @@ int run_residual(int argc, char** argv) {
     if (!horizon) return 2;
   }
   if (!max_lag || !max_delay || !fraction || !alpha || !min_share || !min_std || !min_excess) return 2;
-  if (opt.has("min-excess-null") && opt.all("reference").empty()) {
-    std::fprintf(stderr, "hadynet residual: --min-excess-null needs --reference\n");
+  const std::vector<std::string> reference_args = opt.all("reference");
+  const bool no_reference = reference_args.size() == 1 && reference_args.front() == "none";
+  if (opt.has("min-excess-null") && no_reference) {
+    std::fprintf(stderr, "hadynet residual: --min-excess-null needs a null (not --reference none)\n");
     return 2;
   }
   const auto fix_epochs = opt.get_int("fix-epochs", 1, 100000);
@@ -223,14 +273,14 @@ int run_residual(int argc, char** argv) {
     const std::vector<std::string> args(opt.positional().begin() + 1, opt.positional().end());
     std::vector<rs::LogInput> inputs;
     for (const auto& path : trainer::expand_log_paths(args)) inputs.push_back({datalog::read_log(path), path});
-    std::vector<rs::LogInput> reference;
-    if (!opt.all("reference").empty()) {
-      for (const auto& path : trainer::expand_log_paths(opt.all("reference"))) {
-        for (const auto& in : inputs)
-          if (std::filesystem::equivalent(in.file, path))
-            throw std::invalid_argument("--reference " + path + " is also a log under test; a null must be other logs");
-        reference.push_back({datalog::read_log(path), path});
-      }
+    std::string null_source;
+    const std::vector<rs::LogInput> reference =
+        no_reference ? std::vector<rs::LogInput>{}
+                     : reference_logs(model, model_path, reference_args, inputs, &null_source);
+    if (no_reference) null_source = "--reference none";
+    if (opt.has("min-excess-null") && reference.empty()) {
+      std::fprintf(stderr, "hadynet residual: --min-excess-null needs a null: %s\n", null_source.c_str());
+      return 2;
     }
 
     rs::AnalysisOptions ao;
@@ -244,6 +294,7 @@ int run_residual(int argc, char** argv) {
     ao.attribution.min_explained = *min_share;
     ao.attribution.min_explained_std = *min_std;
     ao.attribution.min_excess_null = *min_excess;
+    ao.null_source = null_source;
     const std::string& pb_choice = ao.pb_choice;
     rs::FixOptions fo;
     fo.train_fraction = *fraction;
@@ -281,6 +332,7 @@ int run_residual(int argc, char** argv) {
       json j = analysis_json(a, current_path, pb_choice);
       j["rated_ranges"] = opt.all("rated-range");
       j["reference"] = opt.all("reference");
+      j["null_source"] = null_source;
       std::optional<rs::FixResult> fixed;
       std::string round_written;
       if (opt.has("fix")) {

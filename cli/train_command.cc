@@ -19,6 +19,7 @@
 #include "hadynet_build_info.h"
 #include "trainer/checkpoint.h"
 #include "trainer/deploy_prep.h"
+#include "trainer/held_out_logs.h"
 #include "trainer/model_file.h"
 #include "trainer/training.h"
 #include "trainer/training_record.h"
@@ -92,7 +93,8 @@ int run_train(int argc, char** argv) {
               "and reported as the held-out loss per epoch. A checkpoint OUT.ckpt is written atomically after\n"
               "every epoch; --resume continues an interrupted run exactly. Writes OUT (safetensors, PyTorch\n"
               "names; docs/model-file.md) with the value ranges measured on the training windows (for\n"
-              "codegen), OUT.loss.csv and OUT.loss.png.",
+              "codegen) and the held-out rows of each log as logs (the residual loop's null), OUT.loss.csv\n"
+              "and OUT.loss.png.",
               "LOG|DIR... --out MODEL [options]");
   opt.value("out", "MODEL", "model file to write (.safetensors)");
   opt.value("epochs", "N", "epochs", "200");
@@ -213,6 +215,8 @@ int run_train(int argc, char** argv) {
     model.ranges = trainer::measure_ranges(model, data, split.train);
     model.ranges->source = "hadynet train: training windows of " + std::to_string(paths.size()) +
                            " logs (data_hash " + model.provenance.at("data_hash") + ")";
+    // The held-out rows as logs: the residual loop's default null (docs/residual.md).
+    model.held_out_logs = trainer::held_out_logs(paths, data, split);
     trainer::save_model(out, model);
     const std::string csv = out + ".loss.csv";
     const std::string png = out + ".loss.png";

@@ -7,10 +7,13 @@
 #   * free-run simulation RMSE from the record's first state with its pump
 #     input only, with the trained PB and with a PB adapted to the record,
 #     next to the published range for good nonlinear models (0.3-0.6 V);
-#   * the residual loop (`hadynet residual --fix`) on both records, and what
-#     it finds about the overflow at 10 V (the level sensor's rail): the rows
-#     at the rail, the model's own highest prediction, the rail hypotheses.
-# Data sets: training = the estimation record (rows 1..1024, seed 1);
+#   * the residual loop (`hadynet residual --fix`) on the validation record,
+#     and what it finds about the overflow at 10 V (the level sensor's rail):
+#     the rows at the rail, the model's own highest prediction, the rail
+#     hypotheses.
+# Data sets: training = the estimation record's first 90 % of windows (seed
+# 1); the residual loop's null = the rest of the estimation record, which
+# train holds out and stores in the model (no training window touches it);
 # measurement = the validation record. No threshold is calibrated here.
 #
 # Usage: scripts/cascaded_tanks.sh [OUT]      (default OUT: build/cascaded-tanks)
@@ -41,8 +44,8 @@ echo "[3/4] free-run simulation of the validation record" >&2
 rmse() { sed -n 's/^  y \+\([0-9.eE+-]*\)$/\1/p' <<<"$1"; }
 trained=$("$hadynet" simulate "$out/tanks.safetensors" --log "$out/val.csv" --out "$out/sim_trained.csv" --pb tanks)
 adapted=$("$hadynet" simulate "$out/tanks.safetensors" --log "$out/val.csv" --out "$out/sim_adapted.csv" --pb adapt)
-echo "[4/4] residual loop on both records" >&2
-"$hadynet" residual "$out/tanks.safetensors" "$out/train/est.csv" "$out/val.csv" --fix \
+echo "[4/4] residual loop on the validation record" >&2
+"$hadynet" residual "$out/tanks.safetensors" "$out/val.csv" --fix \
   --report "$out/residual" > "$out/residual.txt" 2>&1
 
 {
@@ -64,6 +67,7 @@ for rec in ("train/est.csv", "val.csv"):
 sim = column(f"{out}/sim_trained.csv", "y0")
 print(f"free-run prediction (trained PB) peaks at {max(sim):.2f} V")
 j = json.load(open(f"{out}/residual/residual.json"))
+print("residual " + j["attribution"]["floors"])
 print("residual verdict:", j["verdict"])
 for h in j["attribution"]["ranked"]:
     if h["effect"] == "saturation":

@@ -76,6 +76,15 @@ inline constexpr ValueRangeField kValueRangeFields[] = {
     {"dec_bias", &ValueRanges::dec_bias},
 };
 
+// One log kept inside the model file, as the text of a HADYNET log
+// (docs/log-format.md).
+struct StoredLog {
+  std::string name;  // where its rows came from, e.g. "train/a.csv rows 441..499"
+  std::string text;  // datalog::format_log() text; parse_log() reads it back bit for bit
+
+  bool operator==(const StoredLog&) const = default;
+};
+
 struct HadynetModel {
   FeatureLayout layout;
   Normalization norm;
@@ -95,6 +104,12 @@ struct HadynetModel {
   // once, with the channels). Empty: a robot whose logs carry no profile.
   datalog::RobotProfile profile;
   SensorModel sensor;  // measured channels from the network's (sensor_model.h); empty: the same
+  // The rows of each training log that no training window touched (the tail
+  // `train --held-out` kept out, held_out_logs.h), as logs: clean data that
+  // is neither training data nor, as a rule, a log under test. The residual
+  // loop calibrates its null on them by default (docs/residual.md). Empty:
+  // none stored (--held-out 0, or a model written before the format had them).
+  std::vector<StoredLog> held_out_logs;
   std::map<std::string, std::string> hyper_parameters;  // e.g. "lr" -> "0.001"
   std::map<std::string, std::string> provenance;        // data_hash, git_commit, logs, ...
 

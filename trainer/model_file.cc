@@ -18,6 +18,8 @@ using nlohmann::json;
 
 namespace {
 
+constexpr const char* kHeldOutLogsTensor = "held_out_logs.text";
+
 std::vector<std::int64_t> shape_of(const NamedTensor<const float>& t) {
   if (t.rank == 1) return {t.rows};
   return {t.rows, t.cols};
@@ -84,6 +86,38 @@ double json_number(const json& j, const std::string& key, const std::string& whe
     fail(origin, where + " '" + key + "' must be a number in " + range + ", got " + j.at(key).dump());
   }
   return v;
+}
+
+// The stored held-out logs: metadata `logs` ([{"name", "bytes"}], in order)
+// cutting the U8 tensor kHeldOutLogsTensor into texts. The texts are parsed
+// where they are used (the residual loop), not here: loading stays cheap.
+std::vector<StoredLog> held_out_logs_from(const st::File& file, const json& logs, const std::string& origin) {
+  const auto tensor = file.tensors.find(kHeldOutLogsTensor);
+  if (tensor == file.tensors.end()) fail(origin, std::string("metadata 'held_out_logs' without tensor '") +
+                                                     kHeldOutLogsTensor + "'");
+  const st::Tensor& t = tensor->second;
+  if (t.dtype != st::DType::kU8 || t.shape.size() != 1)
+    fail(origin, std::string("tensor '") + kHeldOutLogsTensor + "' must be U8 of rank 1");
+  if (!logs.is_array() || logs.empty()) fail(origin, "metadata 'held_out_logs' must be a non-empty array");
+  std::vector<StoredLog> out;
+  std::size_t offset = 0;
+  for (const json& entry : logs) {
+    StoredLog log;
+    log.name = json_get<std::string>(entry, "name", "held_out_logs entry", origin);
+    const auto bytes = static_cast<std::size_t>(
+        json_int(entry, "bytes", "held_out_logs entry", origin, 1, static_cast<std::int64_t>(t.bytes.size())));
+    if (bytes > t.bytes.size() - offset)
+      fail(origin, "metadata 'held_out_logs' counts more bytes than tensor '" + std::string(kHeldOutLogsTensor) +
+                       "' holds (" + std::to_string(t.bytes.size()) + ")");
+    log.text.assign(t.bytes.begin() + static_cast<std::ptrdiff_t>(offset),
+                    t.bytes.begin() + static_cast<std::ptrdiff_t>(offset + bytes));
+    offset += bytes;
+    out.push_back(std::move(log));
+  }
+  if (offset != t.bytes.size())
+    fail(origin, "tensor '" + std::string(kHeldOutLogsTensor) + "' holds " + std::to_string(t.bytes.size()) +
+                     " bytes, metadata 'held_out_logs' counts " + std::to_string(offset));
+  return out;
 }
 
 // Throws unless every value of `v` lies within +-ModelLimits::kMaxMagnitude.
@@ -307,6 +341,19 @@ st::File model_to_safetensors(const HadynetModel& model) {
   if (!model.sensor.empty()) file.metadata["sensor"] = sensor_json(model.sensor).dump();
   if (!model.profile.empty()) file.metadata["profile"] = profile_json(model.profile).dump();
   if (model.period_s > 0) file.metadata["period_s"] = json(model.period_s).dump();
+  if (!model.held_out_logs.empty()) {
+    // The logs' texts back to back in one U8 tensor; their names and byte
+    // counts, in order, in the metadata.
+    json logs = json::array();
+    st::Tensor text{st::DType::kU8, {0}, {}};
+    for (const StoredLog& log : model.held_out_logs) {
+      logs.push_back({{"name", log.name}, {"bytes", log.text.size()}});
+      text.bytes.insert(text.bytes.end(), log.text.begin(), log.text.end());
+    }
+    text.shape = {static_cast<std::int64_t>(text.bytes.size())};
+    file.metadata["held_out_logs"] = logs.dump();
+    file.tensors[kHeldOutLogsTensor] = std::move(text);
+  }
   return file;
 }
 
@@ -457,6 +504,11 @@ HadynetModel model_from_safetensors(const st::File& file, const std::string& ori
 
     if (file.metadata.count("sensor") != 0)
       model.sensor = sensor_from_json(parse_metadata_json(file, "sensor", origin), origin);
+
+    if (file.metadata.count("held_out_logs") != 0) {
+      model.held_out_logs = held_out_logs_from(file, parse_metadata_json(file, "held_out_logs", origin), origin);
+      expected.insert(kHeldOutLogsTensor);
+    }
 
     for (const auto& [name, tensor] : file.tensors) {
       if (expected.count(name) != 0) continue;

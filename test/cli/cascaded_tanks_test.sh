@@ -28,3 +28,8 @@ print(f"trained {t} V, adapted {a} V: {'ok' if ok else 'FAIL'}")
 sys.exit(0 if ok else 1)
 PY
 grep -q "rows at the 10 V rail" <<<"$out" && grep -q "^residual verdict:" <<<"$out" || { echo "FAIL: no overflow/verdict lines"; exit 1; }
+# The loop's floors on real data come from a calibrated null: the estimation
+# record's held-out rows stored in the model (before: absolute floors set on
+# the hand, two orders of magnitude above this model's whole residual).
+grep -q "^residual floors: calibrated null of 1 reference logs (the model's held-out logs" <<<"$out" \
+  || { echo "FAIL: the residual loop had no calibrated null: $(grep '^residual floors' <<<"$out")"; exit 1; }

@@ -63,5 +63,36 @@ out=$("$hadynet" residual plain.safetensors tagged 2>&1); status=$?
 grep -q "with a PB adapted to their state's logs (states the model was not trained on)" <<<"$out" \
   || fail "an adapted PB was not said: $(head -3 <<<"$out")"
 
+# The null: the model stores its training logs' held-out rows, and the
+# residual loop calibrates its floors on them by default (before: absolute
+# floors set on the hand, whatever the data). Logs under test that hold those
+# rows (here the training logs themselves) cannot be their own null.
+python3 - <<'PY'
+import math
+with open("d.csv", "w") as f:
+    f.write("# format: hadynet-log\n# format_version: 1\n# dt_s: 0.1\n# state: s1\nt,pos0,vel0,u0\n")
+    p = v = 0.0
+    for r in range(120):
+        u = math.cos(0.21 * r)
+        f.write("%.1f,%.6f,%.6f,%.6f\n" % (0.1 * r, p, v, u))
+        v += 0.1 * (u - 2.0 * p - 0.5 * v)
+        p += 0.1 * v
+PY
+out=$("$hadynet" residual plain.safetensors d.csv 2>&1); status=$?
+[[ $status -eq 0 ]] || fail "residual with the stored null: exit $status: $(tail -3 <<<"$out")"
+grep -q "^floors: calibrated null of 2 reference logs (the model's held-out logs" <<<"$out" \
+  || fail "the stored held-out logs are not the null: $(grep floors <<<"$out")"
+out=$("$hadynet" residual plain.safetensors plain 2>&1)
+grep -q "^floors: no calibrated null (every held-out log stored in the model is part of a log under test" <<<"$out" \
+  || fail "the training logs were their own null: $(grep floors <<<"$out")"
+out=$("$hadynet" residual plain.safetensors d.csv --reference none 2>&1)
+grep -q "^floors: no calibrated null (--reference none)" <<<"$out" || fail "--reference none: $(grep floors <<<"$out")"
+"$hadynet" train plain --out all.safetensors --held-out 0 "${small[@]}" >/dev/null 2>&1 || fail "train --held-out 0"
+out=$("$hadynet" residual all.safetensors d.csv 2>&1)
+grep -q "^floors: no calibrated null (the model stores no held-out logs" <<<"$out" \
+  || fail "a model without held-out logs: $(grep floors <<<"$out")"
+out=$("$hadynet" residual all.safetensors d.csv --min-excess-null 2 2>&1); status=$?
+[[ $status -eq 2 && "$out" == *"--min-excess-null needs a null"* ]] || fail "--min-excess-null without a null: $status $out"
+
 echo "generic_logs: $failures failed"
 [[ $failures -eq 0 ]]

@@ -75,7 +75,7 @@ expect 2 "--rounds needs --fix" "$model" good.csv --rounds 2 --json out.json
 expect 2 "--rated-range: rated range 'fc=5..1': LOW must be below HIGH" "$model" good.csv --rated-range fc=5..1 --json out.json
 expect 2 "expected NAME=LOW..HIGH" "$model" good.csv --rated-range fc --json out.json
 expect 1 "rated range 'u': no output channel or group of that name" "$model" good.csv --rated-range u=0..1 --json out.json
-expect 2 "--min-excess-null needs --reference" "$model" good.csv --min-excess-null 2 --json out.json
+expect 2 "--min-excess-null needs a null (not --reference none)" "$model" good.csv --reference none --min-excess-null 2 --json out.json
 expect 2 "--min-excess-null: expected a number" "$model" good.csv --reference good.csv --min-excess-null x --json out.json
 expect 1 "--reference good.csv is also a log under test" "$model" good.csv --reference good.csv --json out.json
 expect 1 "no_fc8.csv: no column 'fc8'" "$model" good.csv --reference no_fc8.csv --json out.json

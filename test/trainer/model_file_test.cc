@@ -73,6 +73,8 @@ HadynetModel sample_model(bool with_detection) {
     m.sensor.drifts = {{y.back(), true, 0.004}, {y.front(), false, -0.5}};
     m.sensor.period_s = 0.2;
     m.sensor.clips = {{y.front(), 1, 0.1875}, {y.back(), -1, -2.5}};
+    // And held-out logs (stored as texts; the loader does not parse them).
+    m.held_out_logs = {{"a.csv rows 18..19", "# format: hadynet-log\nt,q0\n0,1\n"}, {"b.csv rows 9..12", "x"}};
   }
   return m;
 }
@@ -120,6 +122,7 @@ void expect_same_model(const HadynetModel& got, const HadynetModel& want) {
     EXPECT_EQ(g.source, w.source);
   }
   EXPECT_TRUE(got.sensor == want.sensor);
+  EXPECT_EQ(got.held_out_logs, want.held_out_logs);
   ASSERT_EQ(got.ranges.has_value(), want.ranges.has_value());
   if (want.ranges) {
     EXPECT_EQ(*got.ranges, *want.ranges);  // doubles exactly (JSON round trip)
@@ -250,6 +253,30 @@ TEST_F(ModelFileRejects, SensorModelOnAnUnknownChannelOrWithBadNumbers) {
     edit_metadata(f, "sensor", c.from, c.to);
     expect_rejected(f, c.error);
   }
+}
+
+TEST_F(ModelFileRejects, HeldOutLogsWhoseByteCountsDoNotCutTheirTensor) {
+  const struct {
+    const char* from;
+    const char* to;
+    const char* error;
+  } cases[] = {
+      {"\"bytes\":1,", "\"bytes\":2,", "than tensor 'held_out_logs.text' holds (32)"},  // beyond its end
+      {"\"bytes\":31", "\"bytes\":30", "holds 32 bytes, metadata 'held_out_logs' counts 31"},  // a byte left
+      {"\"bytes\":31", "\"bytes\":0", "whole number in 1 .."},  // an empty log
+      {"\"name\"", "\"nmae\"", "has no 'name'"},
+  };
+  for (const auto& c : cases) {
+    st::File f = good_;
+    edit_metadata(f, "held_out_logs", c.from, c.to);
+    expect_rejected(f, c.error);
+  }
+  st::File no_tensor = good_;
+  no_tensor.tensors.erase("held_out_logs.text");
+  expect_rejected(no_tensor, "without tensor 'held_out_logs.text'");
+  st::File no_metadata = good_;
+  no_metadata.metadata.erase("held_out_logs");
+  expect_rejected(no_metadata, "unexpected tensor 'held_out_logs.text'");
 }
 
 TEST_F(ModelFileRejects, TheUnmodifiedFileLoads) {

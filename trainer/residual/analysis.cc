@@ -10,6 +10,7 @@ Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, c
                  const std::vector<LogInput>& reference) {
   Analysis a;
   a.max_lag = options.max_lag;
+  a.null_source = options.null_source;
   a.data = compute_residuals(model, logs, options.pb_choice);
   a.horizon = horizon_metrics(model, a.data, options.horizon > 0 ? options.horizon : model.train_steps);
   if (!a.horizon.rmse.allFinite()) {
@@ -45,19 +46,20 @@ Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, c
 
 std::string floors_summary(const Analysis& a) {
   const auto& o = a.attribution.options;
+  const std::string source = a.null_source.empty() ? std::string() : " (" + a.null_source + ")";
   char buf[512];
   if (!a.attribution.null) {
     std::snprintf(buf, sizeof buf,
-                  "floors: no calibrated null (--reference): absolute floors assumed, an effect must lower its "
+                  "floors: no calibrated null%s: absolute floors assumed, an effect must lower its "
                   "channel's standardised 1-step loss by >= %g (set for the hand's models) and explain >= %g of "
                   "its held-out residual variance",
-                  o.min_explained_std, o.min_explained);
+                  source.c_str(), o.min_explained_std, o.min_explained);
     return buf;
   }
   std::snprintf(buf, sizeof buf,
-                "floors: calibrated null of %ld reference logs (%s): an effect must explain >= %g times its "
+                "floors: calibrated null of %ld reference logs%s, %s: an effect must explain >= %g times its "
                 "channel's clean residual level more than on the null, and >= %g of its held-out residual variance",
-                a.attribution.null->logs, a.reference_pb.c_str(), o.min_excess_null, o.min_explained);
+                a.attribution.null->logs, source.c_str(), a.reference_pb.c_str(), o.min_excess_null, o.min_explained);
   return buf;
 }
 

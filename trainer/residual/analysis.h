@@ -23,6 +23,9 @@ struct AnalysisOptions {
   int max_lag = kDefaultMaxLag;    // whiteness lags 1..L, independence -L..L
   LibraryOptions library;          // which hypotheses are enumerated
   AttributionOptions attribution;  // how they are fitted and tested
+  // Where the reference logs came from, or why there are none, in words for
+  // floors_summary() (e.g. "the model's held-out logs"); may be empty.
+  std::string null_source;
 };
 
 // Everything the analysis computes.
@@ -35,6 +38,7 @@ struct Analysis {
   std::vector<std::vector<CrossCorrelation>> with_observed;  // [c][j]: with y_j (j != c; [c][c] empty)
   Attribution attribution;  // with attribution.null when reference logs were given
   std::string reference_pb;  // with reference logs: pb_summary() of the reference
+  std::string null_source;   // AnalysisOptions::null_source
   std::string verdict;  // verdict_text(attribution)
 };
 
