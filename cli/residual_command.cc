@@ -65,6 +65,13 @@ std::vector<rs::LogInput> reference_logs(const trainer::HadynetModel& model, con
     }
     reference.push_back({std::move(table), name});
   }
+  // The null tests the same hypotheses, aux_* channels included: the aux
+  // channels (the aux_* columns every log has, in order) must be the same.
+  if (!reference.empty() && rs::common_aux_names(reference) != rs::common_aux_names(inputs)) {
+    *source = "the model's held-out logs have other aux_* columns than the logs under test; give clean logs "
+              "with the same columns with --reference";
+    return {};
+  }
   *source = "the model's held-out logs: rows of its training logs no training window used";
   if (overlapping > 0) {
     *source += "; " + std::to_string(overlapping) + " of " + std::to_string(model.held_out_logs.size()) +

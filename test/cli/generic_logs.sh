@@ -85,6 +85,13 @@ grep -q "^floors: calibrated null of 2 reference logs (the model's held-out logs
 out=$("$hadynet" residual plain.safetensors plain 2>&1)
 grep -q "^floors: no calibrated null (every held-out log stored in the model is part of a log under test" <<<"$out" \
   || fail "the training logs were their own null: $(grep floors <<<"$out")"
+# Logs under test with an aux_* column the stored logs lack: the null would
+# test other hypotheses, so there is none, said (before: the run failed).
+sed 's/^t,pos0,vel0,u0$/t,pos0,vel0,u0,aux_x/; /^[0-9]/s/$/,0.5/' d.csv >d_aux.csv
+out=$("$hadynet" residual plain.safetensors d_aux.csv 2>&1); status=$?
+[[ $status -eq 0 ]] || fail "residual with an aux column: exit $status: $(tail -2 <<<"$out")"
+grep -q "^floors: no calibrated null (the model's held-out logs have other aux_\* columns" <<<"$out" \
+  || fail "aux columns: $(grep '^floors' <<<"$out")"
 out=$("$hadynet" residual plain.safetensors d.csv --reference none 2>&1)
 grep -q "^floors: no calibrated null (--reference none)" <<<"$out" || fail "--reference none: $(grep floors <<<"$out")"
 "$hadynet" train plain --out all.safetensors --held-out 0 "${small[@]}" >/dev/null 2>&1 || fail "train --held-out 0"

@@ -26,19 +26,6 @@ double parse_number(const std::string& text, const std::string& what) {
   return v;
 }
 
-// aux_* names present in every log, in the first log's order.
-std::vector<std::string> common_aux_names(const std::vector<LogInput>& logs) {
-  std::vector<std::string> names;
-  if (logs.empty()) return names;
-  for (const auto& c : logs.front().table.columns)
-    if (c.rfind("aux_", 0) == 0) names.push_back(c);
-  std::erase_if(names, [&](const std::string& n) {
-    return std::any_of(logs.begin(), logs.end(),
-                       [&](const LogInput& l) { return !l.table.column_index(n).has_value(); });
-  });
-  return names;
-}
-
 Eigen::VectorXf adapt_to(const HadynetModel& model, const std::vector<LogSequence>& seqs) {
   const WindowDataset data(seqs, std::vector<int>(seqs.size(), 0), model.layout, model.norm, model.train_steps);
   if (data.size() == 0) {
@@ -100,6 +87,18 @@ Eigen::VectorXf explicit_pb(const HadynetModel& model, const std::string& text) 
 }
 
 }  // namespace
+
+std::vector<std::string> common_aux_names(const std::vector<LogInput>& logs) {
+  std::vector<std::string> names;
+  if (logs.empty()) return names;
+  for (const auto& c : logs.front().table.columns)
+    if (c.rfind("aux_", 0) == 0) names.push_back(c);
+  std::erase_if(names, [&](const std::string& n) {
+    return std::any_of(logs.begin(), logs.end(),
+                       [&](const LogInput& l) { return !l.table.column_index(n).has_value(); });
+  });
+  return names;
+}
 
 namespace {
 

@@ -70,6 +70,10 @@ struct LogInput {
   std::string file;
 };
 
+// The aux_* columns present in every one of `logs`, in the first log's order:
+// ResidualData::aux_names of compute_residuals(logs).
+std::vector<std::string> common_aux_names(const std::vector<LogInput>& logs);
+
 // The PB of each log: "auto" (the model's PB for the log's state when the
 // model knows it and it predicts the last 30 % of the state's windows at
 // most kStoredPbMargin times worse than a PB adapted to the first 70 %; else a
