@@ -183,7 +183,7 @@ int run_residual(int argc, char** argv) {
   opt.value("alpha", "A", "family-wise error rate of the Holm-corrected tests", "0.01");
   opt.value("min-explained", "S", "floor: share of the held-out residual variance an effect must explain", "0.1");
   opt.value("min-explained-std", "V",
-            "floor without --reference: held-out explained variance in standardised units (drop of the channel's\n"
+            "floor without a null: held-out explained variance in standardised units (drop of the channel's\n"
             "1-step loss; the default was set on the hand's models)", "0.05");
   opt.repeated("reference", "LOG|DIR|none",
                "clean logs of the same channels for a calibrated null: neither the model's training logs nor the\n"
