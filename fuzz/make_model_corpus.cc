@@ -1,7 +1,7 @@
 // Writes the seed corpus of model_fuzzer (fuzz/corpus/model): small model
 // files that exercise every part of the reader: a model with detection
-// statistics, value ranges and a sensor model (delay, cross-talk, drift,
-// clip), and a bare one. Small (a few KiB) so that the fuzzer mutates them
+// statistics, value ranges, a sensor model (delay, cross-talk, drift,
+// clip) and held-out logs, and a bare one. Small (a few KiB) so that the fuzzer mutates them
 // thousands of times per second; the hand's 0.36 MiB model is read by the
 // reader's unit tests.
 //   make_model_corpus OUT_DIR
@@ -59,6 +59,9 @@ int main(int argc, char** argv) {
   full.sensor.drifts.push_back({"q0", true, 0.01});
   full.sensor.clips.push_back({"q1", 1, 3.0});
   full.sensor.period_s = 0.2;
+  full.held_out_logs = {{"seed.csv rows 8..11", "# format: hadynet-log\n# format_version: 1\n# dt_s: 0.2\nt,q0,q1,v0,u0\n"
+                                                "0,1,2,3,0\n0.2,1,2,3,1\n"},
+                        {"seed2.csv rows 5..6", "# format: hadynet-log\n"}};
   tr::save_model((out / "full.safetensors").string(), full);
   std::printf("make_model_corpus: wrote bare.safetensors and full.safetensors to %s\n", out.c_str());
   return 0;
