@@ -58,8 +58,10 @@ PY
 mkdir -p logs && cp good.csv malformed.csv logs/
 
 # The good log is analysed (exit 0, the JSON written): each bad case below
-# differs from this run by the one thing its message names.
-if ! timeout 60 "$hadynet" residual "$model" good.csv --json out.json >good.out 2>&1 || [[ ! -s out.json ]]; then
+# differs from this run by the one thing its message names. Without a null
+# (--reference none): the default null, the model's 36 held-out logs, adapts
+# a PB per trained state to check it, 6 min under ASan on 2 cores.
+if ! timeout 60 "$hadynet" residual "$model" good.csv --reference none --json out.json >good.out 2>&1 || [[ ! -s out.json ]]; then
   echo "FAIL: the good log is not analysed"; head -5 good.out; failures=$((failures + 1))
 fi
 
