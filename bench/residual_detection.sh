@@ -6,7 +6,10 @@
 # datasheet ranges (--rated-range fc=0..50 --rated-range f=0..200). Per run:
 #   named     --fix confirmed the right effect with the right parameter:
 #             sensor-delay: the delay in steps; crosstalk: a plant pair
-#             (fc0<-fc1, fc1<-fc2, fc2<-fc3, fc3<-fc4, fc4<-fc3); friction:
+#             (fc0<-fc1, fc1<-fc2, fc2<-fc3, fc3<-fc4, fc4<-fc3); tension-leak
+#             (a cross-talk between groups): f5 -> fc6 with a gain within
+#             0.5-1.5 times the plant's (the screen's gain is the plant's
+#             when the network carries little of its input over); friction:
 #             tendon channels (f*); drift: a load drift on a loadcell;
 #             saturation: a loadcell's upper rail within 10 % of the plant's;
 #   cut       the held-out 1-step RMSE on the changed channels (mean ratio
@@ -21,8 +24,9 @@
 # (the default since models store them): seeds 331-340.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
-#          [--reference-seed S]
-#   defaults: models/hand.safetensors, build/residual-detection, 10, 231, --candidates 1, the null of
+#          [--reference-seed S] [--case EFFECT=STRENGTH]...
+#   defaults: models/hand.safetensors, build/residual-detection, 10, 231, --candidates 1, every case
+#   (--case: only those; repeatable), the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
@@ -34,6 +38,7 @@ out=build/residual-detection
 n=10
 first_seed=231
 candidates=()
+only_cases=()
 while (($#)); do
   case "$1" in
     -h | --help) usage; exit 0 ;;
@@ -43,6 +48,7 @@ while (($#)); do
     --seeds) n=$2; shift 2 ;;
     --first-seed) first_seed=$2; shift 2 ;;
     --candidates) candidates=(--candidates "$2"); shift 2 ;;
+    --case) only_cases+=("$2"); shift 2 ;;
     *) echo "residual_detection: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -55,8 +61,9 @@ record_reference "$hadynet" "$out" "$reference_seed"
 runs="$out/runs.txt"
 : >"$runs"
 # effect=strength, weaker first; the second is the larger strength.
-cases=(sensor-delay=1 sensor-delay=2 friction=2 friction=4 crosstalk=0.2 crosstalk=0.35 drift=0.01 drift=0.02
-  saturation=3 saturation=2)
+cases=(sensor-delay=1 sensor-delay=2 friction=2 friction=4 crosstalk=0.2 crosstalk=0.35 tension-leak=0.02
+  tension-leak=0.05 drift=0.01 drift=0.02 saturation=3 saturation=2)
+((${#only_cases[@]})) && cases=("${only_cases[@]}")
 total=$((n * ${#cases[@]})) done_runs=0 start=$(date +%s)
 for ((k = 0; k < n; ++k)); do
   seed=$((first_seed + k))
@@ -85,6 +92,10 @@ if effect == "sensor-delay":
     param_ok = named_effect == "sensor-delay" and aug.get("delay_steps") == int(strength)
 elif effect == "crosstalk":
     param_ok = named_effect == "crosstalk" and bool(channels) and (channels[0], aug.get("source")) in pairs
+elif effect == "tension-leak":
+    gain = aug.get("gain", 0.0)
+    param_ok = (named_effect == "crosstalk" and channels == ["fc6"] and aug.get("source") == "f5"
+                and 0.5 * strength <= gain <= 1.5 * strength)
 elif effect == "friction":
     param_ok = named_effect == "friction" and bool(channels) and all(re.fullmatch(r"f\d+", c) for c in channels)
 elif effect == "drift":

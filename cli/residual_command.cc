@@ -194,7 +194,11 @@ int run_residual(int argc, char** argv) {
                "whose rows are in a log under test is left out); none: no null, absolute floors");
   opt.value("min-excess-null", "S", "with a null: how many times its channel's clean residual level an effect must\n"
                                      "explain beyond the null", num("%g", rs::kDefaultMinExcessNull));
-  opt.flag("all-sources", "cross-talk sources from every observed group (default: the target's group)");
+  opt.value("crosstalk-sources", "unit|group|all",
+            "cross-talk sources of a channel: the other channels of its group and those of any group\n"
+            "measured in its unit (the logs' `units` metadata) (unit), its group only (group), or every\n"
+            "other observed channel (all)",
+            "unit");
   opt.repeated("rated-range", "NAME=LOW..HIGH",
                "a sensor's rated range (datasheet) for an output group or channel, e.g. fc=0..50: the predictions\n"
                "are clipped there as known before anything is searched (a rail there is not an effect); either\n"
@@ -243,6 +247,12 @@ int run_residual(int argc, char** argv) {
   const bool no_reference = reference_args.size() == 1 && reference_args.front() == "none";
   if (opt.has("min-excess-null") && no_reference) {
     std::fprintf(stderr, "hadynet residual: --min-excess-null needs a null (not --reference none)\n");
+    return 2;
+  }
+  const std::string crosstalk_sources = opt.get("crosstalk-sources");
+  if (crosstalk_sources != "unit" && crosstalk_sources != "group" && crosstalk_sources != "all") {
+    std::fprintf(stderr, "hadynet residual: --crosstalk-sources must be unit, group or all, not '%s'\n",
+                 crosstalk_sources.c_str());
     return 2;
   }
   const auto fix_epochs = opt.get_int("fix-epochs", 1, 100000);
@@ -295,13 +305,18 @@ int run_residual(int argc, char** argv) {
     ao.horizon = horizon ? static_cast<int>(*horizon) : 0;
     ao.max_lag = static_cast<int>(*max_lag);
     ao.library.max_delay = static_cast<int>(*max_delay);
-    ao.library.crosstalk_same_group = !opt.has("all-sources");
+    ao.library.crosstalk_sources = crosstalk_sources == "group" ? rs::CrosstalkSources::kSameGroup
+                                   : crosstalk_sources == "all" ? rs::CrosstalkSources::kAll
+                                                                : rs::CrosstalkSources::kSameUnit;
     ao.attribution.train_fraction = *fraction;
     ao.attribution.alpha = *alpha;
     ao.attribution.min_explained = *min_share;
     ao.attribution.min_explained_std = *min_std;
     ao.attribution.min_excess_null = *min_excess;
     ao.null_source = null_source;
+    // The stored held-out logs are the trained states' own rows: their trained PBs.
+    const bool stored_null = !no_reference && reference_args.empty() && !reference.empty();
+    ao.reference_pb_choice = stored_null ? "state" : "";
     const std::string& pb_choice = ao.pb_choice;
     rs::FixOptions fo;
     fo.train_fraction = *fraction;
@@ -311,6 +326,7 @@ int run_residual(int argc, char** argv) {
     fo.control = !opt.has("no-control");
     fo.candidates = static_cast<int>(*candidates);
     fo.reference = &reference;
+    fo.reference_pb_choice = stored_null ? "state" : "auto";
 
     // Rounds: each analyses `current` (the model of the last confirmed round)
     // and fixes when asked; the loop ends at the first round that confirms

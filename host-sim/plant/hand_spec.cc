@@ -63,7 +63,8 @@ Wear wear_from_level(double level) {
 
 bool Effects::any() const {
   return tendon_friction_N > 0 || loadcell_delay_steps > 0 || loadcell_drift_per_Ns > 0 ||
-         loadcell_drift_walk_N > 0 || loadcell_rail_N > 0 || loadcell_crosstalk > 0;
+         loadcell_drift_walk_N > 0 || loadcell_rail_N > 0 || loadcell_crosstalk > 0 ||
+         tension_leak > 0;
 }
 
 std::string Effects::describe() const {
@@ -81,6 +82,7 @@ std::string Effects::describe() const {
   }
   if (loadcell_rail_N > 0) { std::snprintf(buf, sizeof buf, "saturation=%g", loadcell_rail_N); add(buf); }
   if (loadcell_crosstalk > 0) { std::snprintf(buf, sizeof buf, "crosstalk=%g", loadcell_crosstalk); add(buf); }
+  if (tension_leak > 0) { std::snprintf(buf, sizeof buf, "tension-leak=%g", tension_leak); add(buf); }
   return out.empty() ? "none" : out;
 }
 
@@ -106,9 +108,12 @@ std::string apply_effect_arg(std::string_view arg, Effects& e) {
   } else if (name == "crosstalk") {
     e.loadcell_crosstalk = has_value ? value : 0.35;
     if (e.loadcell_crosstalk > 1) return "effect 'crosstalk': expected a fraction in 0..1";
+  } else if (name == "tension-leak") {
+    e.tension_leak = has_value ? value : 0.05;
+    if (e.tension_leak > 1) return "effect 'tension-leak': expected a fraction in 0..1";
   } else {
     return "unknown effect '" + std::string(name) +
-           "' (expected friction, sensor-delay, drift, saturation or crosstalk)";
+           "' (expected friction, sensor-delay, drift, saturation, crosstalk or tension-leak)";
   }
   return "";
 }

@@ -75,13 +75,17 @@ struct Effects {
   // Cross-talk: each fingertip loadcell picks up this fraction of the
   // neighbouring fingertip's force (thumb<-index, index<-middle, ...).
   double loadcell_crosstalk = 0.0;
+  // Cross-talk between groups: the palm loadcell fc6 picks up this fraction
+  // of tendon 5's tension (f5, whose cable runs past it), before noise.
+  double tension_leak = 0.0;
 
   bool any() const;
   // "friction=4,sensor-delay=2" style summary, for declared logs and reports.
   std::string describe() const;
 };
 // Parses one `--effect` argument: NAME or NAME=VALUE, NAME in
-// friction|sensor-delay|drift|saturation|crosstalk. Returns an error text or "".
+// friction|sensor-delay|drift|saturation|crosstalk|tension-leak. Returns an
+// error text or "".
 std::string apply_effect_arg(std::string_view arg, Effects& effects);
 
 // One dynamics state plus its simulation settings.

@@ -18,6 +18,8 @@ double quantise(double value, double lsb) {
 }
 // Fingertip loadcell i (0 thumb .. 4 little) picks up its neighbour's force.
 constexpr int kCrosstalkSource[5] = {1, 2, 3, 4, 3};
+// The tension leak: palm loadcell fc6 picks up tendon 5's tension.
+constexpr int kLeakLoadcell = 6, kLeakTendon = 5;
 }  // namespace
 
 SensorSimulation::SensorSimulation(const Effects& effects, bool realism, std::uint64_t seed)
@@ -28,6 +30,7 @@ Measurement SensorSimulation::measure(const Measurement& truth) {
   auto& fc = out.loadcell_N;
   if (effects_.loadcell_crosstalk > 0)
     for (int i = 0; i < 5; ++i) fc[i] += effects_.loadcell_crosstalk * truth.loadcell_N[kCrosstalkSource[i]];
+  if (effects_.tension_leak > 0) fc[kLeakLoadcell] += effects_.tension_leak * truth.tension_N[kLeakTendon];
   if (effects_.loadcell_drift_per_Ns > 0 || effects_.loadcell_drift_walk_N > 0) {
     for (int i = 0; i < kLoadcells; ++i) {
       drift_bias_N_[i] += effects_.loadcell_drift_per_Ns * truth.loadcell_N[i] * g::kControlStep_s +

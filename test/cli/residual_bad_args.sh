@@ -71,6 +71,7 @@ expect 2 "give MODEL and logs" "$model"
 expect 2 "unknown option '--frobnicate'" "$model" good.csv --frobnicate
 expect 2 "option '--alpha' needs a value" "$model" good.csv --json out.json --alpha
 expect 2 "--alpha: expected a number in 1e-12..0.5, got '2'" "$model" good.csv --json out.json --alpha 2
+expect 2 "--crosstalk-sources must be unit, group or all, not 'near'" "$model" good.csv --json out.json --crosstalk-sources near
 expect 2 "--horizon: expected a whole number in 1..1000, got '0'" "$model" good.csv --json out.json --horizon 0
 expect 2 "--out needs --fix" "$model" good.csv --out fixed.safetensors
 expect 2 "--rounds needs --fix" "$model" good.csv --rounds 2 --json out.json

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <set>
 #include <stdexcept>
 
 namespace hadynet::trainer::residual {
@@ -128,6 +129,44 @@ TEST(Attribution, AuxChannelAndCrosstalkWin) {
   if (neg.winner()) {
     EXPECT_NE(neg.winner()->hypothesis.kind, EffectKind::kCrosstalk) << neg.winner()->label;
   }
+}
+
+// A network that carries a share rho of its measured input over leaves
+// k y_s(t) - rho k y_s(t-1) of a cross-talk in its residual: the gain is
+// still k (with y_s(t) alone it read k (1 - rho corr(y_s(t), y_s(t-1)))).
+TEST(Attribution, CrosstalkGainSurvivesWhatTheNetworkCarriesOver) {
+  const Attribution xt = run(synthetic(7, [](ResidualLog& log) {
+    const Eigen::RowVectorXd source = log.y_hat.row(1) + log.r.row(1);
+    for (Eigen::Index j = 1; j < log.r.cols(); ++j) log.r(0, j) += 0.3 * (source(j) - 0.6 * source(j - 1));
+  }));
+  ASSERT_TRUE(xt.winner().has_value());
+  EXPECT_EQ(xt.winner()->hypothesis.kind, EffectKind::kCrosstalk);
+  EXPECT_EQ(xt.winner()->hypothesis.source, 1);
+  EXPECT_NEAR(xt.winner()->parameter, 0.3, 0.03);  // the same 10 % as the plain pick-up above
+}
+
+// Cross-talk sources by default: the target's group, and other groups in
+// its unit; a group without a declared unit only within itself.
+TEST(Attribution, CrosstalkSourcesAreTheGroupAndTheUnit) {
+  ResidualData d = synthetic(7, [](ResidualLog&) {});
+  d.y_names = {"f0", "f1", "fc0", "l0"};
+  d.y_units = channel_units("t=s f=N fc=N", d.y_names);
+  EXPECT_EQ(d.y_units, (std::vector<std::string>{"N", "N", "N", ""}));
+  EXPECT_EQ(channel_units("f=N f1=kN", {"f0", "f1", "x"}), (std::vector<std::string>{"N", "kN", ""}));
+  auto sources = [&](CrosstalkSources which, int target) {
+    std::set<int> out;
+    std::vector<Hypothesis> hs;
+    LibraryOptions o;
+    o.crosstalk_sources = which;
+    effect_info(EffectKind::kCrosstalk).enumerate(d, o, target, hs);
+    for (const auto& h : hs) out.insert(h.source);
+    return out;
+  };
+  EXPECT_EQ(sources(CrosstalkSources::kSameUnit, 2), (std::set<int>{0, 1}));  // fc0 <- f0, f1 (N)
+  EXPECT_EQ(sources(CrosstalkSources::kSameUnit, 3), (std::set<int>{}));      // l0: no unit, alone in its group
+  EXPECT_EQ(sources(CrosstalkSources::kSameGroup, 2), (std::set<int>{}));
+  EXPECT_EQ(sources(CrosstalkSources::kSameGroup, 0), (std::set<int>{1}));
+  EXPECT_EQ(sources(CrosstalkSources::kAll, 3), (std::set<int>{0, 1, 2}));
 }
 
 // A rail is where the signal sits: a channel's extreme reached in a few rows

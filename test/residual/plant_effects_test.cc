@@ -96,6 +96,28 @@ TEST(PlantEffects, CrosstalkIsNamedWithAPlantPairAndGain) {
   EXPECT_LT(w.parameter, 0.5) << w.label;
 }
 
+TEST(PlantEffects, TensionLeakIsNamedAcrossGroupsWithItsGain) {
+  // Plant: the palm loadcell fc6 adds 0.2 x tendon 5's tension (tension-leak=0.2), a cross-talk between
+  // groups of one unit (N): the default sources hold the pair.
+  Outcome o;
+  o.data = compute_residuals(build_model(), plant_logs("tension-leak=0.2"), "auto");
+  o.attribution = attribute(o.data, enumerate_hypotheses(o.data, {}), {});
+  ASSERT_TRUE(o.attribution.winner().has_value());
+  const auto w = *o.attribution.winner();
+  EXPECT_EQ(w.hypothesis.kind, EffectKind::kCrosstalk) << w.label;
+  EXPECT_EQ(name_of(o, w.hypothesis.source), "f5") << w.label;
+  EXPECT_EQ(name_of(o, w.hypothesis.target), "fc6") << w.label;
+  // The first coefficient is the gain itself (y_s(t) and y_s(t-1) are both regressors, so what the
+  // network carries over of the pick-up is not subtracted from it); bound: within 0.5x..1.5x.
+  EXPECT_GT(w.parameter, 0.1) << w.label;
+  EXPECT_LT(w.parameter, 0.3) << w.label;
+  // Only because tensions and loadcells share a unit (N): the target's group alone does not hold f5.
+  LibraryOptions same_group;
+  same_group.crosstalk_sources = CrosstalkSources::kSameGroup;
+  for (const auto& h : enumerate_hypotheses(o.data, same_group))
+    EXPECT_FALSE(h.kind == EffectKind::kCrosstalk && name_of(o, h.target) == "fc6" && name_of(o, h.source) == "f5");
+}
+
 // The winner is a load drift on a loadcell with a rate within 0.2x..1.5x
 // `plant_rate` (the 1-step residual keeps what the model does not carry over).
 void expect_load_drift_on_a_loadcell(const Outcome& o, double plant_rate) {

@@ -35,8 +35,9 @@ Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, c
   if (reference.empty()) {
     a.attribution = attribute(d, hypotheses, options.attribution);
   } else {
-    const ResidualData ref = compute_residuals(model, reference, options.pb_choice);
-    a.reference_pb = pb_summary(ref, options.pb_choice);
+    const std::string& ref_pb = options.reference_pb_choice.empty() ? options.pb_choice : options.reference_pb_choice;
+    const ResidualData ref = compute_residuals(model, reference, ref_pb);
+    a.reference_pb = pb_summary(ref, ref_pb);
     const NullCalibration null = calibrate_null(d, ref, hypotheses, options.attribution);
     a.attribution = attribute(d, hypotheses, options.attribution, &null);
   }

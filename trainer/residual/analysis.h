@@ -26,6 +26,10 @@ struct AnalysisOptions {
   // Where the reference logs came from, or why there are none, in words for
   // floors_summary() (e.g. "the model's held-out logs"); may be empty.
   std::string null_source;
+  // The PB rule for the reference logs (compute_residuals); empty: pb_choice.
+  // The model's stored held-out logs are rows of its trained states' own
+  // recordings, so their trained PBs are theirs ("state"): no PB check.
+  std::string reference_pb_choice;
 };
 
 // Everything the analysis computes.

@@ -301,7 +301,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   LibraryOptions lib;
   const std::vector<Hypothesis> hypotheses_after = enumerate_hypotheses(again, lib);
   if (options.reference != nullptr && !options.reference->empty()) {
-    ResidualData ref = compute_residuals(after.model, *options.reference, "auto");
+    ResidualData ref = compute_residuals(after.model, *options.reference, options.reference_pb_choice);
     drop_predicted_aux(ref);
     const NullCalibration null = calibrate_null(again, ref, hypotheses_after, attribution.options);
     result.after.verdict = verdict_text(attribute(again, hypotheses_after, attribution.options, &null));

@@ -51,6 +51,8 @@ struct FixOptions {
   // The calibrated null's logs of the analysis (analyse()'s reference), for
   // the augmented model's verdict; nullptr or empty: absolute floors.
   const std::vector<LogInput>* reference = nullptr;
+  // Their PB rule (compute_residuals): as AnalysisOptions::reference_pb_choice.
+  std::string reference_pb_choice = "auto";
 };
 
 struct Augmentation;

@@ -432,16 +432,42 @@ namespace crosstalk {
 void enumerate(const ResidualData& data, const LibraryOptions& options, int c, std::vector<Hypothesis>& out) {
   const int ny = static_cast<int>(data.y_names.size());
   const std::string group = channel_group(y_name(data, c));
+  const auto unit = [&](int i) {
+    return data.y_units.size() == data.y_names.size() ? data.y_units[static_cast<std::size_t>(i)] : std::string();
+  };
   for (int s = 0; s < ny; ++s) {
     if (s == c) continue;
-    if (options.crosstalk_same_group && channel_group(y_name(data, s)) != group) continue;
+    const bool same_group = channel_group(y_name(data, s)) == group;
+    const bool same_unit = !unit(c).empty() && unit(s) == unit(c);
+    switch (options.crosstalk_sources) {
+      case CrosstalkSources::kSameUnit:
+        if (!same_group && !same_unit) continue;
+        break;
+      case CrosstalkSources::kSameGroup:
+        if (!same_group) continue;
+        break;
+      case CrosstalkSources::kAll: break;
+    }
     out.push_back({EffectKind::kCrosstalk, c, s, 0, 0, 0});
   }
 }
 
-// y_s(t), the source's measured value.
+// y_s(t) and y_s(t-1), the source's measured value now and one row
+// earlier. The network starts from x_{t-1}, which holds the target as
+// measured, k y_s(t-1) included, and carries a share rho of it into its
+// prediction: the residual is k y_s(t) - rho k y_s(t-1), linear in the two
+// whatever rho is, and the first coefficient is the gain k itself (with
+// y_s(t) alone it was k (1 - rho corr) and the plant's 0.35 read as 0.25).
 Features features(const Hypothesis& h, const ResidualLog& log) {
-  return one_column(log.size(), [&](int j) { return log.seq.y(h.source, ResidualLog::row(j)); });
+  const int n = log.size();
+  Features f;
+  f.z.resize(n, 2);
+  for (int j = 0; j < n; ++j) {
+    const int t = ResidualLog::row(j);
+    f.z(j, 0) = log.seq.y(h.source, t);
+    f.z(j, 1) = log.seq.y(h.source, t - 1);
+  }
+  return f;
 }
 
 // A cross-talk picks up a fraction of its source. (A negative pick-up
@@ -608,8 +634,10 @@ const std::vector<EffectInfo>& effect_library() {
        SourceKind::kNone, saturation::enumerate, saturation::features, first_coefficient, positive,
        saturation::describe, saturation::plan},
       {EffectKind::kCrosstalk, "crosstalk",
-       "y_s(t): another channel's measured value (by default of the target's group) leaking into the target",
-       "gain: the fraction of y_s the target picks up",
+       "y_s(t) and y_s(t-1): another channel's measured value (by default of the target's group or unit) "
+       "leaking into the "
+       "target, and what the network carries over of it from x_{t-1}",
+       "gain: the fraction of y_s the target picks up (the coefficient of y_s(t))",
        "removal: train on y_c - k y_s (in y and x); the sensor model adds k times the predicted y_s back",
        SourceKind::kObserved, crosstalk::enumerate, crosstalk::features, first_coefficient, crosstalk::fraction,
        crosstalk::describe, crosstalk::plan},

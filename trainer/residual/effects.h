@@ -52,9 +52,23 @@ struct Features {
   int first_valid = 0;
 };
 
+// Cross-talk sources of a target channel c.
+enum class CrosstalkSources {
+  // The other channels of c's group, and the channels of any other group
+  // measured in c's unit (ResidualData::y_units; a channel without a
+  // declared unit only within its group): a sensor may pick up a channel of
+  // another group (a tendon's tension leaking into a palm loadcell), and a
+  // pick-up fraction (the gain's physical domain, 0..1) means something
+  // only between channels of one unit.
+  kSameUnit,
+  kSameGroup,  // the other channels of c's group only
+  kAll,        // every other y channel
+};
+
 struct LibraryOptions {
   int max_delay = 5;                // delays 1..max_delay steps
-  bool crosstalk_same_group = true; // cross-talk sources: channels of the target's group only
+  // Which y channels may be a cross-talk source of a target.
+  CrosstalkSources crosstalk_sources = CrosstalkSources::kSameUnit;
   // A rail is where a signal sits, not merely its extreme: a side of a
   // channel is a saturation candidate only when at least min_rail_share of
   // its rows (and at least 5) lie within rail_band of its range from the

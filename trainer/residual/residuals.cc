@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <sstream>
 #include <stdexcept>
 
 #include "trainer/hadynet_network.h"
@@ -140,11 +141,28 @@ Eigen::MatrixXd predict_windows(const HadynetModel& model, const LogSequence& se
   return out;
 }
 
+std::vector<std::string> channel_units(const std::string& units_text, const std::vector<std::string>& names) {
+  std::map<std::string, std::string> unit_of;
+  std::istringstream in(units_text);
+  for (std::string token; in >> token;) {
+    const auto eq = token.find('=');
+    if (eq != std::string::npos && eq > 0 && eq + 1 < token.size()) unit_of.emplace(token.substr(0, eq), token.substr(eq + 1));
+  }
+  std::vector<std::string> out;
+  for (const auto& name : names) {
+    auto it = unit_of.find(name);
+    if (it == unit_of.end()) it = unit_of.find(channel_group(name));
+    out.push_back(it == unit_of.end() ? std::string() : it->second);
+  }
+  return out;
+}
+
 ResidualData compute_residuals(const HadynetModel& model, const std::vector<LogInput>& logs,
                                const std::string& pb_choice) {
   if (logs.empty()) throw std::runtime_error("no logs");
   ResidualData data;
   data.y_names = model.layout.y_names;
+  data.y_units = channel_units(logs.front().table.metadata.get("units").value_or(""), data.y_names);
   data.u_names = model.layout.u_names;
   data.aux_names = common_aux_names(logs);
   data.y_scale = model.norm.y.std;

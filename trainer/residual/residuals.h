@@ -58,6 +58,9 @@ struct ResidualLog {
 
 struct ResidualData {
   std::vector<std::string> y_names, u_names, aux_names;
+  // The unit of each y channel from the first log's `units` metadata
+  // ("f=N fc=N": a key is a channel or its group); "" where none is declared.
+  std::vector<std::string> y_units;
   // The model's standardisation std of each y channel (physical units): a
   // residual variance divided by its square is in the units of the model's loss.
   Eigen::VectorXd y_scale;
@@ -69,6 +72,10 @@ struct LogInput {
   datalog::LogTable table;
   std::string file;
 };
+
+// The unit of each of `names` in a log's `units` metadata text ("t=s f=N
+// fc=N": the channel's own key, else its group's); "" where none is given.
+std::vector<std::string> channel_units(const std::string& units_text, const std::vector<std::string>& names);
 
 // The aux_* columns present in every one of `logs`, in the first log's order:
 // ResidualData::aux_names of compute_residuals(logs).
