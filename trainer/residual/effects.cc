@@ -457,7 +457,10 @@ void enumerate(const ResidualData& data, const LibraryOptions& options, int c, s
 // measured, k y_s(t-1) included, and carries a share rho of it into its
 // prediction: the residual is k y_s(t) - rho k y_s(t-1), linear in the two
 // whatever rho is, and the first coefficient is the gain k itself (with
-// y_s(t) alone it was k (1 - rho corr) and the plant's 0.35 read as 0.25).
+// y_s(t) alone it reads k (1 - rho corr(y_s(t), y_s(t-1)))). Measured on
+// the plant (docs/residual.md): f5 -> fc6 at 0.2 reads 0.19-0.22; a
+// fingertip pair at 0.35 still reads 0.25, as with y_s(t) alone: there the
+// model's own coupling of neighbouring fingertips absorbs part of it.
 Features features(const Hypothesis& h, const ResidualLog& log) {
   const int n = log.size();
   Features f;
