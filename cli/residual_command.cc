@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 
 #include "cli/commands.h"
@@ -17,6 +18,7 @@
 #include "cli/residual_fix_report.h"
 #include "cli/residual_report.h"
 #include "datalog/log_reader.h"
+#include "datalog/robot_profile.h"
 #include "trainer/held_out_logs.h"
 #include "trainer/model_file.h"
 #include "trainer/residual/analysis.h"
@@ -194,6 +196,9 @@ int run_residual(int argc, char** argv) {
                "whose rows are in a log under test is left out); none: no null, absolute floors");
   opt.value("min-excess-null", "S", "with a null: how many times its channel's clean residual level an effect must\n"
                                      "explain beyond the null", num("%g", rs::kDefaultMinExcessNull));
+  opt.value("absolute-inputs", "GROUPS",
+            "command groups whose commands are levels (a position or voltage set point), not motions, e.g. u:\n"
+            "friction then follows their change (default: the logs' absolute_groups metadata; none: no group)");
   opt.value("crosstalk-sources", "unit|group|all",
             "cross-talk sources of a channel: the other channels of its group and those of any group\n"
             "measured in its unit (the logs' `units` metadata) (unit), its group only (group), or every\n"
@@ -255,6 +260,15 @@ int run_residual(int argc, char** argv) {
                  crosstalk_sources.c_str());
     return 2;
   }
+  std::optional<std::vector<std::string>> absolute_groups;
+  if (opt.has("absolute-inputs")) {
+    try {
+      absolute_groups = datalog::split_list(opt.get("absolute-inputs"));
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "hadynet residual: --absolute-inputs: %s\n", e.what());
+      return 2;
+    }
+  }
   const auto fix_epochs = opt.get_int("fix-epochs", 1, 100000);
   const auto fix_lr = opt.get_double("fix-lr", 1e-12, 10.0);
   const auto fix_seed = opt.get_int("fix-seed", 0, (1ll << 62));
@@ -305,6 +319,7 @@ int run_residual(int argc, char** argv) {
     ao.horizon = horizon ? static_cast<int>(*horizon) : 0;
     ao.max_lag = static_cast<int>(*max_lag);
     ao.library.max_delay = static_cast<int>(*max_delay);
+    ao.library.absolute_groups = absolute_groups;
     ao.library.crosstalk_sources = crosstalk_sources == "group" ? rs::CrosstalkSources::kSameGroup
                                    : crosstalk_sources == "all" ? rs::CrosstalkSources::kAll
                                                                 : rs::CrosstalkSources::kSameUnit;

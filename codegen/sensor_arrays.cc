@@ -29,8 +29,14 @@ SensorArrays sensor_arrays(const trainer::HadynetModel& model, bool q15, int fra
     const auto it = std::find(u.begin(), u.end(), d->base);
     if (it == u.end()) reject("derived input '" + u[i] + "': no command '" + d->base + "' in the model");
     if (trainer::parse_derived_input(d->base)) reject("derived input '" + u[i] + "' is derived from a derived input");
-    a.derived.push_back(d->kind == trainer::DerivedKind::kSign ? "hadynet::firmware::DerivedKind::kSign"
-                                                               : "hadynet::firmware::DerivedKind::kHysteresis");
+    switch (d->kind) {
+      case trainer::DerivedKind::kSign: a.derived.push_back("hadynet::firmware::DerivedKind::kSign"); break;
+      case trainer::DerivedKind::kHysteresis: a.derived.push_back("hadynet::firmware::DerivedKind::kHysteresis"); break;
+      case trainer::DerivedKind::kChangeSign: a.derived.push_back("hadynet::firmware::DerivedKind::kChangeSign"); break;
+      case trainer::DerivedKind::kChangeHysteresis:
+        a.derived.push_back("hadynet::firmware::DerivedKind::kChangeHysteresis");
+        break;
+    }
     a.derived_base.push_back(std::to_string(it - u.begin()));
   }
   const trainer::SensorModel& s = model.sensor;

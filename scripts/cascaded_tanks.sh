@@ -10,7 +10,8 @@
 #   * the residual loop (`hadynet residual --fix`) on the validation record,
 #     and what it finds about the overflow at 10 V (the level sensor's rail):
 #     the rows at the rail, the model's own highest prediction, the rail
-#     hypotheses.
+#     hypotheses; and friction on the pump voltage's change (the logs
+#     declare u an absolute input: absolute_groups=u).
 # Data sets: training = the estimation record's first 90 % of windows (seed
 # 1); the residual loop's null = the rest of the estimation record, which
 # train holds out and stores in the model (no training window touches it);
@@ -35,9 +36,9 @@ summary="$out/summary.txt"
 
 echo "[1/4] import" >&2
 "$hadynet" import "$data" --out "$out/train/est.csv" --column uEst=u0 --column yEst=y0 --dt 4 --state tanks \
-  --meta "units=t=s u=V y=V" >&2
+  --meta "units=t=s u=V y=V" --meta absolute_groups=u >&2
 "$hadynet" import "$data" --out "$out/val.csv" --column uVal=u0 --column yVal=y0 --dt 4 --state tanks \
-  --meta "units=t=s u=V y=V" >&2
+  --meta "units=t=s u=V y=V" --meta absolute_groups=u >&2
 echo "[2/4] train ($epochs epochs on the estimation record)" >&2
 "$hadynet" train "$out/train" --out "$out/tanks.safetensors" --epochs "$epochs" --seed 1 --quiet >&2
 echo "[3/4] free-run simulation of the validation record" >&2
@@ -70,7 +71,8 @@ j = json.load(open(f"{out}/residual/residual.json"))
 print("residual " + j["attribution"]["floors"])
 print("residual verdict:", j["verdict"])
 for h in j["attribution"]["ranked"]:
-    if h["effect"] == "saturation":
+    # The rail, and friction on the pump voltage's change (an absolute input: absolute_groups=u).
+    if h["effect"] in ("saturation", "friction"):
         print(f"  {h['label']}: testable {h['testable']}, held-out explained {h['explained']:.3f}, p(Holm) {h['p_adjusted']:.2g}")
 fix = j.get("fix", {})
 print("fix:", fix.get("status", "-"))

@@ -1,18 +1,24 @@
 #include "trainer/derived_inputs.h"
 
+#include <array>
+#include <utility>
+
 namespace hadynet::trainer {
 
 namespace {
 
-constexpr const char* kSignPrefix = "sign_";
-constexpr const char* kHystPrefix = "hyst_";
+// Prefix of each kind's channel name, in DerivedKind order.
+constexpr std::array<std::pair<const char*, DerivedKind>, 4> kPrefixes = {{{"sign_", DerivedKind::kSign},
+                                                                           {"hyst_", DerivedKind::kHysteresis},
+                                                                           {"dsign_", DerivedKind::kChangeSign},
+                                                                           {"dhyst_", DerivedKind::kChangeHysteresis}}};
 
 double sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
 
 }  // namespace
 
 std::optional<DerivedInput> parse_derived_input(const std::string& name) {
-  for (const auto& [prefix, kind] : {std::pair{kSignPrefix, DerivedKind::kSign}, {kHystPrefix, DerivedKind::kHysteresis}}) {
+  for (const auto& [prefix, kind] : kPrefixes) {
     const std::string p = prefix;
     if (name.size() > p.size() && name.compare(0, p.size(), p) == 0) return DerivedInput{kind, name.substr(p.size())};
   }
@@ -20,7 +26,20 @@ std::optional<DerivedInput> parse_derived_input(const std::string& name) {
 }
 
 std::string derived_input_name(const DerivedInput& d) {
-  return (d.kind == DerivedKind::kSign ? kSignPrefix : kHystPrefix) + d.base;
+  return kPrefixes[static_cast<std::size_t>(d.kind)].first + d.base;
+}
+
+std::vector<double> derived_input_values(DerivedKind kind, const std::vector<double>& base) {
+  const bool of_change = kind == DerivedKind::kChangeSign || kind == DerivedKind::kChangeHysteresis;
+  const bool hysteresis = kind == DerivedKind::kHysteresis || kind == DerivedKind::kChangeHysteresis;
+  std::vector<double> out(base.size());
+  double state = 0;
+  for (std::size_t t = 0; t < base.size(); ++t) {
+    const double s = of_change ? (t == 0 ? 0.0 : sign(base[t] - base[t - 1])) : sign(base[t]);
+    if (s != 0) state = s;
+    out[t] = hysteresis ? state : s;
+  }
+  return out;
 }
 
 std::optional<std::vector<double>> derived_input_column(const datalog::LogTable& table, const std::string& name) {
@@ -28,14 +47,9 @@ std::optional<std::vector<double>> derived_input_column(const datalog::LogTable&
   if (!d) return std::nullopt;
   const auto base = table.column_index(d->base);
   if (!base) return std::nullopt;
-  std::vector<double> out(table.rows());
-  double state = 0;
-  for (std::size_t t = 0; t < table.rows(); ++t) {
-    const double s = sign(table.at(t, *base));
-    if (s != 0) state = s;
-    out[t] = d->kind == DerivedKind::kSign ? s : state;
-  }
-  return out;
+  std::vector<double> values(table.rows());
+  for (std::size_t t = 0; t < table.rows(); ++t) values[t] = table.at(t, *base);
+  return derived_input_values(d->kind, values);
 }
 
 }  // namespace hadynet::trainer

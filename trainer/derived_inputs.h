@@ -4,9 +4,16 @@
 //   sign_<c>   is sign(u_c(t))                         (-1, 0 or +1)
 //   hyst_<c>   is the hysteresis state of u_c at t:     the sign of the last
 //              non-zero u_c(s), s <= t; 0 before the first one
-// for a command column <c> of the log. Both are causal: row t uses rows <= t
-// only, so a host (or the firmware) can compute them from the commands it has
-// sent. log_sequence() computes them when a log lacks the column.
+//   dsign_<c>  is sign(u_c(t) - u_c(t-1)), 0 in the first row: the direction
+//              an absolute command (a position or voltage set point) moves
+//   dhyst_<c>  is the sign of the last non-zero change of u_c up to t; 0
+//              before the first
+// for a command column <c> of the log: sign_/hyst_ for incremental commands
+// (a command is a motion), dsign_/dhyst_ for absolute ones (a command is a
+// level; docs/residual.md, "Absolute inputs"). All are causal: row t uses
+// rows <= t only, so a host (or the firmware) can compute them from the
+// commands it has sent. log_sequence() computes them when a log lacks the
+// column.
 #pragma once
 
 #include <optional>
@@ -17,17 +24,20 @@
 
 namespace hadynet::trainer {
 
-enum class DerivedKind { kSign, kHysteresis };
+enum class DerivedKind { kSign, kHysteresis, kChangeSign, kChangeHysteresis };
 
 struct DerivedInput {
   DerivedKind kind;
   std::string base;  // the command column it is computed from, e.g. "u0"
 };
 
-// The derivation a channel name states ("sign_u0", "hyst_u0"); none for any
-// other name.
+// The derivation a channel name states ("sign_u0", "hyst_u0", "dsign_u0",
+// "dhyst_u0"); none for any other name.
 std::optional<DerivedInput> parse_derived_input(const std::string& name);
 std::string derived_input_name(const DerivedInput& d);
+
+// The derived values of a base command series, row by row (as above).
+std::vector<double> derived_input_values(DerivedKind kind, const std::vector<double>& base);
 
 // The channel's value in every row of `table`; none if `name` is not a
 // derived name or the table has no column `base`.

@@ -78,6 +78,8 @@ enum class DerivedKind : std::uint8_t {
   kNone = 0,        // a command
   kSign = 1,        // sign(u_base): -1, 0, +1
   kHysteresis = 2,  // sign of the last non-zero u_base (0 before the first)
+  kChangeSign = 3,        // sign(u_base - u_base of the previous frame); 0 in the first frame
+  kChangeHysteresis = 4,  // sign of the last non-zero change of u_base (0 before the first)
 };
 
 // clang-format off

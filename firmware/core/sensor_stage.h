@@ -5,7 +5,9 @@
 //
 //   measured frame -> model frame (to_model):
 //     derived commands: sign(u_base) and the hysteresis state (the sign of
-//       the last non-zero u_base, kept here), overwriting the frame's values;
+//       the last non-zero u_base, kept here), or the same of u_base's change
+//       from the previous frame (an absolute command; the previous value is
+//       kept here), overwriting the frame's values;
 //     drift: D_c += |y_c| kSensorPeriod (load) or kSensorPeriod (time), then
 //       y1_c = y_c - rate D_c;
 //     cross-talk: y'_c = y1_c - gain y1_s (the source after the drift step).
@@ -37,6 +39,8 @@ class SensorStage {
   void reset() noexcept {
     for (float& d : driver_) d = 0.0f;
     for (float& h : hysteresis_) h = 0.0f;
+    for (float& b : previous_base_) b = 0.0f;
+    frames_ = 0;
   }
 
   // A measured frame (y_t, u_{t-1}; physical) in the model's frame.
@@ -44,7 +48,14 @@ class SensorStage {
                 float (&u_model)[kU]) noexcept {
     for (int i = 0; i < kU; ++i) {
       const float base = u_prev[M::kUDerivedBase[i]];
-      const float sign = base > 0.0f ? 1.0f : (base < 0.0f ? -1.0f : 0.0f);
+      const float sign = sign_of(base);
+      // The change from the previous frame's base, compared, not subtracted
+      // (the trainer's double difference has the same sign). A frame carries
+      // u_{t-1}: the first frame after reset() carries no command yet, and
+      // the first command (the second frame) has no change, as the
+      // trainer's row 0 of a log.
+      const float change = frames_ < 2 ? 0.0f : sign_of_difference(base, previous_base_[i]);
+      previous_base_[i] = base;
       switch (M::kUDerived[i]) {
         case DerivedKind::kNone: u_model[i] = u_prev[i]; break;
         case DerivedKind::kSign: u_model[i] = sign; break;
@@ -52,8 +63,14 @@ class SensorStage {
           if (sign != 0.0f) hysteresis_[i] = sign;
           u_model[i] = hysteresis_[i];
           break;
+        case DerivedKind::kChangeSign: u_model[i] = change; break;
+        case DerivedKind::kChangeHysteresis:
+          if (change != 0.0f) hysteresis_[i] = change;
+          u_model[i] = hysteresis_[i];
+          break;
       }
     }
+    if (frames_ < 2) ++frames_;
     float drifted[kY];
     for (int i = 0; i < kY; ++i) drifted[i] = y[i];
     for (int k = 0; k < M::kDriftCount; ++k) {
@@ -101,10 +118,17 @@ class SensorStage {
     return M::kDriftIsLoad[k] ? driver_[k] : driver_[k] - M::kSensorPeriod;
   }
 
+  static constexpr float sign_of(float v) noexcept { return v > 0.0f ? 1.0f : (v < 0.0f ? -1.0f : 0.0f); }
+  static constexpr float sign_of_difference(float a, float b) noexcept {
+    return a > b ? 1.0f : (a < b ? -1.0f : 0.0f);
+  }
+
   static constexpr int kDrifts = M::kDriftCount > 0 ? M::kDriftCount : 1;
   const ModelTensors<M>* t_;
   float driver_[kDrifts] = {};
   float hysteresis_[kU] = {};
+  float previous_base_[kU] = {};  // per u slot: its base command in the previous frame
+  int frames_ = 0;                // frames since reset(), counted up to 2
 };
 
 }  // namespace hadynet::firmware

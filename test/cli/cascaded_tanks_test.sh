@@ -33,3 +33,8 @@ grep -q "rows at the 10 V rail" <<<"$out" && grep -q "^residual verdict:" <<<"$o
 # the hand, two orders of magnitude above this model's whole residual).
 grep -q "^residual floors: calibrated null of 1 reference logs (the model's held-out logs" <<<"$out" \
   || { echo "FAIL: the residual loop had no calibrated null: $(grep '^residual floors' <<<"$out")"; exit 1; }
+# The pump voltage is a level (the logs declare absolute_groups: u): friction
+# on its change is tested (before: "not testable", sign(u) of a voltage that
+# never crosses 0 being constant).
+grep -q "^  friction on y0 with the motion of u0 (absolute: its change): .*testable True" <<<"$out" \
+  || { echo "FAIL: friction on the pump voltage's change was not tested: $(grep '^  friction' <<<"$out")"; exit 1; }

@@ -33,10 +33,13 @@ const trainer::HadynetModel& fixed_model() {
 TEST(FixedModelHeader, CarriesTheDerivedInputsAndTheSensorModel) {
   const auto& m = fixed_model();
   ASSERT_EQ(F::kU, m.params.dims.u);
-  EXPECT_EQ(F::kU, test::build_model().params.dims.u + 2);
-  EXPECT_EQ(F::kUDerived[F::kU - 2], firmware::DerivedKind::kSign);
-  EXPECT_EQ(F::kUDerived[F::kU - 1], firmware::DerivedKind::kHysteresis);
-  EXPECT_EQ(F::kUDerivedBase[F::kU - 1], 0);
+  EXPECT_EQ(F::kU, test::build_model().params.dims.u + 4);
+  EXPECT_EQ(F::kUDerived[F::kU - 4], firmware::DerivedKind::kSign);
+  EXPECT_EQ(F::kUDerived[F::kU - 3], firmware::DerivedKind::kHysteresis);
+  EXPECT_EQ(F::kUDerivedBase[F::kU - 3], 0);
+  EXPECT_EQ(F::kUDerived[F::kU - 2], firmware::DerivedKind::kChangeSign);
+  EXPECT_EQ(F::kUDerived[F::kU - 1], firmware::DerivedKind::kChangeHysteresis);
+  EXPECT_EQ(F::kUDerivedBase[F::kU - 1], 1);
   EXPECT_FALSE(F::kControlActive[F::kU - 1]);  // never set by the stabiliser
   EXPECT_EQ(F::kCrosstalkCount, 1);
   EXPECT_EQ(F::kDriftCount, 1);
@@ -150,8 +153,10 @@ TEST(FixedModelRuntime, ControlModeRunsWithDerivedInputsHeld) {
     const auto r = rt->step(f);
     if (t < 1) continue;
     ASSERT_TRUE(r.command_valid) << t;
-    // The derived inputs are reported at their held value (-1, standardised back).
-    EXPECT_NEAR(r.command[Q::kU - 1], -1.0f, 0.01f) << t;
+    // The derived inputs are reported at their held value (hyst_u0 -1, standardised back; u1 never
+    // changes: dhyst_u1 0).
+    EXPECT_NEAR(r.command[Q::kU - 3], -1.0f, 0.01f) << t;
+    EXPECT_NEAR(r.command[Q::kU - 1], 0.0f, 0.01f) << t;
     for (float v : r.command) EXPECT_TRUE(std::isfinite(v));
   }
 }

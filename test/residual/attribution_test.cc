@@ -94,6 +94,53 @@ TEST(Attribution, FrictionWinsWithItsMuscleAndMagnitude) {
   EXPECT_NEAR(w.parameter, -0.3, 0.03);  // 10 %: noise sd 0.1 over ~500 training samples
 }
 
+// An absolute command (a level: here u1 made a set point that rises and
+// falls from 2, never crossing 0) moves when it changes: friction follows the
+// sign of its change and that change's hysteresis state, not its own sign.
+TEST(Attribution, FrictionOfAnAbsoluteCommandFollowsItsChange) {
+  const auto levels = [](ResidualLog& log) {
+    double level = 2;
+    for (Eigen::Index t = 0; t < log.seq.u.cols(); ++t) log.seq.u(1, t) = level += 0.2 * log.seq.u(1, t);
+  };
+  const ResidualData d = synthetic(5, [&](ResidualLog& log) {
+    levels(log);
+    double state = 0;
+    for (Eigen::Index j = 0; j < log.r.cols(); ++j) {
+      const Eigen::Index t = ResidualLog::row(static_cast<int>(j));
+      const double change = log.seq.u(1, t - 1) - log.seq.u(1, t - 2);
+      if (change != 0) state = change > 0 ? 1 : -1;
+      log.r(0, j) += -0.3 * state;
+    }
+  });
+  ASSERT_GT(d.logs.front().seq.u.row(1).minCoeff(), 0.0);
+  // Declared absolute (the logs' absolute_groups, or the option): named, with the magnitude.
+  for (const bool by_option : {false, true}) {
+    ResidualData declared = d;
+    LibraryOptions o;
+    if (by_option)
+      o.absolute_groups = std::vector<std::string>{"u"};
+    else
+      declared.u_absolute = {false, true};
+    const Attribution a = attribute(declared, enumerate_hypotheses(declared, o), {});
+    ASSERT_TRUE(a.winner().has_value());
+    const auto w = *a.winner();
+    EXPECT_EQ(w.hypothesis.kind, EffectKind::kFriction) << w.label;
+    EXPECT_EQ(w.hypothesis.source, 1) << w.label;
+    EXPECT_TRUE(w.hypothesis.of_change) << w.label;
+    EXPECT_NEAR(w.parameter, -0.3, 0.03) << w.label;  // as the incremental case above
+  }
+  // Undeclared, u1's sign is +1 throughout: its friction is not testable (the screen names an input
+  // delay instead, whose regressors u(t-1-d) - u(t-1) hold the change).
+  const Attribution undeclared = run(d);
+  for (const auto& r : undeclared.ranked)
+    if (r.hypothesis.kind == EffectKind::kFriction && r.hypothesis.source == 1) {
+      EXPECT_FALSE(r.testable) << r.label;
+    }
+  if (undeclared.winner()) {
+    EXPECT_NE(undeclared.winner()->hypothesis.kind, EffectKind::kFriction);
+  }
+}
+
 TEST(Attribution, AuxChannelAndCrosstalkWin) {
   const Attribution aux = run(synthetic(6, [](ResidualLog& log) {
     for (Eigen::Index j = 0; j < log.r.cols(); ++j) log.r(1, j) += 0.4 * log.aux(0, ResidualLog::row(static_cast<int>(j)));

@@ -37,6 +37,19 @@ TEST(DerivedInputs, SignAndHysteresisOfACommand) {
   EXPECT_EQ(derived_input_name(*d), "sign_u12");
 }
 
+TEST(DerivedInputs, SignAndHysteresisOfAnAbsoluteCommandsChange) {
+  const auto t = table({"y0", "u0"}, {{0, 2}, {0, 2.5}, {0, 2.5}, {0, 1}, {0, 1}, {0, 1.5}});
+  // 0 in the first row (no change yet), then the sign of u0(t) - u0(t-1).
+  EXPECT_EQ(*derived_input_column(t, "dsign_u0"), (std::vector<double>{0, 1, 0, -1, 0, 1}));
+  EXPECT_EQ(*derived_input_column(t, "dhyst_u0"), (std::vector<double>{0, 1, 1, -1, -1, 1}));
+  const auto d = parse_derived_input("dhyst_u3");
+  ASSERT_TRUE(d.has_value());
+  EXPECT_EQ(d->kind, DerivedKind::kChangeHysteresis);
+  EXPECT_EQ(d->base, "u3");
+  EXPECT_EQ(derived_input_name(*d), "dhyst_u3");
+  EXPECT_EQ(parse_derived_input("dsign_u3")->kind, DerivedKind::kChangeSign);
+}
+
 TEST(DerivedInputs, LogSequenceComputesTheMissingColumnOnly) {
   const auto t = table({"y0", "u0"}, {{1, 0}, {2, -1}, {3, 0}});
   const FeatureLayout layout = feature_layout_from_names({"y0"}, {"u0", "hyst_u0"}, {});

@@ -5,6 +5,7 @@
 #include "trainer/residual/effects.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -17,8 +18,6 @@
 namespace hadynet::trainer::residual {
 
 namespace {
-
-double sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
 
 std::string fmt(const char* format, double v) {
   char buf[64];
@@ -184,25 +183,38 @@ namespace {
 // ---- friction: dry friction / hysteresis driven by the motion of muscle `source` ----
 namespace friction {
 
-void enumerate(const ResidualData& data, const LibraryOptions&, int c, std::vector<Hypothesis>& out) {
+void enumerate(const ResidualData& data, const LibraryOptions& options, int c, std::vector<Hypothesis>& out) {
   const int nu = static_cast<int>(data.u_names.size());
-  for (int m = 0; m < nu; ++m) out.push_back({EffectKind::kFriction, c, m, 0, 0, 0});
+  const std::vector<bool> absolute =
+      options.absolute_groups ? channels_in_groups(data.u_names, *options.absolute_groups) : data.u_absolute;
+  for (int m = 0; m < nu; ++m) {
+    Hypothesis h{EffectKind::kFriction, c, m, 0, 0, 0};
+    h.of_change = static_cast<std::size_t>(m) < absolute.size() && absolute[static_cast<std::size_t>(m)];
+    out.push_back(h);
+  }
 }
 
-// sign(u_m(t - 1)) and the hysteresis state h_m(t) (sign of the last non-zero command).
+// The derived inputs of muscle m's motion: the sign and the hysteresis state
+// of its command (incremental) or of its command's change (absolute).
+std::array<DerivedKind, 2> motion_inputs(const Hypothesis& h) {
+  if (h.of_change) return {DerivedKind::kChangeSign, DerivedKind::kChangeHysteresis};
+  return {DerivedKind::kSign, DerivedKind::kHysteresis};
+}
+
+// The motion's sign and hysteresis state at row t - 1: sign(u_m(t-1)) and the
+// sign of the last non-zero u_m up to t - 1, or the same of u_m's change for
+// an absolute command; the values --fix's derived inputs take there.
 Features features(const Hypothesis& h, const ResidualLog& log) {
   const int n = log.size();
   Features f;
   f.z = Eigen::MatrixXd::Zero(n, 2);
   const auto m = static_cast<Eigen::Index>(h.source);
-  double state = 0;
-  int next_row = 0;  // rows of u folded into `state` so far
-  for (int j = 0; j < n; ++j) {
-    const int t = ResidualLog::row(j);
-    for (; next_row <= t - 1; ++next_row)
-      if (log.seq.u(m, next_row) != 0) state = sign(log.seq.u(m, next_row));
-    f.z(j, 0) = sign(log.seq.u(m, t - 1));
-    f.z(j, 1) = state;
+  std::vector<double> u(static_cast<std::size_t>(log.seq.u.cols()));
+  for (std::size_t t = 0; t < u.size(); ++t) u[t] = log.seq.u(m, static_cast<Eigen::Index>(t));
+  const auto kinds = motion_inputs(h);
+  for (int k = 0; k < 2; ++k) {
+    const std::vector<double> v = derived_input_values(kinds[static_cast<std::size_t>(k)], u);
+    for (int j = 0; j < n; ++j) f.z(j, k) = v[static_cast<std::size_t>(ResidualLog::row(j) - 1)];
   }
   return f;
 }
@@ -211,8 +223,8 @@ Features features(const Hypothesis& h, const ResidualLog& log) {
 double offset(const Eigen::VectorXd& coef) { return coef.size() >= 2 ? coef(0) + coef(1) : coef(0); }
 
 std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
-  return "friction on " + y_name(data, h.target) + " with the motion of " + source_name(h, data) + ": " +
-         fmt("%+.3g", p) + " while it moves +";
+  return "friction on " + y_name(data, h.target) + " with the motion of " + source_name(h, data) +
+         (h.of_change ? " (absolute: its change)" : "") + ": " + fmt("%+.3g", p) + " while it moves +";
 }
 
 void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
@@ -221,11 +233,10 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   for (const auto& r : attribution.family_of(w)) {
     a.channels.push_back(y_name(data, r.hypothesis.target));
     const std::string m = source_name(r.hypothesis, data);
-    if (std::find(muscles.begin(), muscles.end(), m) == muscles.end()) muscles.push_back(m);
+    if (std::find(muscles.begin(), muscles.end(), m) != muscles.end()) continue;
+    muscles.push_back(m);
+    for (const DerivedKind k : motion_inputs(r.hypothesis)) change.inputs.push_back(derived_input_name({k, m}));
   }
-  for (const auto& m : muscles)
-    for (const DerivedKind k : {DerivedKind::kSign, DerivedKind::kHysteresis})
-      change.inputs.push_back(derived_input_name({k, m}));
   a.description = "add the hysteresis state of " + join(muscles) + " as inputs (" + join(change.inputs) +
                   "; friction on " + join(a.channels) + ")";
   a.found_on = a.channels;

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,9 @@ struct Hypothesis {
   int delay = 0;       // steps (delays); 0 for the other effects (a family shares it: attribution.h)
   int side = 0;        // saturation: +1 upper rail, -1 lower rail; 0 for the other effects
   double rail = 0;     // saturation: the rail, target units
+  // friction: the source is an absolute command, so its motion is its change
+  // (regressors and inputs of u's change: derived_inputs.h dsign_/dhyst_)
+  bool of_change = false;
 };
 
 // Regressors of a hypothesis for one log, aligned with the log's residual
@@ -67,6 +71,9 @@ enum class CrosstalkSources {
 
 struct LibraryOptions {
   int max_delay = 5;                // delays 1..max_delay steps
+  // The absolute command groups (ResidualData::u_absolute); nullopt: as the
+  // logs' `absolute_groups` metadata says.
+  std::optional<std::vector<std::string>> absolute_groups;
   // Which y channels may be a cross-talk source of a target.
   CrosstalkSources crosstalk_sources = CrosstalkSources::kSameUnit;
   // A rail is where a signal sits, not merely its extreme: a side of a

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "datalog/robot_profile.h"
 #include "trainer/hadynet_network.h"
 #include "trainer/model_frame.h"
 #include "trainer/output_clip.h"
@@ -157,13 +158,26 @@ std::vector<std::string> channel_units(const std::string& units_text, const std:
   return out;
 }
 
+std::vector<bool> channels_in_groups(const std::vector<std::string>& u_names, const std::vector<std::string>& groups) {
+  std::vector<bool> out;
+  for (const auto& name : u_names)
+    out.push_back(std::find(groups.begin(), groups.end(), channel_group(name)) != groups.end());
+  return out;
+}
+
 ResidualData compute_residuals(const HadynetModel& model, const std::vector<LogInput>& logs,
                                const std::string& pb_choice) {
   if (logs.empty()) throw std::runtime_error("no logs");
   ResidualData data;
   data.y_names = model.layout.y_names;
-  data.y_units = channel_units(logs.front().table.metadata.get("units").value_or(""), data.y_names);
   data.u_names = model.layout.u_names;
+  data.y_units = channel_units(logs.front().table.metadata.get("units").value_or(""), data.y_names);
+  try {
+    data.u_absolute = channels_in_groups(
+        data.u_names, datalog::split_list(logs.front().table.metadata.get("absolute_groups").value_or("")));
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(logs.front().file + ": metadata 'absolute_groups': " + e.what());
+  }
   data.aux_names = common_aux_names(logs);
   data.y_scale = model.norm.y.std;
 

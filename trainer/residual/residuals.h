@@ -61,6 +61,12 @@ struct ResidualData {
   // The unit of each y channel from the first log's `units` metadata
   // ("f=N fc=N": a key is a channel or its group); "" where none is declared.
   std::vector<std::string> y_units;
+  // Per u channel: an absolute command (a level: a position or voltage set
+  // point, whose change is the motion) rather than an incremental one (the
+  // hand's: a command is a motion). From the first log's `absolute_groups`
+  // metadata (u groups, e.g. "u"); LibraryOptions::absolute_groups
+  // overrides it. Empty: every command is incremental.
+  std::vector<bool> u_absolute;
   // The model's standardisation std of each y channel (physical units): a
   // residual variance divided by its square is in the units of the model's loss.
   Eigen::VectorXd y_scale;
@@ -76,6 +82,9 @@ struct LogInput {
 // The unit of each of `names` in a log's `units` metadata text ("t=s f=N
 // fc=N": the channel's own key, else its group's); "" where none is given.
 std::vector<std::string> channel_units(const std::string& units_text, const std::vector<std::string>& names);
+
+// Which of `u_names` are in one of `groups` (channel_group()).
+std::vector<bool> channels_in_groups(const std::vector<std::string>& u_names, const std::vector<std::string>& groups);
 
 // The aux_* columns present in every one of `logs`, in the first log's order:
 // ResidualData::aux_names of compute_residuals(logs).
