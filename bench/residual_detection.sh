@@ -21,7 +21,10 @@
 # others). With a calibrated null (--reference-seed 270, the clean sets of
 # that seed): seeds 291-300; its floor was chosen on development effect
 # logs of seeds 181-184. With the model's stored held-out logs as the null
-# (the default since models store them): seeds 331-340.
+# (the default since models store them): seeds 331-340. Cross-talk sources
+# of the target's unit (the default since; tension-leak added): seeds 351-358
+# development (the strengths 0.1 and 0.2 chosen there: 0.02 and 0.05 were
+# never significant), 381-390 measured.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...

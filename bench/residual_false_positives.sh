@@ -18,7 +18,10 @@
 # null and 13-16 (clean) the development logs its floor was chosen on;
 # seed 270 is the null of the measurement and 271-290 the measured sets.
 # With the model's stored held-out logs as the null (the default since
-# models store them): 311-330 the measured sets. Give others as arguments.
+# models store them): 311-330 the measured sets. Cross-talk sources of the
+# target's unit and the pair of regressors y_s(t), y_s(t-1) (the defaults
+# since): 341-350 development (both against the earlier rule), 361-380 the
+# measured sets. Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
 #          [--reference-seed S] [SEED...]

@@ -8,7 +8,8 @@
 # has no static nonlinearity; the nearest classes are a gain (none), a rail,
 # a drift or a cross-talk. Run with the plant's rated ranges.
 # Seeds: 221-230 (never used elsewhere; see bench/residual_false_positives.sh);
-# with the calibrated null of seed 270 (--reference-seed 270): 301-310.
+# with the calibrated null of seed 270 (--reference-seed 270): 301-310; with
+# the stored null and cross-talk sources of the target's unit: 391-400.
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S]

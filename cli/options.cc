@@ -38,7 +38,14 @@ std::string Options::help_text() const {
     const Spec& s = specs_.at(name);
     std::string left = "  --" + name + (s.takes_value ? " " + s.metavar : "");
     if (left.size() < 26) left.resize(26, ' '); else left += "\n" + std::string(26, ' ');
-    out += left + s.help;
+    // A help text's own line breaks continue in the help column (lines it
+    // indents itself stay as they are).
+    std::string help;
+    for (std::size_t i = 0; i < s.help.size(); ++i) {
+      help += s.help[i];
+      if (s.help[i] == '\n' && i + 1 < s.help.size() && s.help[i + 1] != ' ') help += std::string(26, ' ');
+    }
+    out += left + help;
     if (s.default_value) out += " (default: " + *s.default_value + ")";
     if (s.repeatable) out += " (repeatable)";
     out += "\n";
