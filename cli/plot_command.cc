@@ -23,11 +23,8 @@ std::string plot_script(const datalog::LogTable& log, const datalog::ChannelLayo
   if (layout.aux) groups.push_back(*layout.aux);
   const std::string units = log.metadata.get("units").value_or("");
   auto unit_of = [&](const std::string& prefix) -> std::string {
-    const std::string key = prefix + "=";
-    const auto at = (" " + units).find(" " + key);
-    if (at == std::string::npos) return "";
-    const auto start = at + key.size();
-    return " [" + units.substr(start, units.find(' ', start) - start) + "]";
+    const std::string unit = datalog::declared_unit(units, prefix);
+    return unit.empty() ? "" : " [" + unit + "]";
   };
 
   std::string s;

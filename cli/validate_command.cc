@@ -58,18 +58,8 @@ struct ObjectStats {
 // The unit the log's `units` metadata gives the group of `channel` ("fc3"
 // -> "N" from "... fc=N ..."); empty when it says nothing.
 std::string unit_of(const datalog::LogTable& log, const std::string& channel) {
-  const auto units = log.metadata.get("units");
-  if (!units) return "";
-  std::size_t digits = channel.find_first_of("0123456789");
-  const std::string prefix = channel.substr(0, digits) + "=";
-  std::size_t pos = 0;
-  while (pos < units->size()) {
-    const std::size_t end = std::min(units->find(' ', pos), units->size());
-    const std::string item = units->substr(pos, end - pos);
-    if (item.rfind(prefix, 0) == 0) return item.substr(prefix.size());
-    pos = end + 1;
-  }
-  return "";
+  return datalog::declared_unit(log.metadata.get("units").value_or(""),
+                                channel.substr(0, channel.find_first_of("0123456789")));
 }
 
 }  // namespace

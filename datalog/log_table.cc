@@ -1,5 +1,6 @@
 #include "datalog/log_table.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace hadynet::datalog {
@@ -39,6 +40,18 @@ void LogTable::append_row(const std::vector<double>& row) {
                                 " columns");
   }
   values.insert(values.end(), row.begin(), row.end());
+}
+
+std::string declared_unit(std::string_view units_text, std::string_view key) {
+  std::size_t pos = 0;
+  while (pos < units_text.size()) {
+    const std::size_t end = std::min(units_text.find(' ', pos), units_text.size());
+    const std::string_view item = units_text.substr(pos, end - pos);
+    if (item.size() > key.size() && item.substr(0, key.size()) == key && item[key.size()] == '=')
+      return std::string(item.substr(key.size() + 1));
+    pos = end + 1;
+  }
+  return "";
 }
 
 }  // namespace hadynet::datalog

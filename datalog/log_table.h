@@ -42,6 +42,10 @@ class LogMetadata {
   std::unordered_map<std::string, std::size_t, KeyHash, std::equal_to<>> position_;  // key -> index
 };
 
+// The unit a log's `units` metadata text gives `key` (a channel group's
+// prefix or a channel: "N" for "fc" in "t=s fc=N"); empty when it gives none.
+std::string declared_unit(std::string_view units_text, std::string_view key);
+
 // One channel group: columns named <prefix>0 .. <prefix>N-1 (e.g. fc0..fc8),
 // or, for auxiliary channels, every column whose name starts with "aux_".
 struct ChannelGroup {

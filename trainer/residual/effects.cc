@@ -469,7 +469,7 @@ void enumerate(const ResidualData& data, const LibraryOptions& options, int c, s
 // prediction: the residual is k y_s(t) - rho k y_s(t-1), linear in the two
 // whatever rho is, and the first coefficient is the gain k itself (with
 // y_s(t) alone it reads k (1 - rho corr(y_s(t), y_s(t-1)))). Measured on
-// the plant (docs/residual.md): f5 -> fc6 at 0.2 reads 0.19-0.22; a
+// the plant (docs/residual.md): f5 -> fc6 at 0.2 reads 0.16-0.24; a
 // fingertip pair at 0.35 still reads 0.25, as with y_s(t) alone: there the
 // model's own coupling of neighbouring fingertips absorbs part of it.
 Features features(const Hypothesis& h, const ResidualLog& log) {
@@ -649,8 +649,7 @@ const std::vector<EffectInfo>& effect_library() {
        saturation::describe, saturation::plan},
       {EffectKind::kCrosstalk, "crosstalk",
        "y_s(t) and y_s(t-1): another channel's measured value (by default of the target's group or unit) "
-       "leaking into the "
-       "target, and what the network carries over of it from x_{t-1}",
+       "leaking into the target, and what the network carries over of it from x_{t-1}",
        "gain: the fraction of y_s the target picks up (the coefficient of y_s(t))",
        "removal: train on y_c - k y_s (in y and x); the sensor model adds k times the predicted y_s back",
        SourceKind::kObserved, crosstalk::enumerate, crosstalk::features, first_coefficient, crosstalk::fraction,

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <map>
 #include <numeric>
-#include <sstream>
 #include <stdexcept>
 
 #include "datalog/robot_profile.h"
@@ -143,17 +142,10 @@ Eigen::MatrixXd predict_windows(const HadynetModel& model, const LogSequence& se
 }
 
 std::vector<std::string> channel_units(const std::string& units_text, const std::vector<std::string>& names) {
-  std::map<std::string, std::string> unit_of;
-  std::istringstream in(units_text);
-  for (std::string token; in >> token;) {
-    const auto eq = token.find('=');
-    if (eq != std::string::npos && eq > 0 && eq + 1 < token.size()) unit_of.emplace(token.substr(0, eq), token.substr(eq + 1));
-  }
   std::vector<std::string> out;
   for (const auto& name : names) {
-    auto it = unit_of.find(name);
-    if (it == unit_of.end()) it = unit_of.find(channel_group(name));
-    out.push_back(it == unit_of.end() ? std::string() : it->second);
+    std::string unit = datalog::declared_unit(units_text, name);
+    out.push_back(unit.empty() ? datalog::declared_unit(units_text, channel_group(name)) : unit);
   }
   return out;
 }
