@@ -30,7 +30,8 @@ int run_collect(int argc, char** argv) {
   opt.value("split", "NAME", "split folder for a single experiment", "train");
   opt.repeated("effect", "NAME[=V]",
                "switch on an effect the model may lack: friction[=N], sensor-delay[=steps], drift[=N/(N s)],\n"
-               "                          saturation[=rail N], crosstalk[=fraction], tension-leak[=fraction]");
+               "                          saturation[=rail N], crosstalk[=fraction], tension-leak[=fraction],\n"
+               "                          input-delay[=steps]");
   opt.flag("declare-effects", "write the switched-on effects into the logs and manifest (default: undeclared)");
   opt.flag("no-realism", "no sensor noise, quantisation or rated ranges");
   opt.flag("quiet", "no progress output");

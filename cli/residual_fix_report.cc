@@ -46,7 +46,7 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
       j["augmentation"]["source"] = removal->pair.source;
       j["augmentation"]["gain"] = removal->pair.gain;
     }
-    const auto* hysteresis = std::get_if<rs::HysteresisInputs>(&a.change);
+    const auto* hysteresis = std::get_if<rs::DerivedCommandInputs>(&a.change);
     if (hysteresis != nullptr && !hysteresis->inputs.empty()) j["augmentation"]["derived_inputs"] = hysteresis->inputs;
     if (!f.fitted_rates.empty()) j["augmentation"]["fitted_rates"] = f.fitted_rates;
   }

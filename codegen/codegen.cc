@@ -378,6 +378,7 @@ Emitter emit(const PreparedModel& p, const Formats& f, const HeaderValues& v, co
   e.line("  // ---- derived inputs: computed by the firmware from their base command");
   e.array1("hadynet::firmware::DerivedKind", "kUDerived[kU]", v.sensor.derived);
   e.array1("int", "kUDerivedBase[kU]", v.sensor.derived_base);
+  e.array1("int", "kUDerivedLag[kU]", v.sensor.derived_lag);
   e.line();
   e.line("  // ---- sensor model: measured y_c = clip(y'_c + sum gain y'_source + rate D_c)");
   for (const std::string& l : v.sensor.notes) e.line("  // " + l);

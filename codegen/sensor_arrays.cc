@@ -24,6 +24,7 @@ SensorArrays sensor_arrays(const trainer::HadynetModel& model, bool q15, int fra
     if (!d) {
       a.derived.push_back("hadynet::firmware::DerivedKind::kNone");
       a.derived_base.push_back(std::to_string(i));
+      a.derived_lag.push_back("0");
       continue;
     }
     const auto it = std::find(u.begin(), u.end(), d->base);
@@ -36,8 +37,10 @@ SensorArrays sensor_arrays(const trainer::HadynetModel& model, bool q15, int fra
       case trainer::DerivedKind::kChangeHysteresis:
         a.derived.push_back("hadynet::firmware::DerivedKind::kChangeHysteresis");
         break;
+      case trainer::DerivedKind::kLag: a.derived.push_back("hadynet::firmware::DerivedKind::kLag"); break;
     }
     a.derived_base.push_back(std::to_string(it - u.begin()));
+    a.derived_lag.push_back(std::to_string(d->lag));
   }
   const trainer::SensorModel& s = model.sensor;
   for (const auto& x : s.crosstalk) {

@@ -12,7 +12,7 @@
 namespace hadynet::codegen {
 
 struct SensorArrays {
-  std::vector<std::string> derived, derived_base;
+  std::vector<std::string> derived, derived_base, derived_lag;
   int crosstalk_count = 0, drift_count = 0, clip_count = 0;
   std::vector<std::string> crosstalk_target, crosstalk_source, crosstalk_gain;
   std::vector<std::string> drift_channel, drift_is_load, drift_rate;

@@ -60,8 +60,8 @@ constexpr bool parse_numeric(std::string_view text, Numeric& out) noexcept {
 // kContractVersion (kGeneratorVersion names the generator, not the contract)
 // and the core rejects other versions at compile time (a stale generated
 // header fails the build, not the robot). 3 added kPeriodUs and kBoardGroup,
-// 4 kShapeId.
-inline constexpr int kModelContractVersion = 4;
+// 4 kShapeId, 5 DerivedKind::kLag and kUDerivedLag.
+inline constexpr int kModelContractVersion = 5;
 
 // Loss class of each observed channel for the grasp stabiliser.
 enum class LossClass : std::uint8_t {
@@ -80,6 +80,7 @@ enum class DerivedKind : std::uint8_t {
   kHysteresis = 2,  // sign of the last non-zero u_base (0 before the first)
   kChangeSign = 3,        // sign(u_base - u_base of the previous frame); 0 in the first frame
   kChangeHysteresis = 4,  // sign of the last non-zero change of u_base (0 before the first)
+  kLag = 5,               // u_base of kUDerivedLag frames earlier (0 before the first command)
 };
 
 // clang-format off
@@ -180,9 +181,11 @@ concept GeneratedModel = requires {
   M::kLossWeightDown;     // Value[kY] weight where est <  ref, Q(kFracLossW)
   M::kControlActive;      // bool[kU]  commands the stabiliser may change (others: "no change")
 
-  // ---- derived inputs (DerivedKind, as trainer::DerivedKind; a model fixed for friction has some)
+  // ---- derived inputs (DerivedKind, as trainer::DerivedKind; a model fixed
+  // for friction or input dead time has some)
   M::kUDerived;           // DerivedKind[kU]
   M::kUDerivedBase;       // int[kU]  the command it is computed from (itself for kNone)
+  M::kUDerivedLag;        // int[kU]  steps, 1..20 for kLag; 0 otherwise
 
   // ---- sensor model (trainer/sensor_model.h; counts 0 for a model trained on
   // logs as they are; arrays hold max(count, 1) entries). The measured y is

@@ -7,7 +7,9 @@
 //     derived commands: sign(u_base) and the hysteresis state (the sign of
 //       the last non-zero u_base, kept here), or the same of u_base's change
 //       from the previous frame (an absolute command; the previous value is
-//       kept here), overwriting the frame's values;
+//       kept here), or u_base of kUDerivedLag frames earlier (input dead
+//       time; the newest kMaxLag bases are kept here), overwriting the
+//       frame's values;
 //     drift: D_c += |y_c| kSensorPeriod (load) or kSensorPeriod (time), then
 //       y1_c = y_c - rate D_c;
 //     cross-talk: y'_c = y1_c - gain y1_s (the source after the drift step).
@@ -25,6 +27,15 @@
 
 namespace hadynet::firmware {
 
+// The longest lag of M's kLag inputs (steps; 1 without any).
+template <GeneratedModel M>
+constexpr int longest_command_lag() noexcept {
+  int longest = 1;
+  for (int i = 0; i < M::kU; ++i)
+    if (M::kUDerived[i] == DerivedKind::kLag && M::kUDerivedLag[i] > longest) longest = M::kUDerivedLag[i];
+  return longest;
+}
+
 template <GeneratedModel M>
 class SensorStage {
  public:
@@ -40,6 +51,9 @@ class SensorStage {
     for (float& d : driver_) d = 0.0f;
     for (float& h : hysteresis_) h = 0.0f;
     for (float& b : previous_base_) b = 0.0f;
+    for (auto& ring : lag_ring_)
+      for (float& b : ring) b = 0.0f;
+    lag_slot_ = 0;
     frames_ = 0;
   }
 
@@ -56,6 +70,10 @@ class SensorStage {
       // trainer's row 0 of a log.
       const float change = frames_ < 2 ? 0.0f : sign_of_difference(base, previous_base_[i]);
       previous_base_[i] = base;
+      // The base kUDerivedLag frames ago (read before this frame's is kept):
+      // 0 until a command that old exists, as the trainer's first rows.
+      const float lagged = lag_ring_[i][(lag_slot_ + kMaxLag - M::kUDerivedLag[i]) % kMaxLag];
+      lag_ring_[i][lag_slot_] = frames_ == 0 ? 0.0f : base;
       switch (M::kUDerived[i]) {
         case DerivedKind::kNone: u_model[i] = u_prev[i]; break;
         case DerivedKind::kSign: u_model[i] = sign; break;
@@ -68,8 +86,10 @@ class SensorStage {
           if (change != 0.0f) hysteresis_[i] = change;
           u_model[i] = hysteresis_[i];
           break;
+        case DerivedKind::kLag: u_model[i] = lagged; break;
       }
     }
+    lag_slot_ = (lag_slot_ + 1) % kMaxLag;
     if (frames_ < 2) ++frames_;
     float drifted[kY];
     for (int i = 0; i < kY; ++i) drifted[i] = y[i];
@@ -124,10 +144,16 @@ class SensorStage {
   }
 
   static constexpr int kDrifts = M::kDriftCount > 0 ? M::kDriftCount : 1;
+  static constexpr int kMaxLag = longest_command_lag<M>();
+  static_assert(kMaxLag <= 20, "kUDerivedLag above the contract's 20 steps");
   const ModelTensors<M>* t_;
   float driver_[kDrifts] = {};
   float hysteresis_[kU] = {};
   float previous_base_[kU] = {};  // per u slot: its base command in the previous frame
+  // Per u slot: its base command in the newest kMaxLag frames, the newest at
+  // lag_slot_ - 1 (mod kMaxLag).
+  float lag_ring_[kU][kMaxLag] = {};
+  int lag_slot_ = 0;              // where this frame's base goes
   int frames_ = 0;                // frames since reset(), counted up to 2
 };
 

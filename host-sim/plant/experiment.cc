@@ -63,10 +63,13 @@ HandSpec hand_spec_for(const ExperimentSpec& spec) {
 }
 
 ExperimentLoop::ExperimentLoop(const ExperimentSpec& spec)
-    : plant_(hand_spec_for(spec)), sensors_(spec.effects, spec.sensor_realism, sensor_noise_seed(spec)) {
+    : plant_(hand_spec_for(spec)),
+      sensors_(spec.effects, spec.sensor_realism, sensor_noise_seed(spec)),
+      command_delay_steps_(spec.effects.command_delay_steps) {
   // Start from the open hand, held for 1 s so that the row at t = 0 is at rest.
   target_mm_ = nominal_muscle_lengths_mm(start_pose());
   for (auto& v : target_mm_) v = to_command_resolution(v);
+  servo_target_mm_ = target_mm_;
   plant_.settle(target_mm_, 1.0);
   measured_ = sensors_.measure(plant_.state());
 }
@@ -83,7 +86,12 @@ std::array<double, kMuscles> ExperimentLoop::apply(const std::array<double, kMus
     applied[m] = to_command_resolution(u_mm[m]);  // unchanged if already at the resolution
     target_mm_[m] += applied[m];
   }
-  plant_.step(target_mm_);
+  pending_commands_.push_back(applied);
+  if (static_cast<int>(pending_commands_.size()) > command_delay_steps_) {
+    for (int m = 0; m < kMuscles; ++m) servo_target_mm_[m] += pending_commands_.front()[m];
+    pending_commands_.pop_front();
+  }
+  plant_.step(servo_target_mm_);
   measured_ = sensors_.measure(plant_.state());
   return applied;
 }

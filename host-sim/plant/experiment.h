@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <deque>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -79,12 +80,16 @@ class ExperimentLoop {
 
   // The measured y after the last step (log units), i.e. this row's y.
   const Measurement& measured() const { return measured_; }
+  // The target muscle lengths the commands sent so far set (the servos
+  // follow it Effects::command_delay_steps steps late).
   const std::array<double, kMuscles>& target_mm() const { return target_mm_; }
   // The command that moves the target to `wanted_mm`, at command resolution.
   std::array<double, kMuscles> command_to(const std::array<double, kMuscles>& wanted_mm) const;
   // One 0.2 s step: rounds each u to the command resolution, adds it to the
   // target (no clamping: the servos' 0..200 N force range is the only limit),
-  // steps the plant and measures. Returns the u actually applied.
+  // steps the plant and measures. Returns the u actually applied. With
+  // Effects::command_delay_steps = d the servos get the command of d steps
+  // earlier (dead time; none before the first command).
   std::array<double, kMuscles> apply(const std::array<double, kMuscles>& u_mm);
 
   HandPlant& plant() { return plant_; }
@@ -94,6 +99,9 @@ class ExperimentLoop {
   HandPlant plant_;
   SensorSimulation sensors_;
   std::array<double, kMuscles> target_mm_{};
+  std::array<double, kMuscles> servo_target_mm_{};           // what the servos hold: target_mm_ d commands ago
+  std::deque<std::array<double, kMuscles>> pending_commands_;  // sent, not yet acting (oldest first)
+  int command_delay_steps_ = 0;
   Measurement measured_;
 };
 

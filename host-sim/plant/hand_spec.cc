@@ -64,7 +64,7 @@ Wear wear_from_level(double level) {
 bool Effects::any() const {
   return tendon_friction_N > 0 || loadcell_delay_steps > 0 || loadcell_drift_per_Ns > 0 ||
          loadcell_drift_walk_N > 0 || loadcell_rail_N > 0 || loadcell_crosstalk > 0 ||
-         tension_leak > 0;
+         tension_leak > 0 || command_delay_steps > 0;
 }
 
 std::string Effects::describe() const {
@@ -83,6 +83,7 @@ std::string Effects::describe() const {
   if (loadcell_rail_N > 0) { std::snprintf(buf, sizeof buf, "saturation=%g", loadcell_rail_N); add(buf); }
   if (loadcell_crosstalk > 0) { std::snprintf(buf, sizeof buf, "crosstalk=%g", loadcell_crosstalk); add(buf); }
   if (tension_leak > 0) { std::snprintf(buf, sizeof buf, "tension-leak=%g", tension_leak); add(buf); }
+  if (command_delay_steps > 0) { std::snprintf(buf, sizeof buf, "input-delay=%d", command_delay_steps); add(buf); }
   return out.empty() ? "none" : out;
 }
 
@@ -111,9 +112,13 @@ std::string apply_effect_arg(std::string_view arg, Effects& e) {
   } else if (name == "tension-leak") {
     e.tension_leak = has_value ? value : 0.05;
     if (e.tension_leak > 1) return "effect 'tension-leak': expected a fraction in 0..1";
+  } else if (name == "input-delay") {
+    e.command_delay_steps = has_value ? static_cast<int>(value) : 2;
+    if (has_value && (value != static_cast<int>(value) || value > 20))
+      return "effect 'input-delay': expected a whole number of steps in 0..20";
   } else {
     return "unknown effect '" + std::string(name) +
-           "' (expected friction, sensor-delay, drift, saturation, crosstalk or tension-leak)";
+           "' (expected friction, sensor-delay, drift, saturation, crosstalk, tension-leak or input-delay)";
   }
   return "";
 }

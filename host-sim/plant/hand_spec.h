@@ -78,13 +78,16 @@ struct Effects {
   // Cross-talk between groups: the palm loadcell fc6 picks up this fraction
   // of tendon 5's tension (f5, whose cable runs past it), before noise.
   double tension_leak = 0.0;
+  // Command dead time: the servos act on each command this many 0.2 s steps
+  // after it is sent (ExperimentLoop::apply).
+  int command_delay_steps = 0;
 
   bool any() const;
   // "friction=4,sensor-delay=2" style summary, for declared logs and reports.
   std::string describe() const;
 };
 // Parses one `--effect` argument: NAME or NAME=VALUE, NAME in
-// friction|sensor-delay|drift|saturation|crosstalk|tension-leak. Returns an
+// friction|sensor-delay|drift|saturation|crosstalk|tension-leak|input-delay. Returns an
 // error text or "".
 std::string apply_effect_arg(std::string_view arg, Effects& effects);
 

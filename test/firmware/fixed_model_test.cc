@@ -33,13 +33,17 @@ const trainer::HadynetModel& fixed_model() {
 TEST(FixedModelHeader, CarriesTheDerivedInputsAndTheSensorModel) {
   const auto& m = fixed_model();
   ASSERT_EQ(F::kU, m.params.dims.u);
-  EXPECT_EQ(F::kU, test::build_model().params.dims.u + 4);
-  EXPECT_EQ(F::kUDerived[F::kU - 4], firmware::DerivedKind::kSign);
-  EXPECT_EQ(F::kUDerived[F::kU - 3], firmware::DerivedKind::kHysteresis);
-  EXPECT_EQ(F::kUDerivedBase[F::kU - 3], 0);
-  EXPECT_EQ(F::kUDerived[F::kU - 2], firmware::DerivedKind::kChangeSign);
-  EXPECT_EQ(F::kUDerived[F::kU - 1], firmware::DerivedKind::kChangeHysteresis);
-  EXPECT_EQ(F::kUDerivedBase[F::kU - 1], 1);
+  EXPECT_EQ(F::kU, test::build_model().params.dims.u + 5);
+  EXPECT_EQ(F::kUDerived[F::kU - 5], firmware::DerivedKind::kSign);
+  EXPECT_EQ(F::kUDerived[F::kU - 4], firmware::DerivedKind::kHysteresis);
+  EXPECT_EQ(F::kUDerivedBase[F::kU - 4], 0);
+  EXPECT_EQ(F::kUDerived[F::kU - 3], firmware::DerivedKind::kChangeSign);
+  EXPECT_EQ(F::kUDerived[F::kU - 2], firmware::DerivedKind::kChangeHysteresis);
+  EXPECT_EQ(F::kUDerivedBase[F::kU - 2], 1);
+  EXPECT_EQ(F::kUDerived[F::kU - 1], firmware::DerivedKind::kLag);
+  EXPECT_EQ(F::kUDerivedBase[F::kU - 1], 2);
+  EXPECT_EQ(F::kUDerivedLag[F::kU - 1], 2);
+  EXPECT_EQ(F::kUDerivedLag[F::kU - 2], 0);
   EXPECT_FALSE(F::kControlActive[F::kU - 1]);  // never set by the stabiliser
   EXPECT_EQ(F::kCrosstalkCount, 1);
   EXPECT_EQ(F::kDriftCount, 1);
@@ -154,8 +158,9 @@ TEST(FixedModelRuntime, ControlModeRunsWithDerivedInputsHeld) {
     if (t < 1) continue;
     ASSERT_TRUE(r.command_valid) << t;
     // The derived inputs are reported at their held value (hyst_u0 -1, standardised back; u1 never
-    // changes: dhyst_u1 0).
-    EXPECT_NEAR(r.command[Q::kU - 3], -1.0f, 0.01f) << t;
+    // changes: dhyst_u1 0; u2 is 0: lag2_u2 0).
+    EXPECT_NEAR(r.command[Q::kU - 4], -1.0f, 0.01f) << t;
+    EXPECT_NEAR(r.command[Q::kU - 2], 0.0f, 0.01f) << t;
     EXPECT_NEAR(r.command[Q::kU - 1], 0.0f, 0.01f) << t;
     for (float v : r.command) EXPECT_TRUE(std::isfinite(v));
   }

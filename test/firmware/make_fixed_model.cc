@@ -48,17 +48,18 @@ int main(int argc, char** argv) {
     residual::Augmentation friction;
     friction.kind = residual::EffectKind::kFriction;
     friction.effect = "friction";
-    friction.description = "test: hysteresis inputs of u0 and of u1's change";
-    friction.change.emplace<residual::HysteresisInputs>().inputs = {"sign_u0", "hyst_u0", "dsign_u1", "dhyst_u1"};
+    friction.description = "test: hysteresis inputs of u0 and of u1's change, u2 two steps earlier";
+    friction.change.emplace<residual::DerivedCommandInputs>().inputs = {"sign_u0", "hyst_u0", "dsign_u1", "dhyst_u1",
+                                                                        "lag2_u2"};
     std::vector<LogSequence> seqs;
     const FeatureLayout layout = residual::augmented_layout(base.layout, friction);
     for (const auto& l : logs) seqs.push_back(log_sequence(l.table, l.file, layout));
     HadynetModel m = residual::augmented_model(base, friction, seqs);
-    // Fixed, non-zero weights for the four new inputs (columns before the PB).
+    // Fixed, non-zero weights for the five new inputs (columns before the PB).
     auto& ih = m.params.lstm_weight_ih;
     const int u_old = base.params.dims.u;
     for (Eigen::Index r = 0; r < ih.rows(); ++r)
-      for (int k = 0; k < 4; ++k)
+      for (int k = 0; k < 5; ++k)
         ih(r, u_old + k) = 0.05f * static_cast<float>(std::sin(0.37 * static_cast<double>(r) + k));
 
     m.sensor.crosstalk = {{"fc2", "fc3", 0.25}};

@@ -50,6 +50,22 @@ TEST(DerivedInputs, SignAndHysteresisOfAnAbsoluteCommandsChange) {
   EXPECT_EQ(parse_derived_input("dsign_u3")->kind, DerivedKind::kChangeSign);
 }
 
+TEST(DerivedInputs, LagOfACommandIsTheCommandDStepsEarlier) {
+  const auto t = table({"y0", "u0"}, {{0, 0.5}, {0, -1}, {0, 2}, {0, 0}, {0, 3}});
+  // u0(t - 2), 0 in the first two rows (no command before the log).
+  EXPECT_EQ(*derived_input_column(t, "lag2_u0"), (std::vector<double>{0, 0, 0.5, -1, 2}));
+  EXPECT_EQ(*derived_input_column(t, "lag1_u0"), (std::vector<double>{0, 0.5, -1, 2, 0}));
+  const auto d = parse_derived_input("lag12_u3");
+  ASSERT_TRUE(d.has_value());
+  EXPECT_EQ(d->kind, DerivedKind::kLag);
+  EXPECT_EQ(d->lag, 12);
+  EXPECT_EQ(d->base, "u3");
+  EXPECT_EQ(derived_input_name(*d), "lag12_u3");
+  // Not lag names: no digits, a leading zero, 0, above kMaxCommandLag, no base.
+  for (const char* name : {"lag_u0", "lag02_u0", "lag0_u0", "lag21_u0", "lag2_", "lag2u0", "lagx_u0"})
+    EXPECT_FALSE(parse_derived_input(name).has_value()) << name;
+}
+
 TEST(DerivedInputs, LogSequenceComputesTheMissingColumnOnly) {
   const auto t = table({"y0", "u0"}, {{1, 0}, {2, -1}, {3, 0}});
   const FeatureLayout layout = feature_layout_from_names({"y0"}, {"u0", "hyst_u0"}, {});

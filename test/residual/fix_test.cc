@@ -198,7 +198,7 @@ TEST(ResidualFix, CrosstalkIsRemovedFromTheDataAndCutsTheTargetsError) {
   expect_deployable(r.fix.model);
 }
 
-TEST(ResidualFix, FrictionGetsHysteresisInputsAndCutsTheTendonsError) {
+TEST(ResidualFix, FrictionGetsDerivedCommandInputsAndCutsTheTendonsError) {
   // Plant: 4 N of dry friction on every tendon (friction, the default).
   const FixRun r = run_fix(plant_logs("friction"), "friction");
   ASSERT_TRUE(fixed_as(r, EffectKind::kFriction));
@@ -206,7 +206,7 @@ TEST(ResidualFix, FrictionGetsHysteresisInputsAndCutsTheTendonsError) {
   // Two derived command channels per muscle of the family, appended to u and
   // computed from the logged commands (the logs have no such column).
   const auto& m = r.fix.model;
-  const std::vector<std::string>& inputs = std::get<HysteresisInputs>(a.change).inputs;
+  const std::vector<std::string>& inputs = std::get<DerivedCommandInputs>(a.change).inputs;
   ASSERT_FALSE(inputs.empty());
   EXPECT_EQ(m.params.dims.u, build_model().params.dims.u + static_cast<int>(inputs.size()));
   EXPECT_EQ(m.layout.u_names.back(), inputs.back());

@@ -38,7 +38,11 @@ Segments standardised_loss(const HadynetModel& model, const HeldOutError& e, con
 
 }  // namespace
 
-bool fix_supported(EffectKind kind) { return effect_info(kind).plan != nullptr; }
+std::string why_not_fixable(const ResidualData& data, const Attribution& attribution, const HypothesisResult& r) {
+  const EffectInfo& info = effect_info(r.hypothesis.kind);
+  if (!info.plan) return info.augmentation;
+  return info.not_planned ? info.not_planned(data, attribution, r) : "";
+}
 
 std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attribution& attribution, int count) {
   std::vector<Augmentation> out;
@@ -51,10 +55,14 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   // fc4 -> fc3 above a 2-step sensor delay; docs/residual.md). A sensor delay on a
   // channel the commands drive directly leaves nearly the residual of an
   // input delay on that channel alone, so the two can swap places
-  // (docs/residual.md): an input-delay winner is skipped and said.
+  // (docs/residual.md): an input-delay winner seen on one group only is
+  // skipped and said.
+  std::string winner_not_fixable;
   for (const auto& r : attribution.ranked) {
     if (!r.significant || static_cast<int>(out.size()) >= count) break;
-    if (!fix_supported(r.hypothesis.kind)) continue;
+    const std::string why = why_not_fixable(data, attribution, r);
+    if (r.label == winner->label) winner_not_fixable = why;
+    if (!why.empty()) continue;
     const bool seen = std::any_of(out.begin(), out.end(), [&](const Augmentation& b) { return b.kind == r.hypothesis.kind; });
     if (seen) continue;
     Augmentation a;
@@ -62,15 +70,17 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
     a.effect = r.effect;
     effect_info(a.kind).plan(data, attribution, r, a);
     if (out.empty() && r.label != winner->label)
-      a.description = "the winner (" + winner->effect + ": " + winner->label +
-                      ") has no augmentation; the best significant effect that has: " + r.label + "; " + a.description;
+      a.description = "the winner (" + winner->effect + ": " + winner->label + ") is not added (" +
+                      winner_not_fixable + "); the best significant effect that can be: " + r.label + "; " +
+                      a.description;
     out.push_back(std::move(a));
   }
   if (out.empty()) {  // nothing significant can be added: fix() says "not supported"
     Augmentation a;
     a.kind = winner->hypothesis.kind;
     a.effect = winner->effect;
-    a.description = effect_info(a.kind).augmentation;
+    a.not_fixable = why_not_fixable(data, attribution, *winner);
+    a.description = a.not_fixable;
     out.push_back(std::move(a));
   }
   return out;
@@ -161,7 +171,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     result.status = "no significant effect";
     return result;
   }
-  if (!fix_supported(planned.front().kind)) {
+  if (!planned.front().not_fixable.empty()) {
     result.augmentation = planned.front();
     result.status = "not supported: " + planned.front().effect + ": " + planned.front().description;
     return result;

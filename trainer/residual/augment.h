@@ -81,13 +81,6 @@ struct ModelChange {
   void refine(Augmentation&, const SensorModel&, const TrainingRmse&, std::vector<double>&) {}
 };
 
-// input-delay: nothing (named and reported only: dead time in the commands
-// would change what the stabiliser controls; fix() says "not supported").
-struct NoChange : ModelChange {
-  void add_to_network(const Augmentation& a, const HadynetModel& before, HadynetModel& m,
-                      const std::vector<LogSequence>& train_seqs) const;  // throws std::invalid_argument
-};
-
 // sensor-delay: time alignment of Augmentation::channels (the winner's family
 // with the same delay, extended to its group): the model is fine-tuned on logs
 // with y'_c(s) = y_c(s + delay) and predicts the true-time signal. The delay
@@ -131,10 +124,11 @@ struct OutputClips : ModelChange {
 // winner's family, the derived command channels sign_<m> (direction of
 // motion) and hyst_<m> (sign of the last non-zero command;
 // trainer/derived_inputs.h) are appended to u with zero LSTM input weights.
-// dims.u grows by two per muscle; logs need no new column (they are computed
-// from the commands).
-struct HysteresisInputs : ModelChange {
-  std::vector<std::string> inputs;  // the derived u channels (sign_u0, hyst_u0, ...)
+// dims.u grows by two per muscle. input-delay: the commands d steps earlier,
+// lag<d>_<c> for every command c, appended the same way. Logs need no new
+// column (they are computed from the commands).
+struct DerivedCommandInputs : ModelChange {
+  std::vector<std::string> inputs;  // the derived u channels (sign_u0, hyst_u0, lag2_u0, ...)
   void add_to_channels(std::vector<std::string>& y, std::vector<std::string>& u) const;
   void add_to_network(const Augmentation& a, const HadynetModel& before, HadynetModel& m,
                       const std::vector<LogSequence>& train_seqs) const;
@@ -164,20 +158,24 @@ struct Augmentation {
   // the models there (fix()). The channels above, or for an aux channel the
   // targets it explains.
   std::vector<std::string> found_on;
-  std::variant<NoChange, TimeAlignment, CrosstalkRemoval, BiasState, OutputClips, HysteresisInputs,
+  // Why --fix cannot add it ("" when it can; change is then meaningless).
+  std::string not_fixable;
+  std::variant<TimeAlignment, CrosstalkRemoval, BiasState, OutputClips, DerivedCommandInputs,
                ObservedAuxChannel>
       change;
 };
-// True for the effects --fix implements (those with a plan: all but input-delay).
-bool fix_supported(EffectKind kind);
+// Why --fix cannot add significant hypothesis `r` ("" when it can): its
+// effect has no plan, or the effect's not_planned rule declines it (an input
+// delay seen on one group only; effects.h).
+std::string why_not_fixable(const ResidualData& data, const Attribution& attribution, const HypothesisResult& r);
 
 // The screen's candidates for --fix: the augmentations (each with its
 // family: the effect's plan, effects.cc) of the significant hypotheses in
-// ranking order whose effect has one, the best of each effect, at most
-// `count`. When the winner's effect has no augmentation (input-delay), the
-// first candidate's description says so; when no significant effect has
-// one, the winner's alone (fix() then reports "not supported"). Empty
-// without a winner.
+// ranking order that --fix can add (why_not_fixable), the best of each
+// effect, at most `count`. When the winner cannot be added, the first
+// candidate's description says why; when no significant hypothesis can, the
+// winner's alone with Augmentation::not_fixable set (fix() then reports
+// "not supported"). Empty without a winner.
 std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attribution& attribution, int count);
 
 // The sensor model after adding the augmentation's part (add_to_sensor:

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "trainer/derived_inputs.h"
+#include "trainer/log_dataset.h"
 #include "trainer/residual/attribution.h"
 #include "trainer/residual/augment.h"
 
@@ -167,16 +168,50 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double) {
   return "input delay = " + steps(h.delay) + " seen on " + y_name(data, h.target);
 }
 
-// No plan: a correct augmentation is dead time in the commands, which changes
-// what the stabiliser controls (docs/residual.md, "Open").
+// The channels the winner's delay is significant on, and their groups.
+std::vector<std::string> family_groups(const ResidualData& data, const Attribution& attribution,
+                                       const HypothesisResult& lead) {
+  std::vector<std::string> groups;
+  for (const auto& r : attribution.family_of(lead)) {
+    const std::string g = channel_group(y_name(data, r.hypothesis.target));
+    if (std::find(groups.begin(), groups.end(), g) == groups.end()) groups.push_back(g);
+  }
+  return groups;
+}
+
+// Dead time in the commands delays every channel they drive; a delay seen on
+// one group only is what a sensor delay of that group leaves as well (on a
+// channel the commands drive directly the two residuals nearly coincide), so
+// the plan declines it and --fix takes the next candidate.
+std::string not_planned(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead) {
+  const auto groups = family_groups(data, attribution, lead);
+  if (groups.size() >= 2) return "";
+  return "an input delay seen on one group (" + join(groups) +
+         ") only leaves the residual a sensor delay of that group leaves";
+}
+
+// The commands d steps earlier as inputs: lag<d>_<c> for every command c the
+// model reads from its logs (not the derived ones), beside the commands
+// themselves, so that the network learns which of the two acts.
+void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
+  auto& change = a.change.emplace<DerivedCommandInputs>();
+  const int d = w.hypothesis.delay;
+  for (const auto& r : attribution.family_of(w)) a.channels.push_back(y_name(data, r.hypothesis.target));
+  for (const auto& u : data.u_names) {
+    if (parse_derived_input(u)) continue;
+    const std::string name = derived_input_name({DerivedKind::kLag, u, d});
+    if (std::find(data.u_names.begin(), data.u_names.end(), name) == data.u_names.end()) change.inputs.push_back(name);
+  }
+  if (change.inputs.empty())
+    throw std::invalid_argument("--fix: the model already has every command " + steps(d) + " earlier as an input");
+  a.description = "add the commands " + steps(d) + " earlier as inputs (" + join(change.inputs) + "; input delay on " +
+                  join(a.channels) + ")";
+  a.found_on = a.channels;
+}
 
 }  // namespace input_delay
 }  // namespace
 
-void NoChange::add_to_network(const Augmentation& a, const HadynetModel&, HadynetModel&,
-                              const std::vector<LogSequence>&) const {
-  throw std::invalid_argument("--fix: " + a.effect + " is not implemented");
-}
 
 namespace {
 
@@ -228,7 +263,7 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
 }
 
 void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
-  auto& change = a.change.emplace<HysteresisInputs>();
+  auto& change = a.change.emplace<DerivedCommandInputs>();
   std::vector<std::string> muscles;
   for (const auto& r : attribution.family_of(w)) {
     a.channels.push_back(y_name(data, r.hypothesis.target));
@@ -245,14 +280,14 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
 }  // namespace friction
 }  // namespace
 
-void HysteresisInputs::add_to_channels(std::vector<std::string>&, std::vector<std::string>& u) const {
+void DerivedCommandInputs::add_to_channels(std::vector<std::string>&, std::vector<std::string>& u) const {
   for (const auto& name : inputs) u.push_back(name);
 }
 
 // The derived command channels appended to u: standardisation from the
 // training rows (whose u holds them, last), zero LSTM input weights (inputs
 // are [u ; p]).
-void HysteresisInputs::add_to_network(const Augmentation& a, const HadynetModel& before, HadynetModel& m,
+void DerivedCommandInputs::add_to_network(const Augmentation& a, const HadynetModel& before, HadynetModel& m,
                                       const std::vector<LogSequence>& train_seqs) const {
   m.layout = augmented_layout(before.layout, a);
   const auto u_old = static_cast<Eigen::Index>(before.layout.u_names.size());
@@ -613,20 +648,21 @@ const std::vector<EffectInfo>& effect_library() {
        "time alignment: train on y_c shifted d steps earlier (the network predicts the true-time signal), "
        "with the winner's group where the same delay tests significant; the delay goes into the sensor model",
        SourceKind::kNone, sensor_delay::enumerate, sensor_delay::features, first_coefficient, positive,
-       sensor_delay::describe, sensor_delay::plan},
+       sensor_delay::describe, sensor_delay::plan, nullptr},
       {EffectKind::kInputDelay, "input-delay",
        "u(t-1-d) - u(t-1), every command channel: commands that act d steps later than the model assumes",
        "delay d (steps)",
-       "none (named and reported only): dead time in the commands would change what the stabiliser controls",
+       "dead time as inputs: the commands d steps earlier, lag<d>_<c> for every command c, appended to u "
+       "(not when the delay is seen on one group only: a sensor delay of that group leaves the same residual)",
        SourceKind::kNone, input_delay::enumerate, input_delay::features, input_delay::norm, finite,
-       input_delay::describe, nullptr},
+       input_delay::describe, input_delay::plan, input_delay::not_planned},
       {EffectKind::kFriction, "friction",
        "sign(u_m(t-1)) and the hysteresis state h_m(t) (sign of the last non-zero command of muscle m): dry "
        "friction acting against the motion of muscle m",
        "the residual offset while muscle m moves in the + direction (target units; minus that in the other)",
        "a hysteresis state as an input: the derived commands sign_u_m and hyst_u_m appended to u",
        SourceKind::kCommand, friction::enumerate, friction::features, friction::offset, finite, friction::describe,
-       friction::plan},
+       friction::plan, nullptr},
       {EffectKind::kDriftLoad, "drift-load",
        "the accumulated load sum_{s<=t} |y_c(s)| dt from the log's start: a bias that grows with the load "
        "the sensor has carried",
@@ -634,11 +670,11 @@ const std::vector<EffectInfo>& effect_library() {
        "a drift/bias state in the sensor model: a per-channel bias integrating |y_c| dt at a re-estimated "
        "rate, subtracted from the measured y_c before the network sees it and added to its prediction",
        SourceKind::kNone, drift::enumerate_load, drift::load_features, first_coefficient, finite,
-       drift::describe_load, drift::plan},
+       drift::describe_load, drift::plan, nullptr},
       {EffectKind::kDriftTime, "drift-time", "time since the log's start: a bias growing with time",
        "rate: bias per second (target units per s)",
        "a drift/bias state in the sensor model, growing with time at a re-estimated rate", SourceKind::kNone,
-       drift::enumerate_time, drift::time_features, first_coefficient, finite, drift::describe_time, drift::plan},
+       drift::enumerate_time, drift::time_features, first_coefficient, finite, drift::describe_time, drift::plan, nullptr},
       {EffectKind::kSaturation, "saturation",
        "min(y_hat_c, R) - y_hat_c (upper rail R = the largest measured value over the logs; lower: max(y_hat_c, "
        "R) - y_hat_c with the smallest): the part of the prediction a clipped sensor cannot show",
@@ -646,19 +682,19 @@ const std::vector<EffectInfo>& effect_library() {
        "clipping in the sensor model: the prediction of y_c passes min(., R) (max for a lower rail); "
        "fine-tuned on the clipped output",
        SourceKind::kNone, saturation::enumerate, saturation::features, first_coefficient, positive,
-       saturation::describe, saturation::plan},
+       saturation::describe, saturation::plan, nullptr},
       {EffectKind::kCrosstalk, "crosstalk",
        "y_s(t) and y_s(t-1): another channel's measured value (by default of the target's group or unit) "
        "leaking into the target, and what the network carries over of it from x_{t-1}",
        "gain: the fraction of y_s the target picks up (the coefficient of y_s(t))",
        "removal: train on y_c - k y_s (in y and x); the sensor model adds k times the predicted y_s back",
        SourceKind::kObserved, crosstalk::enumerate, crosstalk::features, first_coefficient, crosstalk::fraction,
-       crosstalk::describe, crosstalk::plan},
+       crosstalk::describe, crosstalk::plan, nullptr},
       {EffectKind::kAuxChannel, "aux-channel", "an aux_* column's value at t: a logged channel the model does not use",
        "gain (target units per aux unit)",
        "use it: the aux channel becomes an observed channel (an input in x, predicted in y)", SourceKind::kAux,
        aux_channel::enumerate, aux_channel::features, first_coefficient, finite, aux_channel::describe,
-       aux_channel::plan},
+       aux_channel::plan, nullptr},
   };
   return library;
 }

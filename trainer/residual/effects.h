@@ -127,6 +127,9 @@ struct EffectInfo {
   // and reported but has no augmentation.
   void (*plan)(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead,
                Augmentation& a);
+  // Why the plan declines the significant hypothesis `lead` ("" when it does
+  // not); nullptr: never.
+  std::string (*not_planned)(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead);
 };
 // The table, in EffectKind order (the order hypotheses are enumerated in).
 const std::vector<EffectInfo>& effect_library();
