@@ -12,6 +12,8 @@
 #             when the network carries little of its input over); friction:
 #             tendon channels (f*); drift: a load drift on a loadcell;
 #             saturation: a loadcell's upper rail within 10 % of the plant's;
+#             input-delay: the commands the plant's delay earlier as inputs
+#             (lag<d>_u*);
 #   cut       the held-out 1-step RMSE on the changed channels (mean ratio
 #             after/before) is at most 0.7;
 #   <control  the augmented model's RMSE there is below fine-tuning alone's.
@@ -24,7 +26,8 @@
 # (the default since models store them): seeds 331-340. Cross-talk sources
 # of the target's unit (the default since; tension-leak added): seeds 351-358
 # development (the strengths 0.1 and 0.2 chosen there: 0.02 and 0.05 were
-# never significant), 381-390 measured.
+# never significant), 381-390 measured. Input dead time (input-delay, its
+# fix added): seed 401 development (one set per strength), 411-420 measured.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...
@@ -65,7 +68,7 @@ runs="$out/runs.txt"
 : >"$runs"
 # effect=strength, weaker first; the second is the larger strength.
 cases=(sensor-delay=1 sensor-delay=2 friction=2 friction=4 crosstalk=0.2 crosstalk=0.35 tension-leak=0.02
-  tension-leak=0.05 drift=0.01 drift=0.02 saturation=3 saturation=2)
+  tension-leak=0.05 drift=0.01 drift=0.02 saturation=3 saturation=2 input-delay=1 input-delay=2)
 ((${#only_cases[@]})) && cases=("${only_cases[@]}")
 total=$((n * ${#cases[@]})) done_runs=0 start=$(date +%s)
 for ((k = 0; k < n; ++k)); do
@@ -106,6 +109,10 @@ elif effect == "drift":
 elif effect == "saturation":
     rails = [float(x) for x in re.findall(r"fc\d+ <= ([0-9.eE+-]+)", aug.get("description", ""))]
     param_ok = named_effect == "saturation" and bool(rails) and all(abs(r - strength) <= 0.1 * strength for r in rails)
+elif effect == "input-delay":
+    lags = aug.get("derived_inputs", [])
+    param_ok = (named_effect == "input-delay" and bool(lags)
+                and all(x.startswith("lag%d_" % int(strength)) for x in lags))
 named = confirmed and param_ok
 cut = below_control = False
 ratio = float("nan")

@@ -46,8 +46,8 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
       j["augmentation"]["source"] = removal->pair.source;
       j["augmentation"]["gain"] = removal->pair.gain;
     }
-    const auto* hysteresis = std::get_if<rs::DerivedCommandInputs>(&a.change);
-    if (hysteresis != nullptr && !hysteresis->inputs.empty()) j["augmentation"]["derived_inputs"] = hysteresis->inputs;
+    const auto* derived = std::get_if<rs::DerivedCommandInputs>(&a.change);
+    if (derived != nullptr && !derived->inputs.empty()) j["augmentation"]["derived_inputs"] = derived->inputs;
     if (!f.fitted_rates.empty()) j["augmentation"]["fitted_rates"] = f.fitted_rates;
   }
   if (f.changed) j["sensor_model"] = f.model.sensor.describe();

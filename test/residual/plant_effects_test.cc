@@ -20,6 +20,7 @@
 #include "test/residual/plant_logs.h"
 #include "trainer/residual/analysis.h"
 #include "trainer/residual/attribution.h"
+#include "trainer/residual/augment.h"
 #include "trainer/residual/rated_ranges.h"
 
 namespace hadynet::test {
@@ -293,6 +294,47 @@ TEST(RatedRange, AKnownRatedFloorIsNotAnEffect) {
 const std::vector<trainer::residual::LogInput>& null_logs() {
   static const auto logs = plant_logs("", 300, 12);
   return logs;
+}
+
+// Plant: the servos act on every command 2 steps after it is sent
+// (input-delay=2, the default). The screen names the delay with its steps on
+// channels of more than one group (the commands drive lengths, tensions and
+// loadcells), so --fix can add it: the commands 2 steps earlier as inputs,
+// one per command. Below the winner: on these logs the model's fingertip
+// misfit (a cross-talk pair) ranks first, so --fix reaches it among its first
+// three candidates (docs/residual.md, "Input dead time").
+TEST(PlantEffects, InputDelayIsNamedOnSeveralGroupsAndAddedAsLaggedCommands) {
+  const Outcome o = analyse("input-delay");
+  const auto it = std::find_if(o.attribution.ranked.begin(), o.attribution.ranked.end(), [](const auto& r) {
+    return r.significant && r.hypothesis.kind == EffectKind::kInputDelay;
+  });
+  ASSERT_NE(it, o.attribution.ranked.end()) << "no input delay significant";
+  EXPECT_EQ(it->hypothesis.delay, 2) << it->label;
+  std::set<std::string> groups;
+  for (const auto& r : o.attribution.family_of(*it)) groups.insert(channel_group(name_of(o, r.hypothesis.target)));
+  EXPECT_GE(groups.size(), 2u) << it->label;
+  EXPECT_EQ(why_not_fixable(o.data, o.attribution, *it), "");
+  const auto candidates = plan_candidates(o.data, o.attribution, 3);
+  const auto planned = std::find_if(candidates.begin(), candidates.end(),
+                                    [](const Augmentation& a) { return a.kind == EffectKind::kInputDelay; });
+  ASSERT_NE(planned, candidates.end()) << "input delay not among the first three candidates";
+  const auto& inputs = std::get<DerivedCommandInputs>(planned->change).inputs;
+  ASSERT_EQ(inputs.size(), 8u);
+  for (std::size_t m = 0; m < inputs.size(); ++m) EXPECT_EQ(inputs[m], "lag2_u" + std::to_string(m));
+}
+
+// A sensor delay of one group leaves nearly the residual of an input delay
+// on the channels the commands drive directly; an input delay seen on one
+// group only is not added (the sensor delay is, test above).
+TEST(PlantEffects, AnInputDelaySeenOnOneGroupIsNotAdded) {
+  const Outcome o = analyse("sensor-delay");
+  for (const auto& r : o.attribution.ranked) {
+    if (!r.significant || r.hypothesis.kind != EffectKind::kInputDelay) continue;
+    std::set<std::string> groups;
+    for (const auto& f : o.attribution.family_of(r)) groups.insert(channel_group(name_of(o, f.hypothesis.target)));
+    EXPECT_EQ(why_not_fixable(o.data, o.attribution, r).empty(), groups.size() >= 2) << r.label;
+  }
+  for (const auto& a : plan_candidates(o.data, o.attribution, 3)) EXPECT_NE(a.kind, EffectKind::kInputDelay) << a.description;
 }
 
 // Seed 64's confirmed false positive without rated ranges was a contact-free
