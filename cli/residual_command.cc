@@ -343,6 +343,7 @@ int run_residual(int argc, char** argv) {
     fo.candidates = static_cast<int>(*candidates);
     fo.reference = &reference;
     fo.reference_pb_choice = stored_null ? "state" : "auto";
+    fo.library = ao.library;
 
     // Rounds: each analyses `current` (the model of the last confirmed round)
     // and fixes when asked; the loop ends at the first round that confirms

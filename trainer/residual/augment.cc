@@ -55,8 +55,8 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   // fc4 -> fc3 above a 2-step sensor delay; docs/residual.md). A sensor delay on a
   // channel the commands drive directly leaves nearly the residual of an
   // input delay on that channel alone, so the two can swap places
-  // (docs/residual.md): an input-delay winner seen on one group only is
-  // skipped and said.
+  // (docs/residual.md): an input-delay winner seen on one group only, with a
+  // sensor delay significant there, is skipped and said.
   std::string winner_not_fixable;
   for (const auto& r : attribution.ranked) {
     if (!r.significant || static_cast<int>(out.size()) >= count) break;
@@ -80,7 +80,7 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
     a.kind = winner->hypothesis.kind;
     a.effect = winner->effect;
     a.not_fixable = why_not_fixable(data, attribution, *winner);
-    a.description = a.not_fixable;
+    a.description = winner->label;
     out.push_back(std::move(a));
   }
   return out;
@@ -173,7 +173,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   }
   if (!planned.front().not_fixable.empty()) {
     result.augmentation = planned.front();
-    result.status = "not supported: " + planned.front().effect + ": " + planned.front().description;
+    result.status = "not supported: " + planned.front().effect + ": " + planned.front().description + ": " +
+                    planned.front().not_fixable;
     return result;
   }
 
@@ -308,8 +309,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   };
   ResidualData again = compute_residuals(after.model, logs, "state");
   drop_predicted_aux(again);
-  LibraryOptions lib;
-  const std::vector<Hypothesis> hypotheses_after = enumerate_hypotheses(again, lib);
+  const std::vector<Hypothesis> hypotheses_after = enumerate_hypotheses(again, options.library);
   if (options.reference != nullptr && !options.reference->empty()) {
     ResidualData ref = compute_residuals(after.model, *options.reference, options.reference_pb_choice);
     drop_predicted_aux(ref);

@@ -53,6 +53,9 @@ struct FixOptions {
   const std::vector<LogInput>* reference = nullptr;
   // Their PB rule (compute_residuals): as AnalysisOptions::reference_pb_choice.
   std::string reference_pb_choice = "auto";
+  // The analysis's effect library options (AnalysisOptions::library): the
+  // augmented model's verdict tests the same hypotheses.
+  LibraryOptions library;
 };
 
 struct Augmentation;
@@ -166,7 +169,7 @@ struct Augmentation {
 };
 // Why --fix cannot add significant hypothesis `r` ("" when it can): its
 // effect has no plan, or the effect's not_planned rule declines it (an input
-// delay seen on one group only; effects.h).
+// delay seen on one group only, beside a sensor delay there; effects.cc).
 std::string why_not_fixable(const ResidualData& data, const Attribution& attribution, const HypothesisResult& r);
 
 // The screen's candidates for --fix: the augmentations (each with its

@@ -179,15 +179,24 @@ std::vector<std::string> family_groups(const ResidualData& data, const Attributi
   return groups;
 }
 
-// Dead time in the commands delays every channel they drive; a delay seen on
-// one group only is what a sensor delay of that group leaves as well (on a
-// channel the commands drive directly the two residuals nearly coincide), so
-// the plan declines it and --fix takes the next candidate.
+// Dead time in the commands delays every channel they drive; on a channel the
+// commands drive directly, a sensor delay leaves nearly the residual of an
+// input delay (of its own or a nearby number of steps). So an input delay
+// seen on one group only is declined when a sensor delay is significant in
+// that group (--fix then takes the sensor delay); seen on two groups or
+// more, or alone, it is planned.
 std::string not_planned(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead) {
   const auto groups = family_groups(data, attribution, lead);
   if (groups.size() >= 2) return "";
-  return "an input delay seen on one group (" + join(groups) +
-         ") only leaves the residual a sensor delay of that group leaves";
+  for (const auto& r : attribution.ranked) {
+    if (!r.significant) break;
+    if (r.hypothesis.kind != EffectKind::kSensorDelay) continue;
+    const std::string& channel = y_name(data, r.hypothesis.target);
+    if (channel_group(channel) != groups.front()) continue;
+    return "seen on one group (" + groups.front() + ") only, where a sensor delay of " + steps(r.hypothesis.delay) +
+           " on " + channel + " is significant too and leaves nearly the same residual";
+  }
+  return "";
 }
 
 // The commands d steps earlier as inputs: lag<d>_<c> for every command c the
@@ -653,7 +662,7 @@ const std::vector<EffectInfo>& effect_library() {
        "u(t-1-d) - u(t-1), every command channel: commands that act d steps later than the model assumes",
        "delay d (steps)",
        "dead time as inputs: the commands d steps earlier, lag<d>_<c> for every command c, appended to u "
-       "(not when the delay is seen on one group only: a sensor delay of that group leaves the same residual)",
+       "(not when it is seen on one group only and a sensor delay is significant there)",
        SourceKind::kNone, input_delay::enumerate, input_delay::features, input_delay::norm, finite,
        input_delay::describe, input_delay::plan, input_delay::not_planned},
       {EffectKind::kFriction, "friction",
