@@ -20,11 +20,13 @@
 #include <unistd.h>
 
 #include "codegen/codegen.h"
+#include "datalog/log_reader.h"
 #include "test/residual/fix_margins.h"
 #include "test/residual/plant_logs.h"
 #include "trainer/residual/rated_ranges.h"
 #include "trainer/model_file.h"
 #include "trainer/residual/augment.h"
+#include "trainer/residual/analysis.h"
 
 namespace hadynet::test {
 namespace {
@@ -38,12 +40,26 @@ struct FixRun {
   FixResult fix;
 };
 
+// With `null`: the analysis and the fix's verdict after calibrate their
+// floors on it, with its logs' trained PBs (as `hadynet residual` on the
+// model's stored held-out logs); without: absolute floors.
 FixRun run_fix(const std::vector<LogInput>& logs, const std::string& label,
-               const trainer::HadynetModel& model = build_model()) {
+               const trainer::HadynetModel& model = build_model(), const std::vector<LogInput>* null = nullptr) {
   FixRun r;
-  r.data = compute_residuals(model, logs, "auto");
-  r.attribution = attribute(r.data, enumerate_hypotheses(r.data, {}), {});
-  r.fix = fix(model, logs, r.data, r.attribution, {});
+  FixOptions fo;
+  if (null != nullptr) {
+    AnalysisOptions ao;
+    ao.reference_pb_choice = "state";
+    Analysis a = analyse(model, logs, ao, *null);
+    r.data = std::move(a.data);
+    r.attribution = std::move(a.attribution);
+    fo.reference = null;
+    fo.reference_pb_choice = "state";
+  } else {
+    r.data = compute_residuals(model, logs, "auto");
+    r.attribution = attribute(r.data, enumerate_hypotheses(r.data, {}), {});
+  }
+  r.fix = fix(model, logs, r.data, r.attribution, fo);
   // The measured table, for docs/residual.md.
   std::printf("[%s] %s; %s\n  before: %s\n", label.c_str(), r.fix.status.c_str(),
               r.fix.augmentation ? r.fix.augmentation->description.c_str() : "-", r.fix.before.verdict.c_str());
@@ -67,6 +83,18 @@ FixRun run_fix(const std::vector<LogInput>& logs, const std::string& label,
                 r.fix.before.whiteness[c].ljung_box.p_value, lba);
   }
   return r;
+}
+
+// The model's stored held-out logs (rows of its training logs no training
+// window used), as `hadynet residual` reads them by default.
+const std::vector<LogInput>& stored_null() {
+  static const std::vector<LogInput> logs = [] {
+    std::vector<LogInput> out;
+    for (const auto& stored : build_model().held_out_logs)
+      out.push_back({datalog::parse_log(stored.text, "held-out log " + stored.name), stored.name});
+    return out;
+  }();
+  return logs;
 }
 
 // The fix produced a model with the augmentation of `kind`.
@@ -214,6 +242,29 @@ TEST(ResidualFix, FrictionGetsDerivedCommandInputsAndCutsTheTendonsError) {
   const std::string& c = a.channels.front();
   expect_cut(r.fix, c, fm::kFriction.winner_vs_before, fm::kFriction.winner_vs_control);
   for (const auto& ch : a.channels) expect_cut(r.fix, ch, fm::kFriction.family_vs_before);
+  expect_deployable(m);
+}
+
+TEST(ResidualFix, InputDelayGetsTheLaggedCommandsAndCutsTheDelayedChannelsError) {
+  // Plant: the servos act on every command 2 steps after it is sent
+  // (input-delay, the default). Against the model's stored null (the
+  // default of `hadynet residual`): with absolute floors a fingertip
+  // cross-talk pair ranks first on these logs (docs/residual.md, "Input dead
+  // time").
+  const FixRun r = run_fix(plant_logs("input-delay"), "input-delay", build_model(), &stored_null());
+  ASSERT_TRUE(fixed_as(r, EffectKind::kInputDelay));
+  const Augmentation& a = *r.fix.augmentation;
+  // Every command 2 steps earlier, appended to u and computed from the
+  // logged commands (the logs have no such column).
+  const auto& m = r.fix.model;
+  const std::vector<std::string>& inputs = std::get<DerivedCommandInputs>(a.change).inputs;
+  ASSERT_EQ(inputs.size(), 8u);
+  EXPECT_EQ(inputs.front(), "lag2_u0");
+  EXPECT_EQ(m.params.dims.u, build_model().params.dims.u + 8);
+  EXPECT_EQ(m.layout.u_names.back(), "lag2_u7");
+  const std::string& c = a.channels.front();
+  expect_cut(r.fix, c, fm::kInputDelay.winner_vs_before, fm::kInputDelay.winner_vs_control);
+  for (const auto& ch : a.channels) expect_cut(r.fix, ch, fm::kInputDelay.family_vs_before);
   expect_deployable(m);
 }
 

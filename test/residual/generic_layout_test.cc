@@ -61,8 +61,9 @@ TEST(ResidualGenericLayout, CleanSpringLogsGiveNothing) {
 TEST(ResidualGenericLayout, DelayedSpringChannelIsNamedAndAligned) {
   // v1 follows the command u1 directly, so its 2-step sensor delay leaves
   // nearly the residual of a 2-step input delay on v1 alone, which ranks
-  // first; input-delay has no augmentation, so --fix takes the best that
-  // has one: the sensor delay of v1 (docs/residual.md).
+  // first; an input delay seen on one group beside a significant sensor
+  // delay is declined, so --fix takes the sensor delay of v1
+  // (docs/residual.md).
   const FixResult f = analyse_and_fix(spring_logs(2));
   ASSERT_TRUE(f.changed) << f.status;
   ASSERT_TRUE(f.augmentation.has_value());
