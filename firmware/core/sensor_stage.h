@@ -36,6 +36,16 @@ constexpr int longest_command_lag() noexcept {
   return longest;
 }
 
+// The contract's kUDerivedLag: 1..20 steps for a kLag input, 0 otherwise.
+template <GeneratedModel M>
+constexpr bool command_lags_valid() noexcept {
+  for (int i = 0; i < M::kU; ++i) {
+    const bool lag = M::kUDerived[i] == DerivedKind::kLag;
+    if (lag ? (M::kUDerivedLag[i] < 1 || M::kUDerivedLag[i] > 20) : M::kUDerivedLag[i] != 0) return false;
+  }
+  return true;
+}
+
 template <GeneratedModel M>
 class SensorStage {
  public:
@@ -145,7 +155,7 @@ class SensorStage {
 
   static constexpr int kDrifts = M::kDriftCount > 0 ? M::kDriftCount : 1;
   static constexpr int kMaxLag = longest_command_lag<M>();
-  static_assert(kMaxLag <= 20, "kUDerivedLag above the contract's 20 steps");
+  static_assert(command_lags_valid<M>(), "kUDerivedLag: 1..20 for a kLag input, 0 for every other");
   const ModelTensors<M>* t_;
   float driver_[kDrifts] = {};
   float hysteresis_[kU] = {};

@@ -98,9 +98,9 @@ std::string apply_effect_arg(std::string_view arg, Effects& e) {
   if (name == "friction") {
     e.tendon_friction_N = has_value ? value : 4.0;
   } else if (name == "sensor-delay") {
-    e.loadcell_delay_steps = has_value ? static_cast<int>(value) : 2;
-    if (has_value && (value != static_cast<int>(value) || value > 20))
+    if (has_value && (value > 20 || value != std::floor(value)))
       return "effect 'sensor-delay': expected a whole number of steps in 0..20";
+    e.loadcell_delay_steps = has_value ? static_cast<int>(value) : 2;
   } else if (name == "drift") {
     e.loadcell_drift_per_Ns = has_value ? value : 0.004;
     e.loadcell_drift_walk_N = 0.01;
@@ -113,9 +113,9 @@ std::string apply_effect_arg(std::string_view arg, Effects& e) {
     e.tension_leak = has_value ? value : 0.05;
     if (e.tension_leak > 1) return "effect 'tension-leak': expected a fraction in 0..1";
   } else if (name == "input-delay") {
-    e.command_delay_steps = has_value ? static_cast<int>(value) : 2;
-    if (has_value && (value != static_cast<int>(value) || value > 20))
+    if (has_value && (value > 20 || value != std::floor(value)))
       return "effect 'input-delay': expected a whole number of steps in 0..20";
+    e.command_delay_steps = has_value ? static_cast<int>(value) : 2;
   } else {
     return "unknown effect '" + std::string(name) +
            "' (expected friction, sensor-delay, drift, saturation, crosstalk, tension-leak or input-delay)";

@@ -18,6 +18,7 @@
 #include <set>
 
 #include "test/residual/plant_logs.h"
+#include "trainer/derived_inputs.h"
 #include "trainer/residual/analysis.h"
 #include "trainer/residual/attribution.h"
 #include "trainer/residual/augment.h"
@@ -321,6 +322,14 @@ TEST(PlantEffects, InputDelayIsNamedOnSeveralGroupsAndAddedAsLaggedCommands) {
   const auto& inputs = std::get<DerivedCommandInputs>(planned->change).inputs;
   ASSERT_EQ(inputs.size(), 8u);
   for (std::size_t m = 0; m < inputs.size(); ++m) EXPECT_EQ(inputs[m], "lag2_u" + std::to_string(m));
+  // Declined, with a reason: a model that has the lagged commands already
+  // (an earlier round added them), and a delay longer than a lag input states.
+  ResidualData fixed = o.data;
+  fixed.u_names.insert(fixed.u_names.end(), inputs.begin(), inputs.end());
+  EXPECT_NE(why_not_fixable(fixed, o.attribution, *it).find("already has"), std::string::npos);
+  HypothesisResult longer = *it;
+  longer.hypothesis.delay = trainer::kMaxCommandLag + 1;
+  EXPECT_NE(why_not_fixable(o.data, o.attribution, longer).find("longer than"), std::string::npos);
 }
 
 // A sensor delay of one group leaves nearly the residual of an input delay

@@ -173,8 +173,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   }
   if (!planned.front().not_fixable.empty()) {
     result.augmentation = planned.front();
-    result.status = "not supported: " + planned.front().effect + ": " + planned.front().description + ": " +
-                    planned.front().not_fixable;
+    result.status = "not supported: " + planned.front().effect + ": " + planned.front().not_fixable;
     return result;
   }
 

@@ -168,7 +168,19 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double) {
   return "input delay = " + steps(h.delay) + " seen on " + y_name(data, h.target);
 }
 
-// The channels the winner's delay is significant on, and their groups.
+// lag<d>_<c> for every command c the model reads from its logs (not the
+// derived ones) that the model does not have yet.
+std::vector<std::string> new_lag_inputs(const ResidualData& data, int d) {
+  std::vector<std::string> out;
+  for (const auto& u : data.u_names) {
+    if (parse_derived_input(u)) continue;
+    const std::string name = derived_input_name({DerivedKind::kLag, u, d});
+    if (std::find(data.u_names.begin(), data.u_names.end(), name) == data.u_names.end()) out.push_back(name);
+  }
+  return out;
+}
+
+// The groups of the channels the lead's delay is significant on.
 std::vector<std::string> family_groups(const ResidualData& data, const Attribution& attribution,
                                        const HypothesisResult& lead) {
   std::vector<std::string> groups;
@@ -184,8 +196,14 @@ std::vector<std::string> family_groups(const ResidualData& data, const Attributi
 // input delay (of its own or a nearby number of steps). So an input delay
 // seen on one group only is declined when a sensor delay is significant in
 // that group (--fix then takes the sensor delay); seen on two groups or
-// more, or alone, it is planned.
+// more, or alone, it is planned. Also declined: a delay longer than a lag
+// input may state, and a delay whose lagged commands the model already has
+// (an earlier round added them).
 std::string not_planned(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead) {
+  const int d = lead.hypothesis.delay;
+  if (d > kMaxCommandLag)
+    return "longer than the " + steps(kMaxCommandLag) + " a lagged command input may state (--max-delay)";
+  if (new_lag_inputs(data, d).empty()) return "the model already has every command " + steps(d) + " earlier as an input";
   const auto groups = family_groups(data, attribution, lead);
   if (groups.size() >= 2) return "";
   for (const auto& r : attribution.ranked) {
@@ -201,18 +219,13 @@ std::string not_planned(const ResidualData& data, const Attribution& attribution
 
 // The commands d steps earlier as inputs: lag<d>_<c> for every command c the
 // model reads from its logs (not the derived ones), beside the commands
-// themselves, so that the network learns which of the two acts.
+// themselves, so that the network learns which of the two acts. Only called
+// when not_planned() returned "" (so there is at least one new input).
 void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
   auto& change = a.change.emplace<DerivedCommandInputs>();
   const int d = w.hypothesis.delay;
   for (const auto& r : attribution.family_of(w)) a.channels.push_back(y_name(data, r.hypothesis.target));
-  for (const auto& u : data.u_names) {
-    if (parse_derived_input(u)) continue;
-    const std::string name = derived_input_name({DerivedKind::kLag, u, d});
-    if (std::find(data.u_names.begin(), data.u_names.end(), name) == data.u_names.end()) change.inputs.push_back(name);
-  }
-  if (change.inputs.empty())
-    throw std::invalid_argument("--fix: the model already has every command " + steps(d) + " earlier as an input");
+  change.inputs = new_lag_inputs(data, d);
   a.description = "add the commands " + steps(d) + " earlier as inputs (" + join(change.inputs) + "; input delay on " +
                   join(a.channels) + ")";
   a.found_on = a.channels;
