@@ -25,13 +25,14 @@
 #include <vector>
 
 #include "datalog/log_table.h"
+#include "firmware/core/model_contract.h"
 
 namespace hadynet::trainer {
 
 enum class DerivedKind { kSign, kHysteresis, kChangeSign, kChangeHysteresis, kLag };
 
-// The longest dead time a lag<d>_ input may state (steps).
-inline constexpr int kMaxCommandLag = 20;
+// The longest dead time a lag<d>_ input may state (steps): the firmware's.
+inline constexpr int kMaxCommandLag = firmware::kMaxDerivedLag;
 
 struct DerivedInput {
   DerivedKind kind;

@@ -82,6 +82,8 @@ enum class DerivedKind : std::uint8_t {
   kChangeHysteresis = 4,  // sign of the last non-zero change of u_base (0 before the first)
   kLag = 5,               // u_base of kUDerivedLag frames earlier (0 before the first command)
 };
+// The longest lag a kLag input may state (frames).
+inline constexpr int kMaxDerivedLag = 20;
 
 // clang-format off
 template <class M>
@@ -185,7 +187,7 @@ concept GeneratedModel = requires {
   // for friction or input dead time has some)
   M::kUDerived;           // DerivedKind[kU]
   M::kUDerivedBase;       // int[kU]  the command it is computed from (itself for kNone)
-  M::kUDerivedLag;        // int[kU]  steps, 1..20 for kLag; 0 otherwise
+  M::kUDerivedLag;        // int[kU]  steps, 1..kMaxDerivedLag for kLag; 0 otherwise
 
   // ---- sensor model (trainer/sensor_model.h; counts 0 for a model trained on
   // logs as they are; arrays hold max(count, 1) entries). The measured y is

@@ -36,12 +36,12 @@ constexpr int longest_command_lag() noexcept {
   return longest;
 }
 
-// The contract's kUDerivedLag: 1..20 steps for a kLag input, 0 otherwise.
+// The contract's kUDerivedLag: 1..kMaxDerivedLag for a kLag input, 0 otherwise.
 template <GeneratedModel M>
 constexpr bool command_lags_valid() noexcept {
   for (int i = 0; i < M::kU; ++i) {
     const bool lag = M::kUDerived[i] == DerivedKind::kLag;
-    if (lag ? (M::kUDerivedLag[i] < 1 || M::kUDerivedLag[i] > 20) : M::kUDerivedLag[i] != 0) return false;
+    if (lag ? (M::kUDerivedLag[i] < 1 || M::kUDerivedLag[i] > kMaxDerivedLag) : M::kUDerivedLag[i] != 0) return false;
   }
   return true;
 }
@@ -80,10 +80,6 @@ class SensorStage {
       // trainer's row 0 of a log.
       const float change = frames_ < 2 ? 0.0f : sign_of_difference(base, previous_base_[i]);
       previous_base_[i] = base;
-      // The base kUDerivedLag frames ago (read before this frame's is kept):
-      // 0 until a command that old exists, as the trainer's first rows.
-      const float lagged = lag_ring_[i][(lag_slot_ + kMaxLag - M::kUDerivedLag[i]) % kMaxLag];
-      lag_ring_[i][lag_slot_] = frames_ == 0 ? 0.0f : base;
       switch (M::kUDerived[i]) {
         case DerivedKind::kNone: u_model[i] = u_prev[i]; break;
         case DerivedKind::kSign: u_model[i] = sign; break;
@@ -96,7 +92,12 @@ class SensorStage {
           if (change != 0.0f) hysteresis_[i] = change;
           u_model[i] = hysteresis_[i];
           break;
-        case DerivedKind::kLag: u_model[i] = lagged; break;
+        case DerivedKind::kLag:
+          // The base kUDerivedLag frames ago (read before this frame's is
+          // kept): 0 until a command that old exists, as the trainer's first rows.
+          u_model[i] = lag_ring_[i][(lag_slot_ + kMaxLag - M::kUDerivedLag[i]) % kMaxLag];
+          lag_ring_[i][lag_slot_] = frames_ == 0 ? 0.0f : base;
+          break;
       }
     }
     lag_slot_ = (lag_slot_ + 1) % kMaxLag;
@@ -155,13 +156,13 @@ class SensorStage {
 
   static constexpr int kDrifts = M::kDriftCount > 0 ? M::kDriftCount : 1;
   static constexpr int kMaxLag = longest_command_lag<M>();
-  static_assert(command_lags_valid<M>(), "kUDerivedLag: 1..20 for a kLag input, 0 for every other");
+  static_assert(command_lags_valid<M>(), "kUDerivedLag: 1..kMaxDerivedLag for a kLag input, 0 for every other");
   const ModelTensors<M>* t_;
   float driver_[kDrifts] = {};
   float hysteresis_[kU] = {};
   float previous_base_[kU] = {};  // per u slot: its base command in the previous frame
-  // Per u slot: its base command in the newest kMaxLag frames, the newest at
-  // lag_slot_ - 1 (mod kMaxLag).
+  // Per kLag u slot: its base command in the newest kMaxLag frames, the
+  // newest at lag_slot_ - 1 (mod kMaxLag); unused for the other slots.
   float lag_ring_[kU][kMaxLag] = {};
   int lag_slot_ = 0;              // where this frame's base goes
   int frames_ = 0;                // frames since reset(), counted up to 2

@@ -58,28 +58,28 @@ inline constexpr SensorDelay kSensorDelay{
            "before; every aligned channel must gain (fc5 barely moves in these grasps: 0.93), which catches "
            "aligning only the channels past the floors (five delayed loadcells got worse, up to 1.4×)"};
 
-// Plant: 4 N of dry friction on every tendon (friction).
-struct Friction {
-  Below winner_vs_before;   // the winner (f0)
+// A fix that adds inputs for the winner's family: its cut on the winner,
+// against fine-tuning alone there, and on every family channel (measured:
+// the worst).
+struct FamilyCut {
+  Below winner_vs_before;
   Below winner_vs_control;
-  Below family_vs_before;   // every friction channel of the family (measured: the worst, f1)
+  Below family_vs_before;
   const char* why;
 };
-inline constexpr Friction kFriction{
+
+// Plant: 4 N of dry friction on every tendon (friction). Winner f0; the
+// family's worst f1.
+inline constexpr FamilyCut kFriction{
     .winner_vs_before = {0.75, 0.61},
     .winner_vs_control = {0.95, 0.87},
     .family_vs_before = {0.9, 0.76},
     .why = "fine-tuning alone already cuts f0 to 0.70×, so the hysteresis inputs are asked for a further 5 %; "
            "the family channels measured 0.58-0.76×"};
 
-// Plant: the servos act on every command 2 steps late (input-delay).
-struct InputDelay {
-  Below winner_vs_before;   // the winner (l5)
-  Below winner_vs_control;
-  Below family_vs_before;   // every channel the delay was found on
-  const char* why;
-};
-inline constexpr InputDelay kInputDelay{
+// Plant: the servos act on every command 2 steps late (input-delay). Winner
+// l5; the family: the channels the delay was found on.
+inline constexpr FamilyCut kInputDelay{
     .winner_vs_before = {0.7, 0.57},
     .winner_vs_control = {0.8, 0.66},
     .family_vs_before = {0.7, 0.57},
