@@ -27,7 +27,9 @@
 # of the target's unit (the default since; tension-leak added): seeds 351-358
 # development (the strengths 0.1 and 0.2 chosen there: 0.02 and 0.05 were
 # never significant), 381-390 measured. Input dead time (input-delay, its
-# fix added): seed 401 development (one set per strength), 411-420 measured.
+# fix added): seed 401 development (one set per strength); 411-420 were run
+# as the measurement, but the plan rule changed after one of them (seed
+# 415), so they are development too; 441-450 measured with the final rule.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...

@@ -22,7 +22,9 @@
 # target's unit and the pair of regressors y_s(t), y_s(t-1) (the defaults
 # since): 341-350 development (both against the earlier rule), 361-380 the
 # measured sets. With input dead time fixable (input-delay's plan): 421-440
-# the measured sets, with and without --candidates 3. Give others as arguments.
+# the measured sets, with and without --candidates 3 (the input-delay rule
+# was final before they were run; nothing was chosen on them). Give others as
+# arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
 #          [--reference-seed S] [SEED...]

@@ -9,7 +9,9 @@
 # a drift or a cross-talk. Run with the plant's rated ranges.
 # Seeds: 221-230 (never used elsewhere; see bench/residual_false_positives.sh);
 # with the calibrated null of seed 270 (--reference-seed 270): 301-310; with
-# the stored null and cross-talk sources of the target's unit: 391-400.
+# the stored null and cross-talk sources of the target's unit: 391-400
+# (measured again, unchanged, after input delays became fixable; nothing was
+# chosen on them).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S]
