@@ -18,6 +18,7 @@ struct Sha256Traits {
   using Hasher = Sha256;
   static constexpr std::size_t kBlock = 64;
   static constexpr std::size_t kDigest = kSha256Bytes;
+  static_assert(kDigest == crypto_hash_sha256_BYTES, "the firmware's digest length is libsodium's");
   static Bytes oracle(std::span<const std::uint8_t> m) {
     Bytes d(crypto_hash_sha256_BYTES);
     crypto_hash_sha256(d.data(), m.data(), m.size());
@@ -33,6 +34,7 @@ struct Sha512Traits {
   using Hasher = Sha512;
   static constexpr std::size_t kBlock = 128;
   static constexpr std::size_t kDigest = kSha512Bytes;
+  static_assert(kDigest == crypto_hash_sha512_BYTES, "the firmware's digest length is libsodium's");
   static Bytes oracle(std::span<const std::uint8_t> m) {
     Bytes d(crypto_hash_sha512_BYTES);
     crypto_hash_sha512(d.data(), m.data(), m.size());
