@@ -6,9 +6,8 @@
 # board's memory), then the release suite under CTest, which also runs the
 # images under QEMU (test/boards/), then the libFuzzer targets (fuzz preset:
 # clang, ASan + UBSan, 10 s each from their seeds), then the same host suite
-# under ASan + UBSan (debug preset: clang at -O0 -g1, a cold build in 10 m 51 s
-# on 2 cores against 19 m 28 s with GCC at -O0 -g), without the tests labelled
-# `slow` (model fine-tuning; they ran in release already).
+# under ASan + UBSan (debug preset: clang, CMakePresets.json says why), without
+# the tests labelled `slow` (model fine-tuning; they ran in release already).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
