@@ -46,9 +46,11 @@ class Boundary {
   }
   // Physical command -> standardised, Q(kFracIn).
   void u_to_model(const float (&u)[M::kU], Value (&out)[M::kU]) const noexcept {
-    for (int i = 0; i < M::kU; ++i) {
-      out[i] = N::template from_real<M::kFracIn>((u[i] - t_->u_mean[i]) * t_->u_inv_std[i]);
-    }
+    for (int i = 0; i < M::kU; ++i) out[i] = u_to_model(i, u[i]);
+  }
+  // Command slot i alone: physical -> standardised, Q(kFracIn).
+  Value u_to_model(int i, float u) const noexcept {
+    return N::template from_real<M::kFracIn>((u - t_->u_mean[i]) * t_->u_inv_std[i]);
   }
   // Standardised Q(kFracIn) -> physical command.
   void u_to_physical(const Value (&v)[M::kU], float (&out)[M::kU]) const noexcept {

@@ -13,6 +13,15 @@
 //   repeated N_epoch times; the first entry is the command. The next period
 //   starts from this sequence shifted by one step, last entry repeated.
 //
+// Derived inputs (model_contract.h, DerivedKind) are never planned. An input
+// dead time's lag input (kLag, lag d, of base command b) at horizon step k is
+// the base command d steps earlier: the plan's u_b,k-d for k >= d, the
+// command already applied for k < d (set_lag_history), mapped from b's
+// standardisation to the lag slot's. Its gradient flows back to u_b,k-d, so
+// the plan sees a command act d steps later. The other derived inputs (signs
+// and hysteresis of a command or of its change) keep their value of now over
+// the horizon (hold_input): they are steps of the commands, with no gradient.
+//
 // Two choices differ from the paper's text, both measured on the plant
 // (docs/firmware.md, "grasp stabiliser"), both switchable in Settings:
 //  * the reference r_k: by default relative to holding still (Reference),
@@ -35,6 +44,7 @@
 
 #include "firmware/core/hadynet_net.h"
 #include "firmware/core/isqrt.h"
+#include "firmware/core/model_contract.h"
 
 namespace hadynet::firmware {
 
@@ -81,11 +91,16 @@ class GraspStabilizer {
   };
 
   // Forgets the plan: the next warm start is `hold` at every step
-  // (standardised Q(kFracIn), e.g. the command "no change").
+  // (standardised Q(kFracIn), e.g. the command "no change"); lag inputs'
+  // history is `hold` too until set_lag_history.
   void reset(const Value (&hold)[kU]) noexcept {
     set_hold(hold);
     for (int k = 0; k < kHorizon; ++k)
       for (int i = 0; i < kU; ++i) seq_[k][i] = hold[i];
+    if constexpr (kHasLags) {
+      for (int i = 0; i < kU; ++i)
+        for (int k = 0; k < kMaxLag; ++k) lag_history_[i][k] = hold[i];
+    }
   }
   void set_reference(const Value (&y_ref)[kY]) noexcept {
     for (int i = 0; i < kY; ++i) y_ref_[i] = y_ref[i];
@@ -101,6 +116,21 @@ class GraspStabilizer {
     hold_[i] = value;
     for (int k = 0; k < kHorizon; ++k) seq_[k][i] = value;
   }
+  // The value lag input i (kLag, lag d) takes at horizon step k < d: its
+  // base command already applied, u_b,t+k-d, in slot i's standardisation
+  // (Q(kFracIn)). Steps k >= d take the plan's own commands.
+  void set_lag_history(int i, int k, Value value) noexcept {
+    if constexpr (kHasLags) {
+      if (i >= 0 && i < kU && k >= 0 && k < kMaxLag) lag_history_[i][k] = value;
+    }
+  }
+  // What set_lag_history set (the hold value after reset); 0 out of range.
+  Value lag_history(int i, int k) const noexcept {
+    if constexpr (kHasLags) {
+      if (i >= 0 && i < kU && k >= 0 && k < kMaxLag) return lag_history_[i][k];
+    }
+    return Value{};
+  }
   Settings& settings() noexcept { return settings_; }
 
   // Optimises the sequence from the standardised initial state x_t (and the
@@ -109,7 +139,8 @@ class GraspStabilizer {
   // the next period's warm start.
   void plan(HadynetNet<M>& net, const Value (&x)[M::kX], const Value (&y_now)[kY],
             const Value (&pb)[M::kPb], Value (&command)[kU]) noexcept {
-    t_ = &net.tensors();  // step sizes and loss weights of the net's model
+    t_ = &net.tensors();  // step sizes, loss weights and standardisation of the net's model
+    if constexpr (kHasLags) set_lag_maps();
     net.encode(x, pb);
     net.save(start_);
     set_step_references(net, y_now);
@@ -148,7 +179,8 @@ class GraspStabilizer {
       if (best_alpha_ < 0) break;  // no step size lowers L: keep the sequence
     }
     loss_final_ = loss;
-    for (int i = 0; i < kU; ++i) command[i] = seq_[0][i];
+    // The first step's inputs: the command, and the derived inputs as used.
+    input_at([this](int j) -> const Value(&)[kU] { return seq_[j]; }, 0, command);
     // Warm start of the next period: shift by one, repeat the last entry.
     for (int k = 0; k + 1 < kHorizon; ++k)
       for (int i = 0; i < kU; ++i) seq_[k][i] = seq_[k + 1][i];
@@ -193,6 +225,83 @@ class GraspStabilizer {
  private:
   using UnitT = std::conditional_t<N::kFixed, std::int32_t, float>;  // Q15 in int32 / float
 
+  using Row = Value[kU];
+  static constexpr int kMaxLag = longest_command_lag<M>();
+  static constexpr bool kHasLags = [] {
+    for (int i = 0; i < kU; ++i)
+      if (M::kUDerived[i] == DerivedKind::kLag) return true;
+    return false;
+  }();
+  static_assert(command_lags_valid<M>(), "kUDerivedLag: 1..kMaxDerivedLag for a kLag input, 0 for every other");
+  // Scale of the map from a base command's standardisation to its lag
+  // slot's: q15 Q(kLagScaleFrac) in int32; f32 float.
+  static constexpr int kLagScaleFrac = 16;
+  using LagScale = std::conditional_t<N::kFixed, std::int32_t, float>;
+
+  // The lag maps of the current model: v_lag = scale v_base + offset, with
+  // scale = std_b / std_lag and offset = (mean_b - mean_lag) / std_lag.
+  void set_lag_maps() noexcept {
+    for (int i = 0; i < kU; ++i) {
+      if (M::kUDerived[i] != DerivedKind::kLag) continue;
+      const int b = M::kUDerivedBase[i];
+      const float scale = t_->u_std[b] * t_->u_inv_std[i];
+      const float offset = (t_->u_mean[b] - t_->u_mean[i]) * t_->u_inv_std[i];
+      if constexpr (N::kFixed) {
+        lag_scale_[i] = fixed::real_to_fixed<std::int32_t, kLagScaleFrac>(scale);
+      } else {
+        lag_scale_[i] = scale;
+      }
+      lag_offset_[i] = N::template from_real<M::kFracIn>(offset);
+    }
+  }
+
+  // The model's inputs at horizon step k, u (Q(kFracIn)), of the plan whose
+  // step j is row(j): row(k), with each lag input replaced by its base
+  // command d steps earlier (see the header).
+  template <class Rows>
+  void input_at(Rows row, int k, Value (&u)[kU]) const noexcept {
+    const Row& r = row(k);
+    for (int i = 0; i < kU; ++i) u[i] = r[i];
+    if constexpr (kHasLags) {
+      for (int i = 0; i < kU; ++i) {
+        if (M::kUDerived[i] != DerivedKind::kLag) continue;
+        const int d = M::kUDerivedLag[i];
+        if (k < d) {
+          u[i] = lag_history_[i][k];
+          continue;
+        }
+        const Value base = row(k - d)[M::kUDerivedBase[i]];
+        if constexpr (N::kFixed) {
+          const std::int64_t scaled = fixed::rounding_shift_right(std::int64_t{lag_scale_[i]} * base, kLagScaleFrac);
+          u[i] = fixed::saturate_i16(scaled + lag_offset_[i]);
+        } else {
+          u[i] = lag_scale_[i] * base + lag_offset_[i];
+        }
+      }
+    }
+  }
+
+  // g_ of the lag inputs added to their base commands d steps earlier (the
+  // chain rule through input_at), then zeroed: a lag input is never planned.
+  void fold_lag_gradients() noexcept {
+    for (int k = 0; k < kHorizon; ++k) {
+      for (int i = 0; i < kU; ++i) {
+        if (M::kUDerived[i] != DerivedKind::kLag) continue;
+        const int d = M::kUDerivedLag[i];
+        if (k >= d) {
+          Grad& to = g_[k - d][M::kUDerivedBase[i]];
+          if constexpr (N::kFixed) {
+            const std::int64_t add = fixed::rounding_shift_right(std::int64_t{lag_scale_[i]} * g_[k][i], kLagScaleFrac);
+            to = fixed::saturate_i32(std::int64_t{to} + add);
+          } else {
+            to += lag_scale_[i] * g_[k][i];
+          }
+        }
+        g_[k][i] = 0;
+      }
+    }
+  }
+
   static void copy(const Value (&from)[kHorizon][kU], Value (&to)[kHorizon][kU]) noexcept {
     for (int k = 0; k < kHorizon; ++k)
       for (int i = 0; i < kU; ++i) to[k][i] = from[k][i];
@@ -208,7 +317,13 @@ class GraspStabilizer {
     Value y_hold[kY];
     net.restore(start_);
     for (int k = 0; k < kHorizon; ++k) {
-      net.step(hold_, y_hold);
+      if constexpr (kHasLags) {
+        Value u[kU];
+        input_at([this](int) -> const Value(&)[kU] { return hold_; }, k, u);
+        net.step(u, y_hold);
+      } else {
+        net.step(hold_, y_hold);
+      }
       for (int i = 0; i < kY; ++i) {
         if constexpr (N::kFixed) {
           ref_[k][i] = fixed::saturate_i16(std::int32_t{y_ref_[i]} + y_hold[i] - y_now[i]);
@@ -237,7 +352,15 @@ class GraspStabilizer {
   // Runs the sequence from the saved initial state, tracing into `slot`.
   Loss rollout(HadynetNet<M>& net, const Value (&seq)[kHorizon][kU], int slot) noexcept {
     net.restore(start_);
-    for (int k = 0; k < kHorizon; ++k) net.step(seq[k], y_est_[slot][k], &trace_[slot][k]);
+    for (int k = 0; k < kHorizon; ++k) {
+      if constexpr (kHasLags) {
+        Value u[kU];
+        input_at([&seq](int j) -> const Value(&)[kU] { return seq[j]; }, k, u);
+        net.step(u, y_est_[slot][k], &trace_[slot][k]);
+      } else {
+        net.step(seq[k], y_est_[slot][k], &trace_[slot][k]);
+      }
+    }
     return loss(y_est_[slot]);
   }
 
@@ -276,6 +399,7 @@ class GraspStabilizer {
       if (!any) return false;
     }
     backward(net, slot);
+    if constexpr (kHasLags) fold_lag_gradients();
     return normalise();
   }
 
@@ -374,6 +498,12 @@ class GraspStabilizer {
   Value seq_[kHorizon][kU] = {};
   Value y_ref_[kY] = {};
   Value hold_[kU] = {};
+  // Per lag input (sized 1 in a model without any): its value at steps
+  // k < d, and the map from its base's standardisation.
+  static constexpr int kLagSlots = kHasLags ? kU : 1;
+  Value lag_history_[kLagSlots][kMaxLag] = {};
+  LagScale lag_scale_[kLagSlots] = {};
+  Value lag_offset_[kLagSlots] = {};
   Value ref_[kHorizon][kY] = {};  // per-step reference of this period
   typename HadynetNet<M>::State start_{};
   const ModelTensors<M>* t_ = &kCompiledTensors<M>;  // the model of the last plan()'s net

@@ -178,10 +178,19 @@ class HadynetRuntime {
         boundary_.x_from_frames(history_.y(0), history_.y(1), x);
         Value u[M::kU];
         if constexpr (SensorStage<M>::has_derived_inputs()) {
-          // Derived inputs keep their value of the newest frame over the horizon.
+          // A lag input starts from the commands already applied (the plan's
+          // own after d steps); the other derived inputs keep their value of
+          // the newest frame over the horizon (grasp_stabilizer.h).
           boundary_.u_to_model(u_frame, u);
-          for (int i = 0; i < M::kU; ++i)
-            if (M::kUDerived[i] != DerivedKind::kNone) stabilizer_.hold_input(i, u[i]);
+          for (int i = 0; i < M::kU; ++i) {
+            if (M::kUDerived[i] == DerivedKind::kLag) {
+              const int d = M::kUDerivedLag[i];
+              for (int k = 0; k < d; ++k)
+                stabilizer_.set_lag_history(i, k, boundary_.u_to_model(i, sensor_.past_command(i, d - k)));
+            } else if (M::kUDerived[i] != DerivedKind::kNone) {
+              stabilizer_.hold_input(i, u[i]);
+            }
+          }
         }
         stabilizer_.plan(net_, x, y_now, pb_, u);
         boundary_.u_to_physical(u, out.command);

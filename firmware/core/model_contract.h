@@ -210,6 +210,25 @@ concept GeneratedModel = requires {
 };
 // clang-format on
 
+// The longest lag of M's kLag inputs (steps; 1 without any).
+template <GeneratedModel M>
+constexpr int longest_command_lag() noexcept {
+  int longest = 1;
+  for (int i = 0; i < M::kU; ++i)
+    if (M::kUDerived[i] == DerivedKind::kLag && M::kUDerivedLag[i] > longest) longest = M::kUDerivedLag[i];
+  return longest;
+}
+
+// The contract's kUDerivedLag: 1..kMaxDerivedLag for a kLag input, 0 otherwise.
+template <GeneratedModel M>
+constexpr bool command_lags_valid() noexcept {
+  for (int i = 0; i < M::kU; ++i) {
+    const bool lag = M::kUDerived[i] == DerivedKind::kLag;
+    if (lag ? (M::kUDerivedLag[i] < 1 || M::kUDerivedLag[i] > kMaxDerivedLag) : M::kUDerivedLag[i] != 0) return false;
+  }
+  return true;
+}
+
 }  // namespace hadynet::firmware
 
 #endif  // HADYNET_FIRMWARE_CORE_MODEL_CONTRACT_H_

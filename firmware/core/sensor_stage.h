@@ -27,25 +27,6 @@
 
 namespace hadynet::firmware {
 
-// The longest lag of M's kLag inputs (steps; 1 without any).
-template <GeneratedModel M>
-constexpr int longest_command_lag() noexcept {
-  int longest = 1;
-  for (int i = 0; i < M::kU; ++i)
-    if (M::kUDerived[i] == DerivedKind::kLag && M::kUDerivedLag[i] > longest) longest = M::kUDerivedLag[i];
-  return longest;
-}
-
-// The contract's kUDerivedLag: 1..kMaxDerivedLag for a kLag input, 0 otherwise.
-template <GeneratedModel M>
-constexpr bool command_lags_valid() noexcept {
-  for (int i = 0; i < M::kU; ++i) {
-    const bool lag = M::kUDerived[i] == DerivedKind::kLag;
-    if (lag ? (M::kUDerivedLag[i] < 1 || M::kUDerivedLag[i] > kMaxDerivedLag) : M::kUDerivedLag[i] != 0) return false;
-  }
-  return true;
-}
-
 template <GeneratedModel M>
 class SensorStage {
  public:
@@ -135,6 +116,14 @@ class SensorStage {
       Value& v = y[M::kClipChannel[k]];
       if (M::kClipSide[k] > 0 ? v > t_->clip_rail_model[k] : v < t_->clip_rail_model[k]) v = t_->clip_rail_model[k];
     }
+  }
+
+  // The base command of kLag slot i (physical, model frame) after frame t
+  // (which carries u_{t-1}) went through to_model: u_base,t-frames_ago, for
+  // 1 <= frames_ago <= kMaxLag; 0 where no command that old exists (as in
+  // to_model).
+  float past_command(int i, int frames_ago) const noexcept {
+    return lag_ring_[i][(lag_slot_ + kMaxLag - frames_ago) % kMaxLag];
   }
 
   static constexpr bool has_derived_inputs() noexcept {

@@ -16,6 +16,7 @@
 #include "hadynet_model_q15.h"
 #include "test/firmware/held_out_logs.h"
 #include "test/firmware/tolerances.h"
+#include "trainer/control/reference_stabiliser.h"
 #include "trainer/derived_inputs.h"
 #include "trainer/residual/residuals.h"
 
@@ -41,7 +42,7 @@ TEST(FixedModelHeader, CarriesTheDerivedInputsAndTheSensorModel) {
   EXPECT_EQ(F::kUDerived[F::kU - 2], firmware::DerivedKind::kChangeHysteresis);
   EXPECT_EQ(F::kUDerivedBase[F::kU - 2], 1);
   EXPECT_EQ(F::kUDerived[F::kU - 1], firmware::DerivedKind::kLag);
-  EXPECT_EQ(F::kUDerivedBase[F::kU - 1], 2);
+  EXPECT_EQ(F::kUDerivedBase[F::kU - 1], 3);
   EXPECT_EQ(F::kUDerivedLag[F::kU - 1], 2);
   EXPECT_EQ(F::kUDerivedLag[F::kU - 2], 0);
   EXPECT_FALSE(F::kControlActive[F::kU - 1]);  // never set by the stabiliser
@@ -146,24 +147,199 @@ TEST(FixedModelRuntime, ResetRestartsTheDriftAndHysteresisStates) {
   EXPECT_EQ(first, second);
 }
 
-TEST(FixedModelRuntime, ControlModeRunsWithDerivedInputsHeld) {
+TEST(FixedModelRuntime, ControlModeHoldsFrictionInputsAndFeedsTheLagInputTheCommandsSent) {
   const datalog::LogTable& table = test::held_out_table("Cylinder", "random2", 150);
+  // u3 sent at row s: a ramp, so that one frame off reads another value.
+  const auto u3_sent = [](std::size_t s) { return 0.1 * static_cast<double>(s + 1); };
+  // Two LSBs of Q(kFracIn) in lag2_u3's physical units.
+  const double lsb2 = 2.0 * fixed_model().norm.u.std(Q::kU - 1) / (1 << Q::kFracIn);
   auto rt = std::make_unique<firmware::HadynetRuntime<Q>>();
   rt->set_mode(firmware::Mode::kControl);
-  for (std::size_t t = 0; t < 6; ++t) {
+  for (std::size_t t = 0; t < 8; ++t) {
     firmware::SensorFrame<Q> f{};
     for (int i = 0; i < Q::kY; ++i) f.y[i] = static_cast<float>(table.at(t, *table.column_index(Q::kYNames[i])));
     f.u_prev[0] = -0.5f;  // u0 moved: sign_u0 = hyst_u0 = -1
+    f.u_prev[3] = t == 0 ? 0.0f : static_cast<float>(u3_sent(t - 1));  // frame t carries u_{t-1}
     const auto r = rt->step(f);
     if (t < 1) continue;
     ASSERT_TRUE(r.command_valid) << t;
-    // The derived inputs are reported at their held value (hyst_u0 -1, standardised back; u1 never
-    // changes: dhyst_u1 0; u2 is 0: lag2_u2 0).
+    // The friction inputs are reported at their held value (hyst_u0 -1, standardised back; u1
+    // never changes: dhyst_u1 0).
     EXPECT_NEAR(r.command[Q::kU - 4], -1.0f, 0.01f) << t;
     EXPECT_NEAR(r.command[Q::kU - 2], 0.0f, 0.01f) << t;
-    EXPECT_NEAR(r.command[Q::kU - 1], 0.0f, 0.01f) << t;
+    // lag2_u3 at the plan's step 0 (the command u_t) is u3 sent two steps earlier, u3_{t-2}
+    // (0 before the first command); one frame off reads u3_{t-1} or u3_{t-3}, 0.1 away.
+    const double want = t < 2 ? 0.0 : u3_sent(t - 2);
+    EXPECT_NEAR(r.command[Q::kU - 1], want, lsb2) << t;
     for (float v : r.command) EXPECT_TRUE(std::isfinite(v));
   }
+}
+
+// ---- the stabiliser through an input dead time: lag2_u3 is u3 two steps
+// earlier, so a planned u3 (a stabiliser command) acts two steps later
+// (grasp_stabilizer.h)
+
+// One planning problem in standardised reals (the f32 boundary's values).
+struct PlanProblem {
+  std::vector<float> x, y_now, y_ref, pb, hold;
+  float history[2] = {};  // lag2_u3 at horizon steps 0 and 1: u3 at t-2 and t-1
+};
+
+PlanProblem plan_problem(const datalog::LogTable& table, std::size_t t, std::size_t t_ref) {
+  using B = firmware::Boundary<F>;
+  const auto& m = fixed_model();
+  const auto y_row = [&](std::size_t r, float (&out)[F::kY]) {
+    for (int i = 0; i < F::kY; ++i) out[i] = static_cast<float>(table.at(r, *table.column_index(F::kYNames[i])));
+  };
+  float yt[F::kY], yp[F::kY], yr[F::kY], x[F::kX], y_now[F::kY], y_ref[F::kY], hold[F::kU];
+  y_row(t, yt);
+  y_row(t - 1, yp);
+  y_row(t_ref, yr);
+  B{}.x_from_frames(yt, yp, x);
+  B{}.y_to_model(yt, y_now);
+  B{}.y_to_model(yr, y_ref);
+  const float zero[F::kU] = {};
+  B{}.u_to_model(zero, hold);
+  PlanProblem p;
+  p.x.assign(x, x + F::kX);
+  p.y_now.assign(y_now, y_now + F::kY);
+  p.y_ref.assign(y_ref, y_ref + F::kY);
+  p.hold.assign(hold, hold + F::kU);
+  for (int i = 0; i < F::kPb; ++i) p.pb.push_back(m.params.pb(0, i));
+  const std::size_t u3 = *table.column_index("u3");
+  for (int k = 0; k < 2; ++k) p.history[k] = B{}.u_to_model(F::kU - 1, static_cast<float>(table.at(t - 2 + k, u3)));
+  return p;
+}
+
+template <class M>
+trainer::control::StabiliserPlan firmware_plan(const PlanProblem& p, int truncation) {
+  using N = firmware::Numerics<M>;
+  using Value = typename M::Value;
+  static firmware::GraspStabilizer<M> stab;  // large: traces
+  static firmware::HadynetNet<M> net;
+  Value hold[M::kU], y_ref[M::kY], y_now[M::kY], x[M::kX], pb[M::kPb], cmd[M::kU];
+  for (int i = 0; i < M::kU; ++i) hold[i] = N::template from_real<M::kFracIn>(p.hold[static_cast<std::size_t>(i)]);
+  for (int i = 0; i < M::kY; ++i) {
+    y_ref[i] = N::template from_real<M::kFracY>(p.y_ref[static_cast<std::size_t>(i)]);
+    y_now[i] = N::template from_real<M::kFracY>(p.y_now[static_cast<std::size_t>(i)]);
+  }
+  for (int i = 0; i < M::kX; ++i) x[i] = N::template from_real<M::kFracIn>(p.x[static_cast<std::size_t>(i)]);
+  for (int i = 0; i < M::kPb; ++i) pb[i] = N::template from_real<M::kFracIn>(p.pb[static_cast<std::size_t>(i)]);
+  stab.reset(hold);
+  stab.set_reference(y_ref);
+  stab.settings().truncation = truncation;
+  for (int k = 0; k < 2; ++k) stab.set_lag_history(M::kU - 1, k, N::template from_real<M::kFracIn>(p.history[k]));
+  stab.plan(net, x, y_now, pb, cmd);
+  trainer::control::StabiliserPlan out;
+  out.direction.resize(M::kControlHorizon * M::kU);
+  for (int k = 0; k < M::kControlHorizon; ++k)
+    for (int i = 0; i < M::kU; ++i) out.direction(k * M::kU + i) = stab.first_direction(k, i);
+  out.command.resize(M::kU);
+  for (int i = 0; i < M::kU; ++i) out.command(i) = N::template to_real<M::kFracIn>(cmd[i]);
+  out.alpha = stab.best_alpha();
+  return out;
+}
+
+// The trainer's reference optimiser on the same problem.
+trainer::control::StabiliserPlan reference_plan(const PlanProblem& p, int truncation) {
+  const auto& m = fixed_model();
+  static const trainer::HadynetParams<double> params = m.params.cast<double>();
+  const auto vec = [](const std::vector<float>& v) {
+    return Eigen::Map<const Eigen::VectorXf>(v.data(), static_cast<Eigen::Index>(v.size())).cast<double>().eval();
+  };
+  trainer::control::StabiliserSettings settings;
+  settings.horizon = F::kControlHorizon;
+  settings.epochs = F::kControlEpochs;
+  settings.truncation = truncation;
+  for (int a = 0; a < F::kControlAlphaCount; ++a) settings.alphas.push_back(F::kControlAlpha[a]);
+  for (int i = 0; i < F::kU; ++i) settings.active.push_back(F::kControlActive[i]);
+  trainer::control::LossWeights w;
+  w.up.resize(F::kY);
+  w.down.resize(F::kY);
+  for (int i = 0; i < F::kY; ++i) {
+    w.up(i) = F::kLossWeightUp[i];
+    w.down(i) = F::kLossWeightDown[i];
+  }
+  trainer::control::StabiliserProblem problem;
+  problem.x0 = vec(p.x);
+  problem.pb = vec(p.pb);
+  problem.y_now = vec(p.y_now);
+  problem.y_ref = vec(p.y_ref);
+  problem.hold = vec(p.hold);
+  problem.lagged = trainer::control::lagged_inputs(m);
+  for (auto& l : problem.lagged) {
+    l.history.resize(2);
+    l.history(0) = p.history[0];
+    l.history(1) = p.history[1];
+  }
+  return trainer::control::reference_plan(params, problem, w, settings);
+}
+
+// 0 when either is zero (a missing gradient path must not read as agreement).
+double cosine(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  const double n = a.norm() * b.norm();
+  return n > 0 ? a.dot(b) / n : 0.0;
+}
+
+// The entries of command u of a step-major direction (k * kU + i), steps 0..H-1.
+Eigen::VectorXd command_part(const Eigen::VectorXd& direction, int u) {
+  Eigen::VectorXd out(F::kControlHorizon);
+  for (int k = 0; k < F::kControlHorizon; ++k) out(k) = direction(k * F::kU + u);
+  return out;
+}
+
+// u3 acts only through lag2_u3 (make_fixed_model.cc), so its whole gradient
+// is the lag path: holding the lag input over the horizon (the rule before)
+// gives u3 none, and the u3 part of the direction below is all that path.
+TEST(FixedModelStabiliser, PlansThroughTheCommandDelayAsTheTrainer) {
+  const auto lagged = trainer::control::lagged_inputs(fixed_model());
+  ASSERT_EQ(lagged.size(), 1u);
+  EXPECT_EQ(lagged[0].slot, F::kU - 1);
+  EXPECT_EQ(lagged[0].base, 3);
+  ASSERT_TRUE(F::kControlActive[3]);
+  EXPECT_EQ(lagged[0].lag, 2);
+  const int h = F::kControlHorizon;
+  const datalog::LogTable& table = test::held_out_table("Cylinder", "random2", 150);
+  double min_cos_f = 1, min_cos_q = 1, max_cmd_f = 0, max_cmd_q = 0, min_cos_u3_f = 1, min_cos_u3_q = 1;
+  double min_u3_share = 1;
+  int plans = 0;
+  for (std::size_t t = 12; t + 1 < table.rows(); t += 9) {
+    const PlanProblem p = plan_problem(table, t, t - 6);
+    for (int truncation : {F::kControlTruncation, 2}) {  // full BPTT (the default) and truncated
+      const auto ref = reference_plan(p, truncation);
+      const auto f = firmware_plan<F>(p, truncation);
+      const auto q = firmware_plan<Q>(p, truncation);
+      min_cos_f = std::min(min_cos_f, cosine(ref.direction, f.direction));
+      min_cos_q = std::min(min_cos_q, cosine(ref.direction, q.direction));
+      max_cmd_f = std::max(max_cmd_f, (f.command - ref.command).cwiseAbs().maxCoeff());
+      max_cmd_q = std::max(max_cmd_q, (q.command - ref.command).cwiseAbs().maxCoeff());
+      const Eigen::VectorXd ref_u3 = command_part(ref.direction, 3);
+      min_u3_share = std::min(min_u3_share, ref_u3.norm());
+      min_cos_u3_f = std::min(min_cos_u3_f, cosine(ref_u3, command_part(f.direction, 3)));
+      min_cos_u3_q = std::min(min_cos_u3_q, cosine(ref_u3, command_part(q.direction, 3)));
+      // A u3 in the last 2 steps acts beyond the horizon: no gradient.
+      for (int k = h - 2; k < h; ++k) {
+        EXPECT_EQ(f.direction(k * F::kU + 3), 0.0) << t;
+        EXPECT_EQ(q.direction(k * F::kU + 3), 0.0) << t;
+      }
+      // The lag input as used at step 0 is the command applied two steps ago.
+      EXPECT_EQ(f.command(F::kU - 1), p.history[0]) << t;
+      EXPECT_NEAR(q.command(F::kU - 1), p.history[0], 1.0 / (1 << Q::kFracIn)) << t;  // its rounding
+      ++plans;
+    }
+  }
+  std::printf("%d plans (truncation 8 and 2): gradient cosine min f32 %.6f q15 %.6f; command max |diff| "
+              "f32 %.3g q15 %.3g (standardised); u3's part (all through lag2_u3): norm at least %.3g of the unit direction, "
+              "cosine min f32 %.6f q15 %.6f\n",
+              plans, min_cos_f, min_cos_q, max_cmd_f, max_cmd_q, min_u3_share, min_cos_u3_f, min_cos_u3_q);
+  EXPECT_GE(min_cos_f, test::tolerance("gradient.f32.cosine_min"));
+  EXPECT_GE(min_cos_q, test::tolerance("gradient.q15.cosine_min"));
+  EXPECT_LE(max_cmd_f, test::tolerance("command.f32.max"));
+  EXPECT_LE(max_cmd_q, test::tolerance("command.q15.max"));
+  // The lag path itself, on its own: present, and in the same direction.
+  EXPECT_GT(min_u3_share, 0.0);
+  EXPECT_GE(min_cos_u3_f, test::tolerance("gradient.f32.cosine_min"));
+  EXPECT_GE(min_cos_u3_q, test::tolerance("gradient.q15.cosine_min"));
 }
 
 }  // namespace

@@ -7,7 +7,8 @@
 //
 // Added: friction inputs sign_u0, hyst_u0 and, as for an absolute command,
 // dsign_u1, dhyst_u1 (their LSTM input weights set to fixed non-zero values,
-// so that the firmware's derived inputs matter),
+// so that the firmware's derived inputs matter), a 2-step dead time of the
+// stabiliser command u3 (lag2_u3 takes u3's input weights, u3 none),
 // cross-talk fc2 += 0.25 fc3, a load drift on fc3 (0.02 per N s, 0.2 s
 // period) and a clip fc6 <= 2 N. No fine-tuning: the test compares the
 // firmware with the trainer on this model, not the model with the plant.
@@ -48,19 +49,23 @@ int main(int argc, char** argv) {
     residual::Augmentation friction;
     friction.kind = residual::EffectKind::kFriction;
     friction.effect = "friction";
-    friction.description = "test: hysteresis inputs of u0 and of u1's change, u2 two steps earlier";
+    friction.description = "test: hysteresis inputs of u0 and of u1's change, u3 two steps earlier";
     friction.change.emplace<residual::DerivedCommandInputs>().inputs = {"sign_u0", "hyst_u0", "dsign_u1", "dhyst_u1",
-                                                                        "lag2_u2"};
+                                                                        "lag2_u3"};
     std::vector<LogSequence> seqs;
     const FeatureLayout layout = residual::augmented_layout(base.layout, friction);
     for (const auto& l : logs) seqs.push_back(log_sequence(l.table, l.file, layout));
     HadynetModel m = residual::augmented_model(base, friction, seqs);
-    // Fixed, non-zero weights for the five new inputs (columns before the PB).
+    // Fixed, non-zero weights for the four friction inputs (columns before
+    // the PB); u3 acts only through its dead time: lag2_u3 takes u3's
+    // column, and u3's own is zero.
     auto& ih = m.params.lstm_weight_ih;
     const int u_old = base.params.dims.u;
     for (Eigen::Index r = 0; r < ih.rows(); ++r)
-      for (int k = 0; k < 5; ++k)
+      for (int k = 0; k < 4; ++k)
         ih(r, u_old + k) = 0.05f * static_cast<float>(std::sin(0.37 * static_cast<double>(r) + k));
+    ih.col(u_old + 4) = ih.col(3);
+    ih.col(3).setZero();
 
     m.sensor.crosstalk = {{"fc2", "fc3", 0.25}};
     m.sensor.drifts = {{"fc3", true, 0.02}};
