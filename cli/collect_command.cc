@@ -28,10 +28,7 @@ int run_collect(int argc, char** argv) {
   opt.value("init", "N", "initialisation (encoder zeroing) id", "0");
   opt.value("wear", "W", "wear level, 0 (new) .. 1 (worn)", "0");
   opt.value("split", "NAME", "split folder for a single experiment", "train");
-  opt.repeated("effect", "NAME[=V]",
-               "switch on an effect the model may lack: friction[=N], sensor-delay[=steps], drift[=N/(N s)],\n"
-               "                          saturation[=rail N], crosstalk[=fraction], tension-leak[=fraction],\n"
-               "                          input-delay[=steps]");
+  opt.repeated("effect", "NAME[=V]", plant::effect_arg_help("                          "));
   opt.flag("declare-effects", "write the switched-on effects into the logs and manifest (default: undeclared)");
   opt.flag("no-realism", "no sensor noise, quantisation or rated ranges");
   opt.flag("quiet", "no progress output");

@@ -153,6 +153,7 @@ int run_stabilize(int argc, char** argv) {
                 "d_without, d_with, cmd_<u> (the controlled run's commands, mm); no *_without\n" + kIndent +
                 "columns with --only-control");
   opt.value("plot", "PNG", "draw E of both runs with the strike force, and the controlled run's commands");
+  opt.repeated("effect", "NAME[=V]", "in the plant (both runs): " + plant::effect_arg_help(kIndent));
   opt.flag("only-control", "skip the run without control");
   if (!opt.parse(argc, argv)) return 2;
   if (opt.help_requested()) return 0;
@@ -181,6 +182,12 @@ int run_stabilize(int argc, char** argv) {
   if (!error.empty()) {
     std::fprintf(stderr, "hadynet stabilize: --disturbance: %s\n", error.c_str());
     return 2;
+  }
+  for (const auto& e : opt.all("effect")) {
+    if (const std::string err = plant::apply_effect_arg(e, co.effects); !err.empty()) {
+      std::fprintf(stderr, "hadynet stabilize: --effect: %s\n", err.c_str());
+      return 2;
+    }
   }
   const auto numeric = opt.get_numeric("numeric");
   if (!numeric) return 2;
@@ -262,6 +269,7 @@ int run_stabilize(int argc, char** argv) {
     std::printf("stabilize: %s, seed %llu, %s, %d steps of 0.2 s; PB: %s\n", state_name.c_str(),
                 static_cast<unsigned long long>(co.seed), firmware::numeric_name(co.numeric), co.steps, pb_note.c_str());
     std::printf("disturbance: %s\n", co.disturbance.describe().c_str());
+    if (co.effects.any()) std::printf("plant effects: %s\n", co.effects.describe().c_str());
     std::printf("mean E [N^2]         %14s %14s\n", early.label().c_str(), late.label().c_str());
     if (without)
       std::printf("  without control    %14.3f %14.3f\n", without->mean_error(early.begin, early.end),

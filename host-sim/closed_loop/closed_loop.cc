@@ -16,7 +16,13 @@ namespace {
 
 template <class M>
 ClosedLoopRun run_with(const ClosedLoopOptions& opt) {
-  plant::GraspSession session(opt.object, opt.init_id, opt.wear_level, opt.seed, opt.disturbance);
+  plant::ExperimentSpec spec;
+  spec.object = opt.object;
+  spec.init_id = opt.init_id;
+  spec.wear_level = opt.wear_level;
+  spec.seed = opt.seed;
+  spec.effects = opt.effects;
+  plant::GraspSession session(spec, opt.disturbance);
   // The model's channels in the plant's order; a derived input is computed
   // by the firmware from its base command, not sent to the plant (kNoCommand).
   constexpr std::size_t kNoCommand = ChannelBinding::kComputed;

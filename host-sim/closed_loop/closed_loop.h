@@ -25,6 +25,7 @@ struct ClosedLoopOptions {
   bool control = true;       // false: hold (u = 0), the firmware only observes
   firmware::Numeric numeric = firmware::Numeric::kQ15;
   std::string pb_state;      // PB table state the stabiliser predicts with ("": the default PB)
+  plant::Effects effects;    // plant effects the model may lack (e.g. an input dead time); none by default
   int control_epochs = -1;   // -1: the model's default
   int control_truncation = -1;
   // Ablations of the stabiliser's design choices (grasp_stabilizer.h):

@@ -123,6 +123,11 @@ std::string apply_effect_arg(std::string_view arg, Effects& e) {
   return "";
 }
 
+std::string effect_arg_help(const std::string& indent) {
+  return "switch on an effect the model may lack: friction[=N], sensor-delay[=steps], drift[=N/(N s)],\n" + indent +
+         "saturation[=rail N], crosstalk[=fraction], tension-leak[=fraction],\n" + indent + "input-delay[=steps]";
+}
+
 std::array<double, kMuscles> encoder_offsets_for(int init_id, std::uint64_t seed) {
   Rng rng(derive_seed(seed, 0x1417u, static_cast<std::uint64_t>(init_id)));
   std::array<double, kMuscles> out{};

@@ -90,6 +90,9 @@ struct Effects {
 // friction|sensor-delay|drift|saturation|crosstalk|tension-leak|input-delay. Returns an
 // error text or "".
 std::string apply_effect_arg(std::string_view arg, Effects& effects);
+// The `--effect` option's help: every NAME[=V] with its unit, one line each
+// after the first indented by `indent`.
+std::string effect_arg_help(const std::string& indent);
 
 // One dynamics state plus its simulation settings.
 struct HandSpec {
