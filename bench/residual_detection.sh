@@ -29,7 +29,9 @@
 # never significant), 381-390 measured. Input dead time (input-delay, its
 # fix added): seed 401 development (one set per strength); 411-420 were run
 # as the measurement, but the plan rule changed after one of them (seed
-# 415), so they are development too; 441-450 measured with the final rule.
+# 415), so they are development too; 441-450 measured with the final rule;
+# 481-490 measured the lag inputs starting as the pure dead time against
+# starting at zero weights (both on the same logs; nothing chosen on them).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...

@@ -23,8 +23,10 @@
 # since): 341-350 development (both against the earlier rule), 361-380 the
 # measured sets. With input dead time fixable (input-delay's plan): 421-440
 # the measured sets, with and without --candidates 3 (the input-delay rule
-# was final before they were run; nothing was chosen on them). Give others as
-# arguments.
+# was final before they were run; nothing was chosen on them). With the lag
+# inputs starting as the pure dead time: 491-510, with and without
+# --candidates 3. Seeds 461 and 471-480 belong to bench/dead_time_control.sh.
+# Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
 #          [--reference-seed S] [SEED...]

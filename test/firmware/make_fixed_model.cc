@@ -57,15 +57,17 @@ int main(int argc, char** argv) {
     for (const auto& l : logs) seqs.push_back(log_sequence(l.table, l.file, layout));
     HadynetModel m = residual::augmented_model(base, friction, seqs);
     // Fixed, non-zero weights for the four friction inputs (columns before
-    // the PB); u3 acts only through its dead time: lag2_u3 takes u3's
-    // column, and u3's own is zero.
+    // the PB). u3 acts only through its dead time: augmented_model already
+    // moved u3's column to lag2_u3 (the fix's pure dead-time start).
     auto& ih = m.params.lstm_weight_ih;
     const int u_old = base.params.dims.u;
     for (Eigen::Index r = 0; r < ih.rows(); ++r)
       for (int k = 0; k < 4; ++k)
         ih(r, u_old + k) = 0.05f * static_cast<float>(std::sin(0.37 * static_cast<double>(r) + k));
-    ih.col(u_old + 4) = ih.col(3);
-    ih.col(3).setZero();
+    if (ih.col(3).norm() != 0.0f || ih.col(u_old + 4).norm() == 0.0f) {
+      std::fprintf(stderr, "make_fixed_model: lag2_u3 did not take u3's input weights\n");
+      return 1;
+    }
 
     m.sensor.crosstalk = {{"fc2", "fc3", 0.25}};
     m.sensor.drifts = {{"fc3", true, 0.02}};

@@ -27,6 +27,7 @@
 #include "trainer/model_file.h"
 #include "trainer/residual/augment.h"
 #include "trainer/residual/analysis.h"
+#include "trainer/residual/residuals.h"
 
 namespace hadynet::test {
 namespace {
@@ -266,6 +267,50 @@ TEST(ResidualFix, InputDelayGetsTheLaggedCommandsAndCutsTheDelayedChannelsError)
   expect_cut(r.fix, c, fm::kInputDelay.winner_vs_before, fm::kInputDelay.winner_vs_control);
   for (const auto& ch : a.channels) expect_cut(r.fix, ch, fm::kInputDelay.family_vs_before);
   expect_deployable(m);
+}
+
+// The lag inputs start as the pure dead time the screen tested (effects.cc,
+// DerivedCommandInputs::add_to_network): before fine-tuning, the augmented
+// model predicts a log as the build's model predicts the same log with every
+// command 2 steps late. Bound 1e-4 standardised: float32 rounding of the
+// rescaled weights and bias (measured in the printout).
+TEST(ResidualFix, AnInputDelayStartsAsThePureDeadTime) {
+  const trainer::HadynetModel& base = build_model();
+  const std::vector<LogInput> logs = plant_logs("input-delay", 120);
+  Augmentation a;
+  a.kind = EffectKind::kInputDelay;
+  a.effect = "input-delay";
+  auto& change = a.change.emplace<DerivedCommandInputs>();
+  for (const auto& u : base.layout.u_names) change.inputs.push_back("lag2_" + u);
+  const trainer::FeatureLayout layout = augmented_layout(base.layout, a);
+  std::vector<trainer::LogSequence> seqs;
+  for (const auto& l : logs) seqs.push_back(trainer::log_sequence(l.table, l.file, layout));
+  const trainer::HadynetModel m = augmented_model(base, a, seqs);
+  const auto u_old = static_cast<Eigen::Index>(base.layout.u_names.size());
+  for (Eigen::Index c = 0; c < u_old; ++c) {
+    EXPECT_EQ(m.params.lstm_weight_ih.col(c).norm(), 0.0f) << base.layout.u_names[static_cast<std::size_t>(c)];
+    EXPECT_GT(m.params.lstm_weight_ih.col(u_old + c).norm(), 0.0f) << change.inputs[static_cast<std::size_t>(c)];
+  }
+  const Eigen::VectorXf pb = base.params.pb.row(0).transpose();
+  double worst = 0, undelayed = 0;
+  for (const auto& l : logs) {
+    datalog::LogTable late = l.table;
+    for (const auto& u : base.layout.u_names) {
+      const std::size_t c = *late.column_index(u);
+      for (std::size_t t = late.rows(); t-- > 0;) late.at(t, c) = t >= 2 ? l.table.at(t - 2, c) : 0.0;
+    }
+    const Eigen::MatrixXd got = predict_windows(m, trainer::log_sequence(l.table, l.file, m.layout), pb, 1);
+    const Eigen::MatrixXd want = predict_windows(base, trainer::log_sequence(late, l.file, base.layout), pb, 1);
+    const Eigen::MatrixXd as_is = predict_windows(base, trainer::log_sequence(l.table, l.file, base.layout), pb, 1);
+    const Eigen::VectorXd inv_std = base.norm.y.std.cwiseInverse();
+    worst = std::max(worst, (inv_std.asDiagonal() * (got - want)).cwiseAbs().maxCoeff());
+    undelayed = std::max(undelayed, (inv_std.asDiagonal() * (got - as_is)).cwiseAbs().maxCoeff());
+  }
+  std::printf("augmented (not fine-tuned) against the build's model with the commands 2 steps late: max %.3g "
+              "standardised; against it with the commands as logged: max %.3g\n",
+              worst, undelayed);
+  EXPECT_LE(worst, 1e-4);
+  EXPECT_GT(undelayed, 0.1);  // the delay matters on these logs: the comparison can fail
 }
 
 TEST(ResidualFix, SaturationClipsThePredictionAndCutsTheRailChannelsError) {

@@ -307,8 +307,15 @@ void DerivedCommandInputs::add_to_channels(std::vector<std::string>&, std::vecto
 }
 
 // The derived command channels appended to u: standardisation from the
-// training rows (whose u holds them, last), zero LSTM input weights (inputs
-// are [u ; p]).
+// training rows (whose u holds them, last); LSTM input weights (inputs are
+// [u ; p]) zero, except for a lag input: the network starts as the pure
+// dead time the screen tested, its base command acting only d steps late.
+// The lag input takes the base's column (rescaled to its standardisation,
+// the means' difference moved into the bias) and the base's column becomes
+// zero; fine-tuning then finds how much acts at once. (Starting the lag at
+// zero instead left the undelayed weights in place after fine-tuning, and
+// the stabiliser then planned with a command effect the plant does not
+// have: docs/residual.md, "Input dead time".)
 void DerivedCommandInputs::add_to_network(const Augmentation& a, const HadynetModel& before, HadynetModel& m,
                                       const std::vector<LogSequence>& train_seqs) const {
   m.layout = augmented_layout(before.layout, a);
@@ -325,6 +332,22 @@ void DerivedCommandInputs::add_to_network(const Augmentation& a, const HadynetMo
   ih.setZero();
   ih.leftCols(u_old) = p.lstm_weight_ih.leftCols(u_old);
   ih.rightCols(pb) = p.lstm_weight_ih.rightCols(pb);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const auto d = parse_derived_input(inputs[static_cast<std::size_t>(i)]);
+    if (!d || d->kind != DerivedKind::kLag) continue;
+    const auto& names = before.layout.u_names;
+    const auto base = static_cast<Eigen::Index>(std::find(names.begin(), names.end(), d->base) - names.begin());
+    if (base >= u_old) continue;  // a base added in this change: nothing to move
+    // W_b z_b = W_b (u - mean_b) / sd_b = W_b (sd_l / sd_b) z_l + W_b (mean_l - mean_b) / sd_b
+    // for the same command d steps late, z_l its lag input standardised.
+    const Eigen::Index lag = u_old + i;
+    const double scale = m.norm.u.std(lag) / m.norm.u.std(base);
+    const double shift = (m.norm.u.mean(lag) - m.norm.u.mean(base)) / m.norm.u.std(base);
+    const Eigen::VectorXf w = ih.col(base);
+    ih.col(lag) = w * static_cast<float>(scale);
+    p.lstm_bias_ih += w * static_cast<float>(shift);
+    ih.col(base).setZero();
+  }
   p.lstm_weight_ih = ih;
   p.dims.u += static_cast<int>(k);
   p.check_shapes();
