@@ -25,7 +25,9 @@
 # the measured sets, with and without --candidates 3 (the input-delay rule
 # was final before they were run; nothing was chosen on them). With the lag
 # inputs starting as the pure dead time: 491-510, with and without
-# --candidates 3. Seeds 461 and 471-480 belong to bench/dead_time_control.sh.
+# --candidates 3. Seeds 461 and 471-480 belong to bench/dead_time_control.sh,
+# 481-490 to bench/residual_detection.sh (input dead time), 511-515 to the
+# two-effect runs with an input dead time (docs/residual.md, "--rounds").
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

@@ -124,13 +124,6 @@ class GraspStabilizer {
       if (i >= 0 && i < kU && k >= 0 && k < kMaxLag) lag_history_[i][k] = value;
     }
   }
-  // What set_lag_history set (the hold value after reset); 0 out of range.
-  Value lag_history(int i, int k) const noexcept {
-    if constexpr (kHasLags) {
-      if (i >= 0 && i < kU && k >= 0 && k < kMaxLag) return lag_history_[i][k];
-    }
-    return Value{};
-  }
   Settings& settings() noexcept { return settings_; }
 
   // Optimises the sequence from the standardised initial state x_t (and the
