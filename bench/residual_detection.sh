@@ -13,7 +13,10 @@
 #             tendon channels (f*); drift: a load drift on a loadcell;
 #             saturation: a loadcell's upper rail within 10 % of the plant's;
 #             input-delay: the commands the plant's delay earlier as inputs
-#             (lag<d>_u*);
+#             (lag<d>_u*); sensor-curve (every loadcell reads
+#             50 N (F / 50 N)^E): curves on loadcells only, the first (the
+#             winner's) reading within 25 % of the plant's 50 (L / 50)^E at
+#             its highest knot L;
 #   cut       the held-out 1-step RMSE on the changed channels (mean ratio
 #             after/before) is at most 0.7;
 #   <control  the augmented model's RMSE there is below fine-tuning alone's.
@@ -32,6 +35,10 @@
 # 415), so they are development too; 441-450 measured with the final rule;
 # 481-490 measured the lag inputs starting as the pure dead time against
 # starting at zero weights (both on the same logs; nothing chosen on them).
+# Static calibration curve (sensor-curve, its fix added): seeds 1, 521-522,
+# 531-540 and 581-590 development (the slope bounds of its fit were chosen
+# on 531-540, the plan's restriction to the winner's group on 581-590),
+# 591-600 measured.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...
@@ -72,7 +79,8 @@ runs="$out/runs.txt"
 : >"$runs"
 # effect=strength, weaker first; the second is the larger strength.
 cases=(sensor-delay=1 sensor-delay=2 friction=2 friction=4 crosstalk=0.2 crosstalk=0.35 tension-leak=0.02
-  tension-leak=0.05 drift=0.01 drift=0.02 saturation=3 saturation=2 input-delay=1 input-delay=2)
+  tension-leak=0.05 drift=0.01 drift=0.02 saturation=3 saturation=2 input-delay=1 input-delay=2 sensor-curve=0.85
+  sensor-curve=0.7)
 ((${#only_cases[@]})) && cases=("${only_cases[@]}")
 total=$((n * ${#cases[@]})) done_runs=0 start=$(date +%s)
 for ((k = 0; k < n; ++k)); do
@@ -117,6 +125,13 @@ elif effect == "input-delay":
     lags = aug.get("derived_inputs", [])
     param_ok = (named_effect == "input-delay" and bool(lags)
                 and all(x.startswith("lag%d_" % int(strength)) for x in lags))
+elif effect == "sensor-curve":
+    curves = aug.get("curves", [])
+    def plant_reading(level):
+        return 50.0 * (max(level, 0.0) / 50.0) ** strength
+    param_ok = (named_effect == "sensor-curve" and bool(curves) and all(c["channel"].startswith("fc") for c in curves)
+                and abs(curves[0]["reading"][-1] - plant_reading(curves[0]["level"][-1]))
+                <= 0.25 * plant_reading(curves[0]["level"][-1]))
 named = confirmed and param_ok
 cut = below_control = False
 ratio = float("nan")

@@ -28,6 +28,11 @@
 # --candidates 3. Seeds 461 and 471-480 belong to bench/dead_time_control.sh,
 # 481-490 to bench/residual_detection.sh (input dead time), 511-515 to the
 # two-effect runs with an input dead time (docs/residual.md, "--rounds").
+# With the static calibration curve in the library (sensor-curve): 541-560
+# development (run before the plan took the winner's group only), 601-620
+# measured, with and without --candidates 3 (seeds 521-522, 531-540 and
+# 581-590 were its development, 591-600 its detection, 561-580 and 621-630
+# the unknown-effect runs).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

@@ -1,20 +1,28 @@
 #!/usr/bin/env bash
 # An effect outside the residual loop's library (issue 12; not a test): does
 # `hadynet residual --fix` answer "unexplained structure" (or nothing), or
-# does it confirm a wrong fix? The effect exists only in this script: a static
-# calibration curve of one loadcell, fc1 reported as 50 N * (fc1 / 50 N)^0.85
-# (monotone, compressive: +60 % at 1 N, +30 % at 10 N), applied to clean plant
-# logs of the four grasps of docs/residual.md after recording. The library
-# has no static nonlinearity; the nearest classes are a gain (none), a rail,
-# a drift or a cross-talk. Run with the plant's rated ranges.
-# Seeds: 221-230 (never used elsewhere; see bench/residual_false_positives.sh);
-# with the calibrated null of seed 270 (--reference-seed 270): 301-310; with
-# the stored null and cross-talk sources of the target's unit: 391-400
-# (measured again, unchanged, after input delays became fixable; nothing was
-# chosen on them).
+# does it confirm a wrong fix? The effect exists only in this script and is
+# applied to clean plant logs of the four grasps of docs/residual.md after
+# recording (--effect-kind):
+#   gain-wobble  (the default) fc1's gain swings with a 30 s period, as a
+#                loadcell's gain with its temperature: fc1 * (1 + 0.3
+#                sin(2 pi t / 30 s)), t = row * 0.2 s; no effect of the
+#                library is a gain that varies in time (drift is a bias).
+#   curve        fc1 reported as 50 N * (fc1 / 50 N)^0.85 (monotone,
+#                compressive: +60 % at 1 N, +30 % at 10 N). Outside the
+#                library until the static calibration curve (sensor-curve)
+#                was added; since, a library effect on one loadcell.
+# Run with the plant's rated ranges.
+# Seeds (curve): 221-230 (never used elsewhere; see
+# bench/residual_false_positives.sh); with the calibrated null of seed 270
+# (--reference-seed 270): 301-310; with the stored null and cross-talk
+# sources of the target's unit: 391-400 (measured again, unchanged, after
+# input delays became fixable; nothing was chosen on them); with
+# sensor-curve in the library: 561-570. Seeds (gain-wobble): 571-580 (before
+# the curve's plan took the winner's group only), 621-630.
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
-#          [--reference-seed S]
+#          [--reference-seed S] [--effect-kind gain-wobble|curve]
 #   defaults: models/hand.safetensors, build/residual-unknown-effect, 10, 221, the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
 # Environment: HADYNET (default build/release/cli/hadynet).
@@ -26,6 +34,7 @@ reference_seed=
 out=build/residual-unknown-effect
 n=10
 first_seed=221
+kind=gain-wobble
 while (($#)); do
   case "$1" in
     -h | --help) usage; exit 0 ;;
@@ -34,6 +43,7 @@ while (($#)); do
     --out) out=$2; shift 2 ;;
     --seeds) n=$2; shift 2 ;;
     --first-seed) first_seed=$2; shift 2 ;;
+    --effect-kind) kind=$2; shift 2 ;;
     *) echo "residual_unknown_effect: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -51,10 +61,12 @@ for ((k = 0; k < n; ++k)); do
   d="$out/seed$seed"
   rm -rf "$d" && mkdir -p "$d/logs"
   collect_residual_grasps "$hadynet" "$d/raw" "$seed"
-  # The curve, on the recorded values (comments and header kept).
-  python3 - "$d/raw" "$d/logs" <<'PY'
-import glob, os, sys
-src, dst = sys.argv[1:3]
+  # The effect, on the recorded values (comments and header kept).
+  python3 - "$d/raw" "$d/logs" "$kind" <<'PY'
+import glob, math, os, sys
+src, dst, kind = sys.argv[1:4]
+if kind not in ("gain-wobble", "curve"):
+    sys.exit("residual_unknown_effect: --effect-kind must be gain-wobble or curve")
 for path in glob.glob(os.path.join(src, "*", "*.csv")):
     lines = open(path).read().splitlines()
     header = next(i for i, l in enumerate(lines) if not l.startswith("#"))
@@ -63,7 +75,11 @@ for path in glob.glob(os.path.join(src, "*", "*.csv")):
     for i in range(header + 1, len(lines)):
         v = lines[i].split(",")
         x = max(float(v[c]), 0.0)
-        v[c] = repr(round(50.0 * (x / 50.0) ** 0.85, 6))
+        if kind == "curve":
+            v[c] = repr(round(50.0 * (x / 50.0) ** 0.85, 6))
+        else:
+            t = (i - header - 1) * 0.2
+            v[c] = repr(round(x * (1.0 + 0.3 * math.sin(2.0 * math.pi * t / 30.0)), 6))
         lines[i] = ",".join(v)
     open(os.path.join(dst, os.path.basename(path)), "w").write("\n".join(lines) + "\n")
 PY
@@ -81,6 +97,6 @@ print(f"seed {seed}: {outcome}: screen {j['verdict'][:60]} | fix {fix.get('statu
 PY
 done
 {
-  echo "effect outside the library (fc1 calibration curve), $n log sets:"
+  echo "effect outside the library ($kind of fc1), $n log sets:"
   for o in confirmed unexplained nothing; do echo "  $o: $(grep -c "^seed [0-9]*: $o:" "$summary" || true)"; done
 } | tee -a "$summary"

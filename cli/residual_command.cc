@@ -167,8 +167,8 @@ int run_residual(int argc, char** argv) {
               "The model's residual over logs and what it lacks (docs/residual.md): multi-step fit and RMSE per\n"
               "channel and horizon, whiteness (autocorrelation, Ljung-Box) and independence (cross-correlation\n"
               "with the inputs) of the 1-step residual, and the effect library's hypotheses (sensor and input\n"
-              "delay, friction/hysteresis, drift, saturation, cross-talk, unused aux_* channels) fitted on the first\n"
-              "part of each log and tested on the rest. Prints the winner with its parameters, or 'no significant\n"
+              "delay, friction/hysteresis, drift, saturation, a static calibration curve, cross-talk, unused aux_*\n"
+              "channels) fitted on the first part of each log and tested on the rest. Prints the winner with its parameters, or 'no significant\n"
               "effect'. Works on any (u, y) logs the model's channels fit.",
               "MODEL LOG|DIR... [options]");
   opt.value("pb", "PB",
@@ -211,8 +211,8 @@ int run_residual(int argc, char** argv) {
   opt.value("report", "DIR", "write DIR/REPORT.md with PNG plots (gnuplot) and DIR/residual.json");
   opt.value("json", "FILE", "write every number as JSON");
   opt.flag("fix", "add the winning effect (sensor delay: time alignment; cross-talk: removal; drift: a bias state;\n"
-                  "saturation: clipping; friction: hysteresis inputs; input delay: the commands d steps earlier as\n"
-                  "inputs; aux channel: an observed channel), fine-tune\n"
+                  "saturation: clipping; sensor curve: a calibration curve; friction: hysteresis inputs; input\n"
+                  "delay: the commands d steps earlier as inputs; aux channel: an observed channel), fine-tune\n"
                   "on the first --train-fraction of each log and report before/after on the rest; the effect is\n"
                   "confirmed (and the model kept) only when it beats fine-tuning alone on the held-out rows of\n"
                   "the channels it changes (one-sided Diebold-Mariano test at --alpha), else 'unexplained structure'");

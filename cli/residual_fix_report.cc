@@ -46,6 +46,11 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
       j["augmentation"]["source"] = removal->pair.source;
       j["augmentation"]["gain"] = removal->pair.gain;
     }
+    if (const auto* curves = std::get_if<rs::CalibrationCurves>(&a.change)) {
+      json list = json::array();
+      for (const auto& c : curves->curves) list.push_back({{"channel", c.channel}, {"level", c.level}, {"reading", c.reading}});
+      j["augmentation"]["curves"] = list;
+    }
     const auto* derived = std::get_if<rs::DerivedCommandInputs>(&a.change);
     if (derived != nullptr && !derived->inputs.empty()) j["augmentation"]["derived_inputs"] = derived->inputs;
     if (!f.fitted_rates.empty()) j["augmentation"]["fitted_rates"] = f.fitted_rates;

@@ -380,8 +380,13 @@ Emitter emit(const PreparedModel& p, const Formats& f, const HeaderValues& v, co
   e.array1("int", "kUDerivedBase[kU]", v.sensor.derived_base);
   e.array1("int", "kUDerivedLag[kU]", v.sensor.derived_lag);
   e.line();
-  e.line("  // ---- sensor model: measured y_c = clip(y'_c + sum gain y'_source + rate D_c)");
-  for (const std::string& l : v.sensor.notes) e.line("  // " + l);
+  e.line("  // ---- sensor model: measured y_c = clip(g_c(y'_c) + sum gain y'_source + rate D_c)");
+  for (const std::string& l : v.sensor.notes) e.out += comment_lines("  // ", comment_text(l), "  //   ");
+  e.member("int", "kCurveCount", std::to_string(v.sensor.curve_count));
+  e.member("int", "kCurveKnots", std::to_string(v.sensor.curve_knots), "knots per curve");
+  e.array1("int", "kCurveChannel[" + std::to_string(v.sensor.curve_channel.size()) + "]", v.sensor.curve_channel);
+  e.array1("float", "kCurveLevel[" + std::to_string(v.sensor.curve_level.size()) + "]", v.sensor.curve_level);
+  e.array1("float", "kCurveReading[" + std::to_string(v.sensor.curve_reading.size()) + "]", v.sensor.curve_reading);
   e.member("int", "kCrosstalkCount", std::to_string(v.sensor.crosstalk_count));
   e.array1("int", "kCrosstalkTarget[" + std::to_string(v.sensor.crosstalk_target.size()) + "]", v.sensor.crosstalk_target);
   e.array1("int", "kCrosstalkSource[" + std::to_string(v.sensor.crosstalk_source.size()) + "]", v.sensor.crosstalk_source);

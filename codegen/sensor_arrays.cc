@@ -64,6 +64,36 @@ SensorArrays sensor_arrays(const trainer::HadynetModel& model, bool q15, int fra
         q15 ? std::to_string(std::clamp<std::int64_t>(to_fixed(standardised, frac_y), -32768, 32767))
             : float_literal(static_cast<float>(standardised)));
   }
+  // The firmware's curves share one knot count (a compile-time size): the
+  // largest. A curve with fewer knots gets more beyond its top knot, on its
+  // last segment's extension, where g continues anyway (sensor_model.h), so
+  // g is unchanged.
+  std::size_t knots = 0;
+  for (const auto& c : s.curves) knots = std::max(knots, c.level.size());
+  for (const auto& c : s.curves) {
+    a.curve_channel.push_back(std::to_string(y_index(c.channel)));
+    std::vector<double> level = c.level, reading = c.reading;
+    for (std::size_t n = c.level.size(); level.size() < knots;) {
+      const auto step = static_cast<double>(level.size() + 1 - n);  // 1, 2, ... segments beyond the top knot
+      level.push_back(c.level[n - 1] + step * (c.level[n - 1] - c.level[n - 2]));
+      reading.push_back(c.reading[n - 1] + step * (c.reading[n - 1] - c.reading[n - 2]));
+    }
+    for (std::size_t k = 0; k < level.size(); ++k) {
+      const float l = static_cast<float>(level[k]), r = static_cast<float>(reading[k]);
+      // The firmware divides by the knots' differences in float.
+      if (k > 0 && !(l > static_cast<float>(level[k - 1]) && r > static_cast<float>(reading[k - 1])))
+        reject("sensor curve of " + c.channel + ": knots " + std::to_string(k - 1) + " and " + std::to_string(k) +
+               " are equal in float (the firmware's curves are float)");
+      a.curve_level.push_back(float_literal(l));
+      a.curve_reading.push_back(float_literal(r));
+    }
+  }
+  if (!s.curves.empty()) a.curve_knots = static_cast<int>(knots);
+  a.curve_count = static_cast<int>(a.curve_channel.size());
+  if (a.curve_channel.empty()) {
+    a.curve_channel = {"0"};
+    a.curve_level = a.curve_reading = {"0.0f", "1.0f"};
+  }
   a.crosstalk_count = static_cast<int>(a.crosstalk_target.size());
   a.drift_count = static_cast<int>(a.drift_channel.size());
   a.clip_count = static_cast<int>(a.clip_channel.size());

@@ -11,7 +11,8 @@ const std::set<std::string>& data_members() {
       "kLstmWeightIh",  "kLstmWeightHh",  "kLstmBias",      "kDecWeight",     "kDecBias",
       "kPbTable",       "kStateNames",    "kStateObjects",  "kDetectPb",      "kDetectMean",
       "kDetectWhiten",  "kDetectThreshold", "kDetectThresholdSq", "kControlAlpha", "kLossWeightUp",
-      "kLossWeightDown", "kCrosstalkGain", "kDriftRate",    "kClipRail",      "kClipRailModel"};
+      "kLossWeightDown", "kCrosstalkGain", "kDriftRate",    "kClipRail",      "kClipRailModel",
+      "kCurveLevel",    "kCurveReading"};
   return names;
 }
 

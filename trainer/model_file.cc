@@ -186,6 +186,7 @@ datalog::RobotProfile profile_from_json(const json& j, const std::vector<std::st
 // The sensor model (sensor_model.h) as metadata "sensor":
 //   {"delays": [{"channel", "steps"}], "crosstalk": [{"target", "source", "gain"}],
 //    "drifts": [{"channel", "driver": "load"|"time", "rate"}], "period_s": s,
+//    "curves": [{"channel", "level": [knots], "reading": [knots]}] (optional, none if absent),
 //    "clips": [{"channel", "side", "rail"}]}
 json sensor_json(const SensorModel& s) {
   json j = json::object();
@@ -197,6 +198,11 @@ json sensor_json(const SensorModel& s) {
   for (const auto& d : s.drifts)
     j["drifts"].push_back({{"channel", d.channel}, {"driver", d.load ? "load" : "time"}, {"rate", d.rate}});
   j["period_s"] = s.period_s;
+  if (!s.curves.empty()) {
+    j["curves"] = json::array();
+    for (const auto& c : s.curves)
+      j["curves"].push_back({{"channel", c.channel}, {"level", c.level}, {"reading", c.reading}});
+  }
   j["clips"] = json::array();
   for (const auto& c : s.clips) j["clips"].push_back({{"channel", c.channel}, {"side", c.side}, {"rail", c.rail}});
   return j;
@@ -225,6 +231,11 @@ SensorModel sensor_from_json(const json& j, const std::string& origin) {
                         json_number(d, "rate", "sensor drift", origin)});
   }
   s.period_s = json_number(j, "period_s", "sensor", origin, 0.0);
+  if (j.contains("curves"))
+    for (const json& c : json_array(j, "curves", origin))
+      s.curves.push_back({json_get<std::string>(c, "channel", "sensor curve", origin),
+                          json_get<std::vector<double>>(c, "level", "sensor curve", origin),
+                          json_get<std::vector<double>>(c, "reading", "sensor curve", origin)});
   for (const json& c : json_array(j, "clips", origin))
     s.clips.push_back({json_get<std::string>(c, "channel", "sensor clip", origin),
                        static_cast<int>(json_int(c, "side", "sensor clip", origin, -1, 1)),

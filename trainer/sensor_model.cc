@@ -49,6 +49,20 @@ void SensorModel::check(const std::vector<std::string>& y_names) const {
     need_channel(d.channel, "drift");
     if (!std::isfinite(d.rate)) throw std::invalid_argument("sensor model: drift rate on " + d.channel + " not finite");
   }
+  for (std::size_t i = 0; i < curves.size(); ++i) {
+    const SensorCurve& c = curves[i];
+    need_channel(c.channel, "curve");
+    for (std::size_t j = 0; j < i; ++j)
+      if (curves[j].channel == c.channel) throw std::invalid_argument("sensor model: two curves on " + c.channel);
+    if (c.level.size() < 2 || c.level.size() != c.reading.size())
+      throw std::invalid_argument("sensor model: the curve of " + c.channel + " needs >= 2 knots, as many readings");
+    for (std::size_t k = 0; k < c.level.size(); ++k) {
+      if (!std::isfinite(c.level[k]) || !std::isfinite(c.reading[k]))
+        throw std::invalid_argument("sensor model: the curve of " + c.channel + " has a knot that is not finite");
+      if (k > 0 && !(c.level[k] > c.level[k - 1] && c.reading[k] > c.reading[k - 1]))
+        throw std::invalid_argument("sensor model: the curve of " + c.channel + " is not strictly increasing");
+    }
+  }
   for (const auto& c : clips) {
     need_channel(c.channel, "output clip");
     if (c.side != 1 && c.side != -1) throw std::invalid_argument("sensor model: output clip side must be +1 or -1");
@@ -62,9 +76,37 @@ std::vector<std::string> SensorModel::describe() const {
   for (const auto& x : crosstalk) out.push_back(x.target + " += " + num(x.gain) + " * " + x.source);
   for (const auto& d : drifts)
     out.push_back(d.channel + " += " + num(d.rate) + (d.load ? " * sum |" + d.channel + "| dt" : std::string(" * t")));
+  for (const auto& c : curves) {
+    std::string knots;
+    for (std::size_t k = 0; k < c.level.size(); ++k)
+      knots += (k ? ", " : "") + num(c.level[k]) + " -> " + num(c.reading[k]);
+    out.push_back(c.channel + " reads g(" + c.channel + "), g through " + knots);
+  }
   for (const auto& c : clips) out.push_back(c.channel + (c.side > 0 ? " <= " : " >= ") + num(c.rail));
   return out;
 }
+
+const SensorCurve* SensorModel::curve_of(const std::string& channel) const {
+  for (const auto& c : curves)
+    if (c.channel == channel) return &c;
+  return nullptr;
+}
+
+namespace {
+
+// The piecewise-linear map through (from[k], to[k]), continued along the end
+// segments; `from` strictly increasing, >= 2 knots.
+double piecewise_linear(const std::vector<double>& from, const std::vector<double>& to, double v) {
+  const std::size_t n = from.size();
+  std::size_t k = 1;  // segment [k - 1, k]
+  while (k + 1 < n && v > from[k]) ++k;
+  return to[k - 1] + (v - from[k - 1]) * (to[k] - to[k - 1]) / (from[k] - from[k - 1]);
+}
+
+}  // namespace
+
+double curve_reading(const SensorCurve& c, double level) { return piecewise_linear(c.level, c.reading, level); }
+double curve_level(const SensorCurve& c, double reading) { return piecewise_linear(c.reading, c.level, reading); }
 
 int SensorModel::max_delay() const {
   int d = 0;
@@ -139,10 +181,20 @@ datalog::LogTable drift_removed(const datalog::LogTable& table, const std::strin
   return out;
 }
 
+datalog::LogTable curves_inverted(const datalog::LogTable& table, const std::string& file,
+                                  const std::vector<SensorCurve>& curves) {
+  datalog::LogTable out = table;
+  for (const auto& curve : curves) {
+    const std::size_t c = column(out, file, curve.channel);
+    for (std::size_t r = 0; r < out.rows(); ++r) out.at(r, c) = curve_level(curve, out.at(r, c));
+  }
+  return out;
+}
+
 datalog::LogTable to_model_frame(const SensorModel& sensor, const datalog::LogTable& table, const std::string& file) {
   if (sensor.frame_is_measured()) return table;
-  return time_aligned(crosstalk_removed(drift_removed(table, file, sensor.drifts), file, sensor.crosstalk), file,
-                      sensor.delays);
+  const datalog::LogTable without_bias = crosstalk_removed(drift_removed(table, file, sensor.drifts), file, sensor.crosstalk);
+  return time_aligned(curves_inverted(without_bias, file, sensor.curves), file, sensor.delays);
 }
 
 }  // namespace hadynet::trainer

@@ -4,9 +4,11 @@
 // trained on logs as they are. With the network's channels y' (physical
 // units, the model's frame), a measured channel is
 //
-//   y_c(t) = clip_c( y'_c(t - delay_c) + sum_s k_cs y'_s(t) + b_c(t) )
+//   y_c(t) = clip_c( g_c(y'_c(t - delay_c)) + sum_s k_cs y'_s(t) + b_c(t) )
 //
 //   delay_c y_c is reported `steps` rows late (a sensor delay);
+//   g_c     a static calibration curve: the sensor reports a monotone
+//           function of its channel's level (identity without one);
 //   k_cs    cross-talk: the target picks up `gain` times the source;
 //   b_c     a drift/bias state, rate * D_c(t), D_c the load the sensor has
 //           carried since the log's start (sum_{s<=t} |y_c(s)| dt) or the
@@ -14,11 +16,12 @@
 //   clip_c  a rail the sensor saturates at (side +1: min(., rail); -1: max).
 //
 // to_model_frame() moves a log into the model's frame (the inverse: the
-// delay undone, which is not causal, cross-talk and drift removed); the
+// delay undone, which is not causal, cross-talk and drift removed, the
+// curve inverted); the
 // clips are applied to every prediction (output_clip.h). Whoever feeds the
 // network logs or frames must apply it: the trainer's commands do
-// (read_sequences), the firmware applies cross-talk, drift and clips at its
-// boundary (docs/firmware.md).
+// (read_sequences), the firmware applies cross-talk, drift, curves and clips
+// at its boundary (docs/firmware.md).
 #pragma once
 
 #include <string>
@@ -50,6 +53,23 @@ struct SensorDrift {
   bool operator==(const SensorDrift&) const = default;
 };
 
+// A static calibration curve g: the sensor reads g(level) when its
+// channel's level (the model's frame, physical units) is `level`. g is
+// piecewise linear through the knots (level[i], reading[i]), both strictly
+// increasing (so g is monotone and invertible), and continues beyond the end
+// knots along the end segments.
+struct SensorCurve {
+  std::string channel;          // a y channel
+  std::vector<double> level;    // >= 2 knots, strictly increasing (channel units, the model's frame)
+  std::vector<double> reading;  // the reading at each knot, strictly increasing (channel units, measured)
+
+  bool operator==(const SensorCurve&) const = default;
+};
+// g(level) and its inverse g^-1(reading) (curve_level(c, curve_reading(c, v))
+// == v up to rounding).
+double curve_reading(const SensorCurve& curve, double level);
+double curve_level(const SensorCurve& curve, double reading);
+
 struct OutputClip {
   std::string channel;  // a y channel
   int side = 1;         // +1 upper rail, -1 lower rail
@@ -62,14 +82,19 @@ struct SensorModel {
   std::vector<SensorDelay> delays;  // one per delayed channel
   std::vector<SensorCrosstalk> crosstalk;
   std::vector<SensorDrift> drifts;
+  std::vector<SensorCurve> curves;  // at most one per channel
   std::vector<OutputClip> clips;
   // The control period (s) of the logs the drifts were fitted on: D of a
   // load drift grows by |y_c| period_s per row (the firmware integrates it).
   double period_s = 0;
 
-  bool empty() const { return delays.empty() && crosstalk.empty() && drifts.empty() && clips.empty(); }
-  // The frame transform (delay, cross-talk, drift) is the identity.
-  bool frame_is_measured() const { return delays.empty() && crosstalk.empty() && drifts.empty(); }
+  bool empty() const { return frame_is_measured() && clips.empty(); }
+  // The frame transform (delay, cross-talk, drift, curves) is the identity.
+  bool frame_is_measured() const {
+    return delays.empty() && crosstalk.empty() && drifts.empty() && curves.empty();
+  }
+  // The channel's curve, nullptr without one.
+  const SensorCurve* curve_of(const std::string& channel) const;
   // The largest delay (rows; 0 without one), and the delay of a channel.
   int max_delay() const;
   int delay_of(const std::string& channel) const;
@@ -95,15 +120,19 @@ std::vector<double> drift_driver(const datalog::LogTable& table, const std::stri
 //                 y'_c(s) = y_c(s + steps); the last max_delay rows are dropped.
 //   crosstalk_removed: target -= gain * source, every row.
 //   drift_removed: y_c -= rate * D_c (D_c from the measured column), every row.
+//   curves_inverted: y_c = g_c^-1(y_c), every row.
 datalog::LogTable time_aligned(const datalog::LogTable& table, const std::string& file,
                                const std::vector<SensorDelay>& delays);
 datalog::LogTable crosstalk_removed(const datalog::LogTable& table, const std::string& file,
                                     const std::vector<SensorCrosstalk>& crosstalk);
 datalog::LogTable drift_removed(const datalog::LogTable& table, const std::string& file,
                                 const std::vector<SensorDrift>& drifts);
+datalog::LogTable curves_inverted(const datalog::LogTable& table, const std::string& file,
+                                  const std::vector<SensorCurve>& curves);
 
 // A measured log in the model's frame: drift removed, then cross-talk
-// removed, then time-aligned (the inverse of the sensor model's order).
+// removed, then the curves inverted, then time-aligned (the inverse of the
+// sensor model's order).
 datalog::LogTable to_model_frame(const SensorModel& sensor, const datalog::LogTable& table, const std::string& file);
 
 }  // namespace hadynet::trainer

@@ -60,8 +60,9 @@ constexpr bool parse_numeric(std::string_view text, Numeric& out) noexcept {
 // kContractVersion (kGeneratorVersion names the generator, not the contract)
 // and the core rejects other versions at compile time (a stale generated
 // header fails the build, not the robot). 3 added kPeriodUs and kBoardGroup,
-// 4 kShapeId, 5 DerivedKind::kLag and kUDerivedLag.
-inline constexpr int kModelContractVersion = 5;
+// 4 kShapeId, 5 DerivedKind::kLag and kUDerivedLag, 6 the sensors'
+// calibration curves (kCurve*).
+inline constexpr int kModelContractVersion = 6;
 
 // Loss class of each observed channel for the grasp stabiliser.
 enum class LossClass : std::uint8_t {
@@ -191,8 +192,17 @@ concept GeneratedModel = requires {
 
   // ---- sensor model (trainer/sensor_model.h; counts 0 for a model trained on
   // logs as they are; arrays hold max(count, 1) entries). The measured y is
-  //   y_c = clip( y'_c + sum k y'_s + rate D_c ),  y' the network's channel,
+  //   y_c = clip( g_c(y'_c) + sum k y'_s + rate D_c ),  y' the network's channel,
+  // g_c the channel's calibration curve (the identity without one),
   // D_c = sum |y_c| kSensorPeriod (load) or t kSensorPeriod (time) since reset.
+  { M::kCurveCount } -> std::convertible_to<int>;  // at most one curve per channel
+  { M::kCurveKnots } -> std::convertible_to<int>;  // knots of every curve (>= 2; 2 without a curve)
+  M::kCurveChannel;       // int[]
+  // g of curve j is piecewise linear through (level, reading) of its knots
+  // [j * kCurveKnots, (j + 1) * kCurveKnots), both strictly increasing,
+  // continued beyond the end knots along the end segments.
+  M::kCurveLevel;         // float[] physical, the model's frame (y')
+  M::kCurveReading;       // float[] physical, as the sensor reports it
   { M::kCrosstalkCount } -> std::convertible_to<int>;
   M::kCrosstalkTarget;    // int[]  y channel that picks up
   M::kCrosstalkSource;    // int[]  y channel it picks up from
@@ -217,6 +227,22 @@ constexpr int longest_command_lag() noexcept {
   for (int i = 0; i < M::kU; ++i)
     if (M::kUDerived[i] == DerivedKind::kLag && M::kUDerivedLag[i] > longest) longest = M::kUDerivedLag[i];
   return longest;
+}
+
+// The contract's curves: kCurveKnots >= 2, each on a distinct y channel, and
+// the knots of M's own arrays strictly increasing (a model image's knots are
+// checked by codegen when the image is written).
+template <GeneratedModel M>
+constexpr bool curves_valid() noexcept {
+  if (M::kCurveCount < 0 || M::kCurveKnots < 2) return false;
+  for (int j = 0; j < M::kCurveCount; ++j) {
+    if (M::kCurveChannel[j] < 0 || M::kCurveChannel[j] >= M::kY) return false;
+    for (int i = 0; i < j; ++i)
+      if (M::kCurveChannel[i] == M::kCurveChannel[j]) return false;
+    for (int k = j * M::kCurveKnots + 1; k < (j + 1) * M::kCurveKnots; ++k)
+      if (!(M::kCurveLevel[k] > M::kCurveLevel[k - 1] && M::kCurveReading[k] > M::kCurveReading[k - 1])) return false;
+  }
+  return true;
 }
 
 // The contract's kUDerivedLag: 1..kMaxDerivedLag for a kLag input, 0 otherwise.

@@ -1,9 +1,10 @@
 // The data of a generated model that a model update may replace: weights
 // (in the storage order the build's kernels read), standardisation, the PB
 // table, detection statistics, control step sizes and loss weights, the
-// sensor model's values. Everything else of the model contract (dimensions,
-// formats, channel layout, counts, control constants) is its SHAPE: compile
-// time, the same for every image this firmware accepts (shape_id below).
+// sensor model's values (gains, rates, rails, curve knots). Everything else
+// of the model contract (dimensions, formats, channel layout, counts, control
+// constants) is its SHAPE: compile time, the same for every image this
+// firmware accepts (shape_id below).
 //
 // The core reads the model through a `const ModelTensors<M>&`: the
 // compiled-in one (kCompiledTensors<M>, the factory default, built at
@@ -68,6 +69,7 @@ struct ModelTensors {
   static constexpr int kCrosstalks = M::kCrosstalkCount > 0 ? M::kCrosstalkCount : 1;
   static constexpr int kDrifts = M::kDriftCount > 0 ? M::kDriftCount : 1;
   static constexpr int kClips = M::kClipCount > 0 ? M::kClipCount : 1;
+  static constexpr int kCurveValues = (M::kCurveCount > 0 ? M::kCurveCount : 1) * M::kCurveKnots;
 
   // ---- 8 bytes
   std::uint64_t model_hash;  // FNV-1a 64 of the model file these tensors came from (kModelHash)
@@ -81,6 +83,8 @@ struct ModelTensors {
   float crosstalk_gain[kCrosstalks];
   float drift_rate[kDrifts];
   float clip_rail[kClips];
+  float curve_level[kCurveValues];    // knot k of curve j at [j * kCurveKnots + k] (model_contract.h)
+  float curve_reading[kCurveValues];
   // ---- Bias (int32 in its accumulator's format, or float)
   Bias enc_bias[M::kHidden];
   Bias lstm_bias[kGates];
@@ -133,6 +137,10 @@ constexpr void build_tensors(const Source& s, ModelTensors<M>& t) noexcept {
     t.clip_rail[k] = s.kClipRail[k];
     t.clip_rail_model[k] = s.kClipRailModel[k];
   }
+  for (int k = 0; k < ModelTensors<M>::kCurveValues; ++k) {
+    t.curve_level[k] = s.kCurveLevel[k];
+    t.curve_reading[k] = s.kCurveReading[k];
+  }
   for (int r = 0; r < M::kHidden; ++r) t.enc_bias[r] = s.kEncBias[r];
   for (int r = 0; r < ModelTensors<M>::kGates; ++r) t.lstm_bias[r] = s.kLstmBias[r];
   if constexpr (M::kNumeric == Numeric::kQ15) {
@@ -184,6 +192,7 @@ constexpr std::size_t unpadded_tensor_bytes() noexcept {
       sizeof(T::model_hash) + sizeof(T::detect_threshold_sq) + sizeof(T::x_mean) + sizeof(T::x_inv_std) + sizeof(T::u_mean) +
       sizeof(T::u_std) + sizeof(T::u_inv_std) + sizeof(T::y_mean) + sizeof(T::y_std) + sizeof(T::y_inv_std) +
       sizeof(T::detect_threshold) + sizeof(T::crosstalk_gain) + sizeof(T::drift_rate) + sizeof(T::clip_rail) +
+      sizeof(T::curve_level) + sizeof(T::curve_reading) +
       sizeof(T::enc_bias) + sizeof(T::lstm_bias) + sizeof(T::dec_bias) + sizeof(T::weights) +
       sizeof(T::pb_table) + sizeof(T::detect_pb) + sizeof(T::detect_mean) + sizeof(T::detect_whiten) +
       sizeof(T::control_alpha) + sizeof(T::loss_weight_up) + sizeof(T::loss_weight_down) +

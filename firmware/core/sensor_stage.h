@@ -12,9 +12,13 @@
 //       frame's values;
 //     drift: D_c += |y_c| kSensorPeriod (load) or kSensorPeriod (time), then
 //       y1_c = y_c - rate D_c;
-//     cross-talk: y'_c = y1_c - gain y1_s (the source after the drift step).
+//     cross-talk: y2_c = y1_c - gain y1_s (the source after the drift step);
+//     curves: y'_c = g_c^-1(y2_c) (the identity without a curve).
 //   model-frame prediction -> measured (to_measured):
-//     y_c = clip(y'_c + gain y'_s + rate D_c), D_c as of the newest frame.
+//     y_c = clip(g_c(y'_c) + gain y'_s + rate D_c), D_c as of the newest frame.
+// g_c and g_c^-1 are piecewise linear through the curve's knots, continued
+// along the end segments, with the trainer's segment rule and arithmetic
+// (trainer/sensor_model.cc, curve_reading and curve_level) in binary32.
 // The trainer does the same (to_model_frame, the --fix evaluation). A sensor
 // delay is not undone here (it needs future samples): the network gets the
 // late measurement. Float operations only, each one IEEE binary32 operation
@@ -95,11 +99,19 @@ class SensorStage {
     for (int i = 0; i < kY; ++i) y_model[i] = drifted[i];
     for (int k = 0; k < M::kCrosstalkCount; ++k)
       y_model[M::kCrosstalkTarget[k]] -= t_->crosstalk_gain[k] * drifted[M::kCrosstalkSource[k]];
+    for (int j = 0; j < M::kCurveCount; ++j) {
+      float& v = y_model[M::kCurveChannel[j]];
+      v = piecewise_linear(t_->curve_reading, t_->curve_level, j, v);  // g^-1
+    }
   }
 
   // A model-frame prediction (physical) as the sensors would report it.
   void to_measured(const float (&y_model)[kY], float (&y)[kY]) const noexcept {
     for (int i = 0; i < kY; ++i) y[i] = y_model[i];
+    for (int j = 0; j < M::kCurveCount; ++j) {
+      const int c = M::kCurveChannel[j];
+      y[c] = piecewise_linear(t_->curve_level, t_->curve_reading, j, y_model[c]);  // g
+    }
     for (int k = 0; k < M::kCrosstalkCount; ++k)
       y[M::kCrosstalkTarget[k]] += t_->crosstalk_gain[k] * y_model[M::kCrosstalkSource[k]];
     for (int k = 0; k < M::kDriftCount; ++k) y[M::kDriftChannel[k]] += t_->drift_rate[k] * drift_driver(k);
@@ -138,12 +150,24 @@ class SensorStage {
     return M::kDriftIsLoad[k] ? driver_[k] : driver_[k] - M::kSensorPeriod;
   }
 
+  // Curve j's piecewise-linear map through (from[k], to[k]) of its knots
+  // (model_tensors.h), continued along the end segments: the segment is the
+  // first whose upper knot is >= v (the last one beyond it), as the trainer's.
+  using CurveValues = float[ModelTensors<M>::kCurveValues];
+  static float piecewise_linear(const CurveValues& from, const CurveValues& to, int j, float v) noexcept {
+    const int base = j * M::kCurveKnots;
+    int k = base + 1;  // segment [k - 1, k]
+    while (k + 1 < base + M::kCurveKnots && v > from[k]) ++k;
+    return to[k - 1] + (v - from[k - 1]) * (to[k] - to[k - 1]) / (from[k] - from[k - 1]);
+  }
+
   static constexpr float sign_of(float v) noexcept { return v > 0.0f ? 1.0f : (v < 0.0f ? -1.0f : 0.0f); }
   static constexpr float sign_of_difference(float a, float b) noexcept {
     return a > b ? 1.0f : (a < b ? -1.0f : 0.0f);
   }
 
   static constexpr int kDrifts = M::kDriftCount > 0 ? M::kDriftCount : 1;
+  static_assert(curves_valid<M>(), "kCurve*: >= 2 knots, distinct y channels, strictly increasing knots");
   static constexpr int kMaxLag = longest_command_lag<M>();
   static_assert(command_lags_valid<M>(), "kUDerivedLag: 1..kMaxDerivedLag for a kLag input, 0 for every other");
   const ModelTensors<M>* t_;

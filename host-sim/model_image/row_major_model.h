@@ -125,6 +125,7 @@ struct RowMajorModel {
   static constexpr int kCrosstalks = M::kCrosstalkCount > 0 ? M::kCrosstalkCount : 1;
   static constexpr int kDrifts = M::kDriftCount > 0 ? M::kDriftCount : 1;
   static constexpr int kClips = M::kClipCount > 0 ? M::kClipCount : 1;
+  static constexpr int kCurveValues = (M::kCurveCount > 0 ? M::kCurveCount : 1) * M::kCurveKnots;
 
   std::uint64_t kModelHash;
   float kXMean[M::kX], kXInvStd[M::kX];
@@ -152,6 +153,8 @@ struct RowMajorModel {
   float kDriftRate[kDrifts];
   float kClipRail[kClips];
   Value kClipRailModel[kClips];
+  float kCurveLevel[kCurveValues];
+  float kCurveReading[kCurveValues];
 
   RowMajorModel() = default;
   RowMajorModel(const RowMajorModel&) = delete;  // kStateNames points into this object
@@ -195,6 +198,8 @@ struct RowMajorModel {
     fill(l, "kDriftRate", kDriftRate);
     fill(l, "kClipRail", kClipRail);
     fill(l, "kClipRailModel", kClipRailModel);
+    fill(l, "kCurveLevel", kCurveLevel);
+    fill(l, "kCurveReading", kCurveReading);
   }
 };
 

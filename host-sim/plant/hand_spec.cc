@@ -64,7 +64,7 @@ Wear wear_from_level(double level) {
 bool Effects::any() const {
   return tendon_friction_N > 0 || loadcell_delay_steps > 0 || loadcell_drift_per_Ns > 0 ||
          loadcell_drift_walk_N > 0 || loadcell_rail_N > 0 || loadcell_crosstalk > 0 ||
-         tension_leak > 0 || command_delay_steps > 0;
+         tension_leak > 0 || command_delay_steps > 0 || loadcell_curve_exponent != 1.0;
 }
 
 std::string Effects::describe() const {
@@ -84,6 +84,10 @@ std::string Effects::describe() const {
   if (loadcell_crosstalk > 0) { std::snprintf(buf, sizeof buf, "crosstalk=%g", loadcell_crosstalk); add(buf); }
   if (tension_leak > 0) { std::snprintf(buf, sizeof buf, "tension-leak=%g", tension_leak); add(buf); }
   if (command_delay_steps > 0) { std::snprintf(buf, sizeof buf, "input-delay=%d", command_delay_steps); add(buf); }
+  if (loadcell_curve_exponent != 1.0) {
+    std::snprintf(buf, sizeof buf, "sensor-curve=%g", loadcell_curve_exponent);
+    add(buf);
+  }
   return out.empty() ? "none" : out;
 }
 
@@ -116,16 +120,22 @@ std::string apply_effect_arg(std::string_view arg, Effects& e) {
     if (has_value && (value > 20 || value != std::floor(value)))
       return "effect 'input-delay': expected a whole number of steps in 0..20";
     e.command_delay_steps = has_value ? static_cast<int>(value) : 2;
+  } else if (name == "sensor-curve") {
+    e.loadcell_curve_exponent = has_value ? value : 0.85;
+    if (!(e.loadcell_curve_exponent > 0.2 && e.loadcell_curve_exponent <= 5))
+      return "effect 'sensor-curve': expected an exponent in (0.2, 5]";
   } else {
     return "unknown effect '" + std::string(name) +
-           "' (expected friction, sensor-delay, drift, saturation, crosstalk, tension-leak or input-delay)";
+           "' (expected friction, sensor-delay, drift, saturation, crosstalk, tension-leak, input-delay or "
+           "sensor-curve)";
   }
   return "";
 }
 
 std::string effect_arg_help(const std::string& indent) {
   return "switch on an effect the model may lack: friction[=N], sensor-delay[=steps], drift[=N/(N s)],\n" + indent +
-         "saturation[=rail N], crosstalk[=fraction], tension-leak[=fraction],\n" + indent + "input-delay[=steps]";
+         "saturation[=rail N], crosstalk[=fraction], tension-leak[=fraction],\n" + indent +
+         "input-delay[=steps], sensor-curve[=exponent: loadcells read 50 N (F / 50 N)^exponent]";
 }
 
 std::array<double, kMuscles> encoder_offsets_for(int init_id, std::uint64_t seed) {

@@ -81,13 +81,17 @@ struct Effects {
   // Command dead time: the servos act on each command this many 0.2 s steps
   // after it is sent (ExperimentLoop::apply).
   int command_delay_steps = 0;
+  // A static calibration curve: every loadcell reports R (F / R)^exponent of
+  // its force F >= 0, R its rated range (50 N); 1 = linear (off). Below 1
+  // compressive (0.85: +28 % at 10 N, +80 % at 1 N).
+  double loadcell_curve_exponent = 1.0;
 
   bool any() const;
   // "friction=4,sensor-delay=2" style summary, for declared logs and reports.
   std::string describe() const;
 };
 // Parses one `--effect` argument: NAME or NAME=VALUE, NAME in
-// friction|sensor-delay|drift|saturation|crosstalk|tension-leak|input-delay. Returns an
+// friction|sensor-delay|drift|saturation|crosstalk|tension-leak|input-delay|sensor-curve. Returns an
 // error text or "".
 std::string apply_effect_arg(std::string_view arg, Effects& effects);
 // The `--effect` option's help: every NAME[=V] with its unit, one line each

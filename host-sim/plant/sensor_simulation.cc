@@ -28,6 +28,8 @@ SensorSimulation::SensorSimulation(const Effects& effects, bool realism, std::ui
 Measurement SensorSimulation::measure(const Measurement& truth) {
   Measurement out = truth;
   auto& fc = out.loadcell_N;
+  if (effects_.loadcell_curve_exponent != 1.0)
+    for (auto& v : fc) v = g::kLoadcellRange_N * std::pow(std::max(v, 0.0) / g::kLoadcellRange_N, effects_.loadcell_curve_exponent);
   if (effects_.loadcell_crosstalk > 0)
     for (int i = 0; i < 5; ++i) fc[i] += effects_.loadcell_crosstalk * truth.loadcell_N[kCrosstalkSource[i]];
   if (effects_.tension_leak > 0) fc[kLeakLoadcell] += effects_.tension_leak * truth.tension_N[kLeakTendon];

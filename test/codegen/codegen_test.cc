@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -18,6 +19,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "codegen/header_text.h"
+#include "codegen/sensor_arrays.h"
 #include "firmware/core/fixed_point.h"
 #include "trainer/deploy_prep.h"
 #include "trainer/detection.h"
@@ -580,6 +583,87 @@ TEST(Generate, PeriodAndBoardGroupComeFromTheModel) {
     o.period_s = bad;
     EXPECT_THROW(generate(m, kIdentity, o), UnsupportedModel) << bad;
   }
+}
+
+// ---- the sensor model's calibration curves (trainer/sensor_model.h) ----------------
+
+// The generated header's literals of one member.
+std::vector<std::string> literal(const GeneratedHeader& h, const std::string& name) {
+  const auto it = h.literals.find(name);
+  return it == h.literals.end() ? std::vector<std::string>{"<missing>"} : it->second;
+}
+
+TEST(Generate, SensorCurvesAreFloatArraysOfTheirKnots) {
+  HadynetModel m = synthetic_model(true);
+  const trainer::SensorCurve curve{"fc1", {-0.5, 0.25, 2.0}, {-0.4, 0.3, 1.7}};
+  m.sensor.curves = {curve};
+  const auto& y = m.layout.y_names;
+  const std::string channel = std::to_string(std::find(y.begin(), y.end(), "fc1") - y.begin());
+  std::vector<std::string> level, reading;
+  for (std::size_t k = 0; k < curve.level.size(); ++k) {
+    level.push_back(float_literal(static_cast<float>(curve.level[k])));
+    reading.push_back(float_literal(static_cast<float>(curve.reading[k])));
+  }
+  for (const Numeric n : {Numeric::kQ15, Numeric::kF32}) {  // physical floats in both numerics
+    CodegenOptions o;
+    o.numeric = n;
+    const GeneratedHeader h = generate(m, kIdentity, o);
+    EXPECT_EQ(literal(h, "kCurveCount"), std::vector<std::string>{"1"});
+    EXPECT_EQ(literal(h, "kCurveKnots"), std::vector<std::string>{"3"});
+    EXPECT_EQ(literal(h, "kCurveChannel"), std::vector<std::string>{channel});
+    EXPECT_EQ(literal(h, "kCurveLevel"), level);
+    EXPECT_EQ(literal(h, "kCurveReading"), reading);
+    EXPECT_TRUE(contains(h.text, "static constexpr float kCurveLevel[3] = {")) << h.text;
+    EXPECT_TRUE(contains(h.text, "measured y_c = clip(g_c(y'_c) + sum gain y'_source + rate D_c)"));
+    EXPECT_TRUE(contains(h.text, "// fc1 reads g(fc1), g through -0.5 -> -0.4, 0.25 -> 0.3, 2 -> 1.7"));
+  }
+  // Without a curve: count 0 and one unused identity segment.
+  const GeneratedHeader none = generate_q15(synthetic_model(true));
+  EXPECT_EQ(literal(none, "kCurveCount"), std::vector<std::string>{"0"});
+  EXPECT_EQ(literal(none, "kCurveKnots"), std::vector<std::string>{"2"});
+  EXPECT_EQ(literal(none, "kCurveChannel"), std::vector<std::string>{"0"});
+  EXPECT_EQ(literal(none, "kCurveLevel"), (std::vector<std::string>{"0.0f", "1.0f"}));
+  EXPECT_EQ(literal(none, "kCurveReading"), (std::vector<std::string>{"0.0f", "1.0f"}));
+}
+
+// The knots are model data (a model image carries them); the curves'
+// count, knot count and channels are shape (docs/model-update.md).
+TEST(Generate, SensorCurveKnotsAreDataTheirChannelsShape) {
+  HadynetModel m = synthetic_model(true);
+  m.sensor.curves = {{"fc1", {0.0, 1.0, 2.0}, {0.0, 1.2, 2.1}}};
+  const std::uint64_t shape = generate_q15(m).shape_id;
+  HadynetModel other_knots = m;
+  other_knots.sensor.curves[0].reading = {0.1, 1.0, 2.5};
+  other_knots.sensor.curves[0].level = {-0.2, 0.8, 2.2};
+  EXPECT_EQ(generate_q15(other_knots).shape_id, shape);
+  HadynetModel other_channel = m;
+  other_channel.sensor.curves[0].channel = "fc0";
+  EXPECT_NE(generate_q15(other_channel).shape_id, shape);
+  HadynetModel more_knots = m;
+  more_knots.sensor.curves[0] = {"fc1", {0.0, 1.0, 2.0, 3.0}, {0.0, 1.2, 2.1, 3.0}};
+  EXPECT_NE(generate_q15(more_knots).shape_id, shape);
+  EXPECT_NE(generate_q15(synthetic_model(true)).shape_id, shape);
+}
+
+// Curves with fewer knots than the model's most get more on their last
+// segment's extension (the firmware has one knot count): g is unchanged.
+TEST(Generate, SensorCurvesWithFewerKnotsArePaddedOnTheirEndSegment) {
+  HadynetModel m = synthetic_model(true);
+  m.sensor.curves = {{"fc0", {0.0, 1.0}, {0.0, 1.5}}, {"fc1", {0.0, 1.0, 2.0}, {0.0, 1.2, 2.1}}};
+  const SensorArrays a = sensor_arrays(m, false, 0);
+  EXPECT_EQ(a.curve_knots, 3);
+  EXPECT_EQ(a.curve_level, (std::vector<std::string>{"0.0f", "1.0f", "2.0f", "0.0f", "1.0f", "2.0f"}));
+  EXPECT_EQ(a.curve_reading, (std::vector<std::string>{"0.0f", "1.5f", "3.0f", "0.0f", "1.20000005f", "2.0999999f"}));
+}
+
+TEST(Rejects, SensorCurveKnotsThatAreEqualInFloat) {
+  HadynetModel m = synthetic_model(true);
+  // Strictly increasing in double (the trainer's check passes), one float apart at most.
+  m.sensor.curves = {{"fc1", {0.0, 1.0, 1.0 + 1e-12}, {0.0, 1.0, 2.0}}};
+  expect_unsupported(m, {}, "sensor curve of fc1: knots 1 and 2 are equal in float");
+  // A curve the trainer rejects (not increasing) is rejected as the model's inconsistency.
+  m.sensor.curves = {{"fc1", {0.0, 1.0, 2.0}, {0.0, 2.0, 1.0}}};
+  expect_unsupported(m, {}, "not strictly increasing");
 }
 
 }  // namespace

@@ -1,19 +1,25 @@
 // A model fixed by `hadynet residual --fix` through codegen and the firmware
 // core (make_fixed_model.cc: derived inputs sign_u0 and hyst_u0, cross-talk,
-// a load drift and a clip): the runtime's reported prediction on a held-out
-// plant log must equal the trainer's measured-frame prediction of the same
-// model (to_model_frame, the network, then the sensor model forward) within
-// the forward tolerances of docs/tolerances.md; the derived inputs must be
-// computed by the firmware (the frames carry garbage in their slots).
+// a load drift, a calibration curve and a clip): the runtime's reported
+// prediction on a held-out plant log must equal the trainer's measured-frame
+// prediction of the same model (to_model_frame, the network, then the sensor
+// model forward) within the forward tolerances of docs/tolerances.md; the
+// derived inputs must be computed by the firmware (the frames carry garbage
+// in their slots). The sensor stage alone (the curve beyond its end knots
+// included) is checked against the trainer's transforms, and a model image
+// of this model against its compiled-in tensors.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 
+#include "codegen/codegen.h"
 #include "firmware/core/hadynet_runtime.h"
 #include "hadynet_model_f32.h"
 #include "hadynet_model_q15.h"
+#include "host-sim/model_image/row_major_model.h"
 #include "test/firmware/held_out_logs.h"
 #include "test/firmware/tolerances.h"
 #include "trainer/control/reference_stabiliser.h"
@@ -51,34 +57,58 @@ TEST(FixedModelHeader, CarriesTheDerivedInputsAndTheSensorModel) {
   EXPECT_EQ(F::kClipCount, 1);
   EXPECT_EQ(Q::kClipCount, 1);
   EXPECT_EQ(F::kSensorPeriod, 0.2f);
+  ASSERT_EQ(m.sensor.curves.size(), 1u);
+  const trainer::SensorCurve& curve = m.sensor.curves[0];
+  ASSERT_EQ(F::kCurveCount, 1);
+  ASSERT_EQ(Q::kCurveCount, 1);
+  ASSERT_EQ(F::kCurveKnots, static_cast<int>(curve.level.size()));
+  EXPECT_STREQ(F::kYNames[F::kCurveChannel[0]], curve.channel.c_str());
+  for (int k = 0; k < F::kCurveKnots; ++k) {  // physical floats in both numerics
+    EXPECT_EQ(F::kCurveLevel[k], static_cast<float>(curve.level[static_cast<std::size_t>(k)])) << k;
+    EXPECT_EQ(F::kCurveReading[k], static_cast<float>(curve.reading[static_cast<std::size_t>(k)])) << k;
+    EXPECT_EQ(Q::kCurveLevel[k], F::kCurveLevel[k]) << k;
+    EXPECT_EQ(Q::kCurveReading[k], F::kCurveReading[k]) << k;
+  }
+}
+
+Eigen::Index y_row(const trainer::HadynetModel& m, const std::string& name) {
+  const auto& y = m.layout.y_names;
+  return static_cast<Eigen::Index>(std::find(y.begin(), y.end(), name) - y.begin());
+}
+
+// The trainer's sensor model forward on model-frame values (physical, y x T;
+// column t is row t of `table`): the curves (held_out.cc's order), cross-talk
+// from the model-frame source, the drift with D(t) from the measured column,
+// and the clips.
+Eigen::MatrixXd sensor_forward(const trainer::HadynetModel& m, const Eigen::MatrixXd& model_frame,
+                               const datalog::LogTable& table) {
+  Eigen::MatrixXd out = model_frame;
+  for (const auto& c : m.sensor.curves)
+    for (Eigen::Index t = 0; t < out.cols(); ++t)
+      out(y_row(m, c.channel), t) = trainer::curve_reading(c, model_frame(y_row(m, c.channel), t));
+  for (const auto& x : m.sensor.crosstalk) out.row(y_row(m, x.target)) += x.gain * model_frame.row(y_row(m, x.source));
+  for (const auto& d : m.sensor.drifts) {
+    const std::vector<double> driver = trainer::drift_driver(table, "log", d);
+    for (Eigen::Index t = 0; t < out.cols(); ++t) out(y_row(m, d.channel), t) += d.rate * driver[static_cast<std::size_t>(t)];
+  }
+  for (const auto& c : m.sensor.clips)
+    out.row(y_row(m, c.channel)) = c.side > 0 ? out.row(y_row(m, c.channel)).cwiseMin(c.rail).eval()
+                                              : out.row(y_row(m, c.channel)).cwiseMax(c.rail).eval();
+  return out;
 }
 
 // The trainer's prediction of every measured row t >= 2 of `table`
 // (physical, y x T; column t valid for t >= 2): the model-frame 1-step
 // prediction (the runtime's N_detect is 1 without detection statistics),
-// then cross-talk from the predicted source, the drift with D(t) from the
-// measured column, and the clip.
+// then the sensor model forward.
 Eigen::MatrixXd trainer_measured(const trainer::HadynetModel& m, const datalog::LogTable& table,
                                  const Eigen::VectorXf& pb) {
   const datalog::LogTable frame_table = trainer::to_model_frame(m.sensor, table, "log");
   const trainer::LogSequence frame = trainer::log_sequence(frame_table, "log", m.layout);
   const Eigen::MatrixXd p = trainer::residual::predict_windows(m, frame, pb, 1);  // clips applied
-  const auto row = [&](const std::string& n) {
-    return static_cast<Eigen::Index>(std::find(m.layout.y_names.begin(), m.layout.y_names.end(), n) -
-                                     m.layout.y_names.begin());
-  };
-  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(p.rows(), static_cast<Eigen::Index>(table.rows()));
-  for (Eigen::Index b = 0; b < p.cols(); ++b) out.col(b + 2) = p.col(b);
-  const Eigen::MatrixXd model_frame = out;
-  for (const auto& x : m.sensor.crosstalk) out.row(row(x.target)) += x.gain * model_frame.row(row(x.source));
-  for (const auto& d : m.sensor.drifts) {
-    const std::vector<double> driver = trainer::drift_driver(table, "log", d);
-    for (Eigen::Index t = 2; t < out.cols(); ++t) out(row(d.channel), t) += d.rate * driver[static_cast<std::size_t>(t)];
-  }
-  for (const auto& c : m.sensor.clips)
-    out.row(row(c.channel)) = c.side > 0 ? out.row(row(c.channel)).cwiseMin(c.rail).eval()
-                                         : out.row(row(c.channel)).cwiseMax(c.rail).eval();
-  return out;
+  Eigen::MatrixXd model_frame = Eigen::MatrixXd::Zero(p.rows(), static_cast<Eigen::Index>(table.rows()));
+  for (Eigen::Index b = 0; b < p.cols(); ++b) model_frame.col(b + 2) = p.col(b);
+  return sensor_forward(m, model_frame, table);
 }
 
 // Largest |firmware - trainer| per channel over the log, in standardised units.
@@ -120,6 +150,20 @@ double max_error(const datalog::LogTable& table) {
 TEST(FixedModelRuntime, PredictionEqualsTheTrainersMeasuredFramePrediction) {
   // A held-out Cylinder grasp (fc3 and fc6 loaded: the drift and the clip act).
   const datalog::LogTable& table = test::held_out_table("Cylinder", "random2", 150);
+  // fc3 in the model's frame visits both continuations of its curve (below
+  // the first knot, beyond the last), so that both directions of the curve
+  // are exercised there too.
+  const auto& m = fixed_model();
+  const trainer::SensorCurve& curve = m.sensor.curves.at(0);
+  const datalog::LogTable frame = trainer::to_model_frame(m.sensor, table, "log");
+  int below = 0, beyond = 0;
+  for (std::size_t t = 0; t < frame.rows(); ++t) {
+    const double v = frame.at(t, *frame.column_index(curve.channel));
+    below += v < curve.level.front();
+    beyond += v > curve.level.back();
+  }
+  EXPECT_GT(below, 0);
+  EXPECT_GT(beyond, 0);
   const double f32 = max_error<F>(table), q15 = max_error<Q>(table);
   std::printf("fixed model, 1-step prediction vs trainer, max standardised error: f32 %.3g, q15 %.3g\n", f32, q15);
   EXPECT_LE(f32, test::tolerance("forward.f32.max"));
@@ -174,6 +218,135 @@ TEST(FixedModelRuntime, ControlModeHoldsFrictionInputsAndFeedsTheLagInputTheComm
     for (float v : r.command) EXPECT_TRUE(std::isfinite(v));
   }
 }
+
+// ---- the sensor stage on its own: the curve on fc3 (with the drift and the
+// cross-talk it sits behind) against the trainer's transforms
+
+// Firmware (binary32) against trainer (double), physical units, relative to
+// 1 + |value|: the inputs and knots are rounded to float and each of the
+// stage's few operations per value rounds again (2^-24 each), the segment
+// slopes are below 1.5, and the drift integral adds one rounding per row
+// (60 rows here): together below 1e-6; 1e-5 leaves a margin of 10.
+constexpr double kStageTolerance = 1e-5;
+
+// The held-out log's first `rows` rows with the curve's channel replaced by a
+// ramp from 1 (unit) below the curve's first reading knot to 1 beyond its
+// last: the inverse curve is used on both continuations and every segment.
+datalog::LogTable curve_sweep_table(const trainer::SensorCurve& curve, std::size_t rows) {
+  datalog::LogTable t = test::held_out_table("Cylinder", "random2", 150);
+  t.values.resize(rows * t.columns.size());
+  const std::size_t c = *t.column_index(curve.channel);
+  const double lo = curve.reading.front() - 1, hi = curve.reading.back() + 1;
+  for (std::size_t r = 0; r < rows; ++r) t.at(r, c) = lo + (hi - lo) * static_cast<double>(r) / static_cast<double>(rows - 1);
+  return t;
+}
+
+template <class M>
+void expect_stage_as_the_trainer() {
+  const auto& m = fixed_model();
+  const trainer::SensorCurve& curve = m.sensor.curves.at(0);
+  const datalog::LogTable table = curve_sweep_table(curve, 60);
+  // Frame transform: drift removed, cross-talk removed, the curve inverted.
+  const datalog::LogTable frame = trainer::to_model_frame(m.sensor, table, "log");
+  ASSERT_EQ(frame.rows(), table.rows());
+  // Output transform of those model-frame values: the curve, cross-talk, drift, clip.
+  Eigen::MatrixXd model_frame(M::kY, static_cast<Eigen::Index>(table.rows()));
+  for (int i = 0; i < M::kY; ++i)
+    for (std::size_t t = 0; t < table.rows(); ++t)
+      model_frame(i, static_cast<Eigen::Index>(t)) = frame.at(t, *frame.column_index(M::kYNames[i]));
+  const Eigen::MatrixXd measured = sensor_forward(m, model_frame, table);
+
+  const int fc3 = static_cast<int>(y_row(m, curve.channel));
+  firmware::SensorStage<M> stage;
+  stage.reset();
+  double worst_frame = 0, worst_measured = 0;
+  int below = 0, beyond = 0;
+  for (std::size_t t = 0; t < table.rows(); ++t) {
+    float y[M::kY], u_prev[M::kU] = {}, y_model[M::kY], u_model[M::kU], y_prime[M::kY], y_out[M::kY];
+    for (int i = 0; i < M::kY; ++i) y[i] = static_cast<float>(table.at(t, *table.column_index(M::kYNames[i])));
+    stage.to_model(y, u_prev, y_model, u_model);
+    for (int i = 0; i < M::kY; ++i) {
+      const double want = model_frame(i, static_cast<Eigen::Index>(t));
+      worst_frame = std::max(worst_frame, std::abs(y_model[i] - want) / (1 + std::abs(want)));
+      y_prime[i] = static_cast<float>(want);
+    }
+    below += y_prime[fc3] < curve.level.front();
+    beyond += y_prime[fc3] > curve.level.back();
+    stage.to_measured(y_prime, y_out);  // D as of this frame, as the trainer's column t
+    for (int i = 0; i < M::kY; ++i) {
+      const double want = measured(i, static_cast<Eigen::Index>(t));
+      worst_measured = std::max(worst_measured, std::abs(y_out[i] - want) / (1 + std::abs(want)));
+    }
+  }
+  std::printf("sensor stage vs trainer, largest |diff| / (1 + |value|): frame %.3g, measured %.3g "
+              "(%d rows below the curve's first knot, %d beyond its last)\n",
+              worst_frame, worst_measured, below, beyond);
+  EXPECT_LE(worst_frame, kStageTolerance);
+  EXPECT_LE(worst_measured, kStageTolerance);
+  EXPECT_GT(below, 0);
+  EXPECT_GT(beyond, 0);
+  // g on its own (no drift yet after a reset; fc3 is no cross-talk target)
+  // on a finer grid: at and between the knots and 2 N beyond both ends.
+  stage.reset();
+  for (double v = curve.level.front() - 2; v <= curve.level.back() + 2; v += 0.0625) {
+    float y_prime[M::kY] = {}, y_out[M::kY];
+    y_prime[fc3] = static_cast<float>(v);
+    stage.to_measured(y_prime, y_out);
+    const double want = trainer::curve_reading(curve, v);
+    EXPECT_NEAR(y_out[fc3], want, kStageTolerance * (1 + std::abs(want))) << v;
+  }
+}
+
+TEST(FixedModelSensorStage, CurveFrameAndOutputTransformsAreTheTrainersF32) { expect_stage_as_the_trainer<F>(); }
+TEST(FixedModelSensorStage, CurveFrameAndOutputTransformsAreTheTrainersQ15) { expect_stage_as_the_trainer<Q>(); }
+
+// ---- the fixed model as a model image: its curve knots are data
+
+// The image's tensors of `model` for a firmware of shape M (as
+// host-sim/model_image/model_image_writer.h builds them, without signing).
+template <class M>
+std::unique_ptr<firmware::ModelTensors<M>> image_tensors(const trainer::HadynetModel& model,
+                                                         const codegen::ModelIdentity& identity) {
+  codegen::CodegenOptions o;
+  o.numeric = M::kNumeric;
+  const codegen::GeneratedHeader h = codegen::generate(model, identity, o);
+  EXPECT_EQ(h.shape_id, M::kShapeId) << "not the fixed firmware's shape";
+  auto source = std::make_unique<host::RowMajorModel<M>>();
+  source->read(h.literals);
+  auto tensors = std::make_unique<firmware::ModelTensors<M>>();
+  std::memset(static_cast<void*>(tensors.get()), 0, sizeof(firmware::ModelTensors<M>));
+  firmware::build_tensors<M>(*source, *tensors);
+  return tensors;
+}
+
+template <class M>
+void expect_image_carries_the_curve() {
+  if (std::string(HADYNET_CODEGEN_OPTIONS) != "") GTEST_SKIP() << "the build's codegen options are not the defaults";
+  const codegen::LoadedModel loaded = codegen::load_model_file(HADYNET_FIXED_MODEL_PATH);
+  const auto same = image_tensors<M>(loaded.model, loaded.identity);
+  EXPECT_EQ(0, std::memcmp(same.get(), &firmware::kCompiledTensors<M>, sizeof(firmware::ModelTensors<M>)))
+      << "the image's tensors differ from the compiled-in ones";
+  // An update with a re-fitted curve (other knots, same shape) carries the
+  // new knots, and a stage reading the image's tensors uses them.
+  trainer::HadynetModel refitted = loaded.model;
+  trainer::SensorCurve& curve = refitted.sensor.curves.at(0);
+  for (double& r : curve.reading) r = 1.1 * r + 0.05;
+  const auto updated = image_tensors<M>(refitted, loaded.identity);
+  for (int k = 0; k < M::kCurveKnots; ++k)
+    EXPECT_EQ(updated->curve_reading[k], static_cast<float>(curve.reading[static_cast<std::size_t>(k)])) << k;
+  const firmware::SensorStage<M> stage(*updated);
+  const int c = static_cast<int>(y_row(refitted, curve.channel));
+  for (const double v : {curve.level.front() - 1, curve.level[1], curve.level.back() + 1}) {
+    float y_prime[M::kY] = {}, y[M::kY];
+    y_prime[c] = static_cast<float>(v);
+    stage.to_measured(y_prime, y);
+    const double want = trainer::curve_reading(curve, v);
+    EXPECT_NEAR(y[c], want, kStageTolerance * (1 + std::abs(want))) << v;
+  }
+}
+
+TEST(FixedModelImage, CarriesTheCurveKnotsF32) { expect_image_carries_the_curve<F>(); }
+TEST(FixedModelImage, CarriesTheCurveKnotsQ15) { expect_image_carries_the_curve<Q>(); }
 
 // ---- the stabiliser through an input dead time: lag2_u3 is u3 two steps
 // earlier, so a planned u3 (a stabiliser command) acts two steps later

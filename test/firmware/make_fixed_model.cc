@@ -10,8 +10,9 @@
 // so that the firmware's derived inputs matter), a 2-step dead time of the
 // stabiliser command u3 (lag2_u3 takes u3's input weights, u3 none),
 // cross-talk fc2 += 0.25 fc3, a load drift on fc3 (0.02 per N s, 0.2 s
-// period) and a clip fc6 <= 2 N. No fine-tuning: the test compares the
-// firmware with the trainer on this model, not the model with the plant.
+// period), a calibration curve on fc3 (kFc3Curve) and a clip fc6 <= 2 N.
+// No fine-tuning: the test compares the firmware with the trainer on this
+// model, not the model with the plant.
 // Value ranges are measured on two held-out plant logs in the model's frame.
 #include <cmath>
 #include <cstdio>
@@ -26,6 +27,11 @@
 
 using namespace hadynet;
 using namespace hadynet::trainer;
+
+// fc3 reads g(level), g through (0, 0.05), (0.5, 0.6), (1.8, 1.6) N: an offset
+// and a gain that falls with load. The held-out Cylinder grasp's fc3 (0 to
+// 3 N) visits both segments and both continuations (below 0.05 N, above 1.6 N).
+const SensorCurve kFc3Curve{"fc3", {0.0, 0.5, 1.8}, {0.05, 0.6, 1.6}};
 
 int main(int argc, char** argv) {
   if (argc != 3) {
@@ -72,6 +78,7 @@ int main(int argc, char** argv) {
     m.sensor.crosstalk = {{"fc2", "fc3", 0.25}};
     m.sensor.drifts = {{"fc3", true, 0.02}};
     m.sensor.period_s = 0.2;
+    m.sensor.curves = {kFc3Curve};
     m.sensor.clips = {{"fc6", 1, 2.0}};
     m.provenance["residual_fix"] = "test model of test/firmware/make_fixed_model.cc (no fine-tuning)";
     m.check_consistent();

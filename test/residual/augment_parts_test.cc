@@ -1,7 +1,8 @@
 // The parts --fix builds on (docs/residual.md, "--fix"), against hand-computed
 // answers: derived command channels, output clips (physical and on the
 // training loss), and the sensor model's frame transforms (alignment,
-// cross-talk and drift removal). All exact: integer-valued or closed-form cases, tolerance 1e-12.
+// cross-talk and drift removal, calibration curves). All exact: integer-valued or closed-form cases,
+// tolerance 1e-12.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -178,6 +179,42 @@ TEST(SensorFrame, AlignmentCrosstalkAndTheWholeFrame) {
   EXPECT_EQ(s.describe().size(), 3u);
   EXPECT_TRUE(SensorModel{}.empty());
   EXPECT_EQ(to_model_frame(SensorModel{}, in, "d.csv").values, in.values);
+}
+
+// g through (0, 0), (1, 2), (3, 3): slope 2 on [0, 1], 1/2 on [1, 3],
+// continued along the end segments.
+TEST(SensorFrame, ACalibrationCurveAndItsInverse) {
+  const SensorCurve g{"fc0", {0, 1, 3}, {0, 2, 3}};
+  EXPECT_NEAR(curve_reading(g, 0.5), 1.0, 1e-12);
+  EXPECT_NEAR(curve_reading(g, 2.0), 2.5, 1e-12);
+  EXPECT_NEAR(curve_reading(g, -1.0), -2.0, 1e-12);  // below: the first segment's slope
+  EXPECT_NEAR(curve_reading(g, 5.0), 4.0, 1e-12);    // above: the last's
+  for (double v : {-2.0, 0.0, 0.25, 1.0, 2.9, 3.0, 7.5}) EXPECT_NEAR(curve_level(g, curve_reading(g, v)), v, 1e-12) << v;
+  // In the frame: drift and cross-talk removed first, then the curve inverted.
+  const datalog::LogTable in = drift_log();  // fc0: 1, -2, 3, 0
+  SensorModel s;
+  s.curves = {g};
+  const auto frame = to_model_frame(s, in, "d.csv");
+  const double want[] = {0.5, -1.0, 3.0, 0.0};
+  for (std::size_t r = 0; r < 4; ++r) EXPECT_NEAR(frame.at(r, 0), want[r], 1e-12) << r;
+  EXPECT_EQ(frame.at(1, 1), in.at(1, 1));
+  EXPECT_FALSE(s.frame_is_measured());
+  EXPECT_EQ(s.curve_of("fc0"), &s.curves[0]);
+  EXPECT_EQ(s.curve_of("fc1"), nullptr);
+  EXPECT_NO_THROW(s.check({"fc0", "fc1"}));
+  // Not increasing, too few knots, two on one channel: rejected, naming the channel.
+  const std::vector<std::vector<SensorCurve>> invalid = {
+      {{"fc0", {0, 1, 3}, {0, 2, 2}}}, {{"fc0", {0, 0, 3}, {0, 1, 2}}}, {{"fc0", {0}, {0}}}, {g, g}};
+  for (const auto& curves : invalid) {
+    SensorModel bad;
+    bad.curves = curves;
+    try {
+      bad.check({"fc0"});
+      ADD_FAILURE() << "accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("fc0"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

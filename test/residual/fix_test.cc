@@ -33,6 +33,7 @@ namespace hadynet::test {
 namespace {
 
 using namespace trainer::residual;
+using trainer::channel_group;
 namespace fm = fix_margins;
 
 struct FixRun {
@@ -337,6 +338,34 @@ TEST(ResidualFix, SaturationClipsThePredictionAndCutsTheRailChannelsError) {
         std::find(again.y_names.begin(), again.y_names.end(), clip.channel) - again.y_names.begin());
     for (const auto& log : again.logs) EXPECT_LE(log.y_hat.row(row).maxCoeff(), clip.rail) << clip.channel;
   }
+  expect_deployable(m);
+}
+
+TEST(ResidualFix, ACalibrationCurveIsFittedAndCutsTheLoadcellsError) {
+  // Plant: every loadcell reads 50 N (F / 50 N)^0.85 of its force F
+  // (sensor-curve). Against the model's stored null, as `hadynet residual`
+  // by default.
+  const FixRun r = run_fix(plant_logs("sensor-curve"), "sensor-curve", build_model(), &stored_null());
+  ASSERT_TRUE(fixed_as(r, EffectKind::kSensorCurve));
+  const Augmentation& a = *r.fix.augmentation;
+  const auto& m = r.fix.model;
+  EXPECT_TRUE(m.sensor.curves == std::get<CalibrationCurves>(a.change).curves);
+  EXPECT_TRUE(m.layout == build_model().layout);
+  for (const auto& curve : m.sensor.curves) {
+    ASSERT_EQ(channel_group(curve.channel), "fc");
+    // The fitted curve against the plant's at its highest knot: compressive
+    // like the plant's, a reading above the level.
+    const double top = curve.level.back(), plant = 50.0 * std::pow(std::max(top, 0.0) / 50.0, 0.85);
+    std::printf("  curve %s: at %.3g N reads %.3g N (plant %.3g N)\n", curve.channel.c_str(), top,
+                curve.reading.back(), plant);
+  }
+  // The winner's curve within 25 % of the plant's at its highest knot.
+  const trainer::SensorCurve& winner = m.sensor.curves.front();
+  const double top = winner.level.back(), plant = 50.0 * std::pow(top / 50.0, 0.85);
+  EXPECT_NEAR(winner.reading.back(), plant, fm::kSensorCurve.winner_reading_error.limit * plant);
+  const std::string& c = a.channels.front();
+  expect_cut(r.fix, c, fm::kSensorCurve.winner_vs_before, fm::kSensorCurve.winner_vs_control);
+  for (const auto& ch : a.channels) expect_cut(r.fix, ch, fm::kSensorCurve.family_vs_before);
   expect_deployable(m);
 }
 

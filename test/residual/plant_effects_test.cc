@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <set>
 
+#include "datalog/log_reader.h"
 #include "test/residual/plant_logs.h"
 #include "trainer/derived_inputs.h"
 #include "trainer/residual/analysis.h"
@@ -376,6 +377,40 @@ TEST(CalibratedNull, FrictionBeyondTheNullIsNamedOnATension) {
   EXPECT_EQ(w.hypothesis.kind, EffectKind::kFriction);
   EXPECT_EQ(channel_group(a.data.y_names[static_cast<std::size_t>(w.hypothesis.target)]), "f");
   EXPECT_GE(w.excess_share, kDefaultMinExcessNull);
+}
+
+TEST(PlantEffects, ACalibrationCurveIsNamedOnALoadcellAndItsGroupWithANull) {
+  // Plant: every loadcell reads 50 N (F / 50 N)^0.85 of its force F
+  // (sensor-curve, the default: +80 % at 1 N, +28 % at 10 N). Curves are
+  // tested only against a null (effects.h, LibraryOptions::sensor_curves):
+  // without one the library has no curve hypothesis. The null: the model's
+  // stored held-out logs, as `hadynet residual` by default.
+  namespace rs = trainer::residual;
+  const auto logs = plant_logs("sensor-curve");
+  const rs::Analysis without = rs::analyse(build_model(), logs, {});
+  for (const auto& r : without.attribution.ranked) EXPECT_NE(r.hypothesis.kind, EffectKind::kSensorCurve);
+  EXPECT_NE(rs::floors_summary(without).find("calibration curves are not tested"), std::string::npos);
+  std::vector<rs::LogInput> stored_null;
+  for (const auto& stored : build_model().held_out_logs)
+    stored_null.push_back({datalog::parse_log(stored.text, "held-out log " + stored.name), stored.name});
+  rs::AnalysisOptions options;
+  options.reference_pb_choice = "state";
+  const rs::Analysis o = rs::analyse(build_model(), logs, options, stored_null);
+  std::printf("sensor-curve with the null: %s\n", o.verdict.c_str());
+  ASSERT_TRUE(o.attribution.winner().has_value());
+  const auto w = *o.attribution.winner();
+  EXPECT_EQ(w.hypothesis.kind, EffectKind::kSensorCurve) << w.label;
+  EXPECT_EQ(channel_group(o.data.y_names[static_cast<std::size_t>(w.hypothesis.target)]), "fc") << w.label;
+  // --fix's plan: a curve on the winner and the loadcells where the curve
+  // tests significant (the group), never on another group's channel.
+  const auto candidates = plan_candidates(o.data, o.attribution, 1);
+  ASSERT_EQ(candidates.size(), 1u);
+  const auto& curves = std::get<CalibrationCurves>(candidates.front().change).curves;
+  EXPECT_GE(curves.size(), 5u);
+  for (const auto& c : curves) {
+    EXPECT_EQ(channel_group(c.channel), "fc") << c.channel;
+    EXPECT_EQ(c.level, c.reading) << c.channel;  // the identity, which refine() fits
+  }
 }
 
 }  // namespace

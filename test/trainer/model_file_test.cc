@@ -72,6 +72,7 @@ HadynetModel sample_model(bool with_detection) {
     m.sensor.crosstalk = {{y.front(), y.back(), 0.25}};
     m.sensor.drifts = {{y.back(), true, 0.004}, {y.front(), false, -0.5}};
     m.sensor.period_s = 0.2;
+    m.sensor.curves = {{y.front(), {0.0, 0.5, 2.0}, {0.0, 0.75, 2.25}}};
     m.sensor.clips = {{y.front(), 1, 0.1875}, {y.back(), -1, -2.5}};
     // And held-out logs (stored as texts; the loader does not parse them).
     m.held_out_logs = {{"a.csv rows 18..19", "# format: hadynet-log\nt,q0\n0,1\n"}, {"b.csv rows 9..12", "x"}};

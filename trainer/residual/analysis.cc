@@ -31,7 +31,9 @@ Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, c
     for (std::size_t j = 0; j < ny; ++j)
       if (j != c) a.with_observed[c][j] = cross_correlate(r, observed[j], a.max_lag);
   }
-  const std::vector<Hypothesis> hypotheses = enumerate_hypotheses(d, options.library);
+  LibraryOptions library = options.library;
+  library.sensor_curves = !reference.empty();
+  const std::vector<Hypothesis> hypotheses = enumerate_hypotheses(d, library);
   if (reference.empty()) {
     a.attribution = attribute(d, hypotheses, options.attribution);
   } else {
@@ -53,7 +55,7 @@ std::string floors_summary(const Analysis& a) {
     std::snprintf(buf, sizeof buf,
                   "floors: no calibrated null%s: absolute floors assumed, an effect must lower its "
                   "channel's standardised 1-step loss by >= %g (set for the hand's models) and explain >= %g of "
-                  "its held-out residual variance",
+                  "its held-out residual variance; calibration curves are not tested (they need a null)",
                   source.c_str(), o.min_explained_std, o.min_explained);
     return buf;
   }

@@ -134,7 +134,7 @@ HypothesisResult test_hypothesis(const ResidualData& data, const Hypothesis& h, 
   }
   res.coef = beta;
   res.parameter = main_parameter(h, beta);
-  res.plausible = plausible(h, res.parameter);
+  res.plausible = plausible(h, beta);
   res.label = describe(h, data, beta);
   res.explained_train = explained(train, beta).share;
   const Explained e_held = explained(held, beta);

@@ -44,6 +44,12 @@ std::string why_not_fixable(const ResidualData& data, const Attribution& attribu
   return info.not_planned ? info.not_planned(data, attribution, r) : "";
 }
 
+double TrainingRmse::operator()(const SensorModel& sensor, const std::string& channel) const {
+  const auto it = std::find(y_names.begin(), y_names.end(), channel);
+  if (it == y_names.end()) throw std::logic_error("--fix: refine probes " + channel + ", not a y channel");
+  return all(sensor)(it - y_names.begin());
+}
+
 std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attribution& attribution, int count) {
   std::vector<Augmentation> out;
   const auto winner = attribution.winner();
@@ -181,14 +187,16 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // fine-tuning (drift: the rates), probing the unchanged network with a
   // sensor model.
   HadynetModel probe = model;
-  const TrainingRmse training_rmse = [&](const SensorModel& sensor, const std::string& channel) {
+  TrainingRmse training_rmse;
+  training_rmse.y_names = model.layout.y_names;
+  training_rmse.all = [&](const SensorModel& sensor) {
     probe.sensor = sensor;
     std::vector<HeldOutLog> train = eval_logs(probe, before_pbs);
     for (std::size_t i = 0; i < train.size(); ++i) {
       train[i].end = train[i].first;
       train[i].first = ResidualLog::kFirstRow + d;
     }
-    return held_out_error(probe, train).rmse(static_cast<Eigen::Index>(index_of(model.layout.y_names, channel)));
+    return Eigen::VectorXd(held_out_error(probe, train).rmse);
   };
 
   // Training data: raw rows [0, cut[i]) in the measured frame; a frame
@@ -308,7 +316,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   };
   ResidualData again = compute_residuals(after.model, logs, "state");
   drop_predicted_aux(again);
-  const std::vector<Hypothesis> hypotheses_after = enumerate_hypotheses(again, options.library);
+  LibraryOptions library_after = options.library;
+  library_after.sensor_curves = options.reference != nullptr && !options.reference->empty();
+  const std::vector<Hypothesis> hypotheses_after = enumerate_hypotheses(again, library_after);
   if (options.reference != nullptr && !options.reference->empty()) {
     ResidualData ref = compute_residuals(after.model, *options.reference, options.reference_pb_choice);
     drop_predicted_aux(ref);

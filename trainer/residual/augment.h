@@ -60,10 +60,14 @@ struct FixOptions {
 
 struct Augmentation;
 
-// fix()'s probe for refine(): the unchanged network's 1-step RMSE of
-// `channel` (physical units) on the training rows, in the measured frame,
-// with sensor model `sensor`.
-using TrainingRmse = std::function<double(const SensorModel& sensor, const std::string& channel)>;
+// fix()'s probe for refine(): the unchanged network's 1-step RMSE (physical
+// units) on the training rows, in the measured frame, with sensor model
+// `sensor`: of every y channel (`all`, in y_names' order) or of one.
+struct TrainingRmse {
+  std::function<Eigen::VectorXd(const SensorModel& sensor)> all;
+  std::vector<std::string> y_names;
+  double operator()(const SensorModel& sensor, const std::string& channel) const;
+};
 
 // What an alternative of Augmentation::change does to a model. std::visit
 // calls these on the alternative held; the base's no-ops are what an
@@ -123,6 +127,16 @@ struct OutputClips : ModelChange {
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;
 };
 
+// sensor-curve: a static calibration curve per family channel: the logs are
+// read through its inverse (in y and x), the prediction through it; the
+// curves' slopes are re-estimated before fine-tuning (refine).
+struct CalibrationCurves : ModelChange {
+  std::vector<SensorCurve> curves;  // one per channel
+  void add_to_sensor(SensorModel& s, const Augmentation& a) const;
+  void refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
+              std::vector<double>& fitted);
+};
+
 // friction: a hysteresis state as an input: for every muscle m of the
 // winner's family, the derived command channels sign_<m> (direction of
 // motion) and hyst_<m> (sign of the last non-zero command;
@@ -163,7 +177,7 @@ struct Augmentation {
   std::vector<std::string> found_on;
   // Why --fix cannot add it ("" when it can; change is then meaningless).
   std::string not_fixable;
-  std::variant<TimeAlignment, CrosstalkRemoval, BiasState, OutputClips, DerivedCommandInputs,
+  std::variant<TimeAlignment, CrosstalkRemoval, BiasState, OutputClips, CalibrationCurves, DerivedCommandInputs,
                ObservedAuxChannel>
       change;
 };

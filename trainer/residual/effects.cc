@@ -39,9 +39,9 @@ std::string steps(int d) { return std::to_string(d) + (d == 1 ? " step" : " step
 // The defaults of a row: the main parameter is the first coefficient, and any
 // finite value is in the effect's domain.
 double first_coefficient(const Eigen::VectorXd& coef) { return coef(0); }
-bool finite(double parameter) { return std::isfinite(parameter); }
+bool finite(double parameter, const Eigen::VectorXd&) { return std::isfinite(parameter); }
 // A delay or a rail explains the residual with a positive gain.
-bool positive(double parameter) { return parameter > 0; }
+bool positive(double parameter, const Eigen::VectorXd&) { return parameter > 0; }
 
 // One regressor per row: column 0 of an n x 1 matrix.
 Features one_column(int n, const auto& value_of_column) {
@@ -517,6 +517,220 @@ void OutputClips::add_to_sensor(SensorModel& s, const Augmentation&) const {
 
 namespace {
 
+// ---- sensor-curve: the target reports a static monotone curve of its own level ----
+namespace sensor_curve {
+
+// One per channel whose range over the logs is not a point, when curves are
+// tested (LibraryOptions::sensor_curves: with a null only); the range is
+// that of the middle 90 % of its values (5 % to 95 % quantiles), where the
+// fit has data (a loadcell's extremes are a few rows of one grasp).
+void enumerate(const ResidualData& data, const LibraryOptions& options, int c, std::vector<Hypothesis>& out) {
+  if (!options.sensor_curves) return;
+  std::vector<double> v;
+  for (const auto& log : data.logs)
+    for (Eigen::Index t = 0; t < log.seq.y.cols(); ++t) v.push_back(log.seq.y(c, t));
+  if (v.empty()) return;
+  std::sort(v.begin(), v.end());
+  const auto quantile = [&](double q) { return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))]; };
+  const double lo = quantile(0.05), hi = quantile(0.95);
+  if (!(hi > lo)) return;
+  Hypothesis h{EffectKind::kSensorCurve, c, -1, 0, 0, 0};
+  h.centre = 0.5 * (hi + lo);
+  h.half_range = 0.5 * (hi - lo);
+  out.push_back(h);
+}
+
+// The bend's basis: q(v) = (v - m)^2 / (2 w), m the range's midpoint, w half
+// its width, so that g(v) = v + a v + b q(v) has the slope 1 + a + b (v - m) / w:
+// 1 + a - b at the bottom of the range, 1 + a + b at the top.
+double bend(const Hypothesis& h, double v) { return (v - h.centre) * (v - h.centre) / (2 * h.half_range); }
+
+// y_hat_c(t), y_c(t-1), q(y_hat_c(t)), q(y_c(t-1)). A sensor that reads
+// g(y') = y' + a y' + b q(y') feeds the network g of the level at t-1, which
+// it carries over by a share rho; the residual is then
+// a (y'(t) - rho y'(t-1)) + b (q(y'(t)) - rho q(y'(t-1))) (as cross-talk's
+// two regressors, features of the level now and one row earlier), with the
+// prediction standing in for the level now (the measurement itself would
+// bring its own noise into the regressor).
+Features features(const Hypothesis& h, const ResidualLog& log) {
+  const int n = log.size();
+  const auto c = static_cast<Eigen::Index>(h.target);
+  Features f;
+  f.z.resize(n, 4);
+  for (int j = 0; j < n; ++j) {
+    const double now = log.y_hat(c, j), before = log.seq.y(c, ResidualLog::row(j) - 1);
+    f.z.row(j) << now, before, bend(h, now), bend(h, before);
+  }
+  return f;
+}
+
+// The slopes of g at the bottom and the top of the range (coefficients of y_hat and q(y_hat)).
+double slope_bottom(const Eigen::VectorXd& coef) { return 1 + coef(0) - coef(2); }
+double slope_top(const Eigen::VectorXd& coef) { return 1 + coef(0) + coef(2); }
+// The main parameter: the ratio of the slopes, top / bottom (< 1: the curve
+// flattens with the level, a compressive sensor; > 1: it steepens).
+double slope_ratio(const Eigen::VectorXd& coef) { return slope_top(coef) / slope_bottom(coef); }
+// A calibration curve is monotone increasing over the range.
+bool monotone(double, const Eigen::VectorXd& coef) { return slope_bottom(coef) > 0 && slope_top(coef) > 0; }
+
+std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
+  return "curve of " + y_name(data, h.target) + ": slope ratio" + fmt(" %.3g", p) + " (top / bottom of" +
+         fmt(" %.4g", h.centre - h.half_range) + fmt("..%.4g)", h.centre + h.half_range);
+}
+
+// The knots of a channel's curve: 9 quantiles (0, 1/8, .., 1) of its values
+// in the first half of each log (the fix's training rows begin there),
+// duplicates dropped; fewer than 2 distinct: none.
+std::vector<double> knot_levels(const ResidualData& data, int c) {
+  std::vector<double> v;
+  for (const auto& log : data.logs) {
+    const auto y = log.seq.y.row(c);
+    for (Eigen::Index t = 0; t < y.size() / 2; ++t) v.push_back(y(t));
+  }
+  std::sort(v.begin(), v.end());
+  std::vector<double> knots;
+  if (v.empty()) return knots;
+  for (int k = 0; k <= 8; ++k) {
+    const double q = v[static_cast<std::size_t>(k * static_cast<double>(v.size() - 1) / 8.0)];
+    if (knots.empty() || q > knots.back()) knots.push_back(q);
+  }
+  if (knots.size() < 2) knots.clear();
+  return knots;
+}
+
+// The winner's group: the family's channels in it, extended to the other
+// channels of the group where a curve passes the test (Holm-adjusted p <
+// alpha, monotone) without the practical floors. Sensors of one group are of
+// one kind, so, as for a sensor delay, once a curve is established the test
+// only says where else in the group it is (the floors keep the model's own
+// misfit from being named). Family channels of other groups are left to a
+// later round: on fresh plant logs with curved loadcells they were tendons
+// and lengths, the model's misfit. Each channel's curve starts as the
+// identity on its knots (the screen's slopes are of the measured level and
+// carry the network's misfit) and refine() fits it.
+void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
+  auto& change = a.change.emplace<CalibrationCurves>();
+  const std::string group = channel_group(y_name(data, w.hypothesis.target));
+  std::vector<int> targets;
+  for (const auto& r : attribution.family_of(w))
+    if (channel_group(y_name(data, r.hypothesis.target)) == group) targets.push_back(r.hypothesis.target);
+  std::vector<std::string> extended;
+  for (const auto& r : attribution.ranked) {
+    const auto& hr = r.hypothesis;
+    if (hr.kind != EffectKind::kSensorCurve || channel_group(y_name(data, hr.target)) != group) continue;
+    if (!r.testable || !r.plausible || r.p_adjusted >= attribution.options.alpha) continue;
+    if (std::find(targets.begin(), targets.end(), hr.target) != targets.end()) continue;
+    targets.push_back(hr.target);
+    extended.push_back(y_name(data, hr.target));
+  }
+  for (int c : targets) {
+    SensorCurve curve{y_name(data, c), knot_levels(data, c), {}};
+    if (curve.level.empty()) continue;
+    curve.reading = curve.level;
+    a.channels.push_back(curve.channel);
+    change.curves.push_back(std::move(curve));
+  }
+  a.description = "a static calibration curve of " + join(a.channels) +
+                  (extended.empty() ? "" : " (" + join(extended) + ": a curve in the same group)") +
+                  " (piecewise linear, monotone): the logs read through its inverse, the prediction through it";
+  a.found_on = a.channels;
+}
+
+}  // namespace sensor_curve
+}  // namespace
+
+// A curve on a channel that has one already: the new curve acts on the old
+// one's level (found in the model's frame), so the two compose; stored as the
+// composition on the union of their knots.
+void CalibrationCurves::add_to_sensor(SensorModel& s, const Augmentation&) const {
+  for (const SensorCurve& c : curves) {
+    const auto it = std::find_if(s.curves.begin(), s.curves.end(),
+                                 [&](const SensorCurve& o) { return o.channel == c.channel; });
+    if (it == s.curves.end()) {
+      s.curves.push_back(c);
+      continue;
+    }
+    // measured = old(new(level)): knots at the new curve's levels and at the
+    // levels where the new curve reaches the old one's knots.
+    std::vector<double> level = c.level;
+    for (double k : it->level) level.push_back(curve_level(c, k));
+    std::sort(level.begin(), level.end());
+    level.erase(std::unique(level.begin(), level.end()), level.end());
+    SensorCurve composed{c.channel, level, {}};
+    for (double v : level) composed.reading.push_back(curve_reading(*it, curve_reading(c, v)));
+    *it = composed;
+  }
+}
+
+// Each curve is fitted on the training rows: its segment slopes by
+// coordinate search (each slope times 0.5, 0.7, 0.85, 0.93, 1/0.93, 1/0.85,
+// 1/0.7 or 2 within 1/4..4, kept where the loss falls; sweeps until one
+// changes nothing, at most 6), channels in plan order, each with the others' curves so far. The
+// curve stays anchored at its lowest knot. The loss is the unchanged
+// network's 1-step error of every channel in the measured frame, each
+// relative to its error before the curves: sum_c (rmse_c / rmse_c,before)^2.
+// The channel's own error alone is no criterion: a flat curve feeds the
+// network an exaggerated level and reads its prediction back compressed,
+// which turns it into persistence (a good 1-step predictor of a slow
+// loadcell); what the network predicts of every other channel from that
+// level shows the distortion. `fitted` gets 1 per channel (the identity the
+// search starts from).
+void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
+                               std::vector<double>& fitted) {
+  static constexpr double kFactors[] = {0.5, 0.7, 0.85, 0.93, 1 / 0.93, 1 / 0.85, 1 / 0.7, 2.0};
+  // A segment's slope stays within 1/4..4 of the identity's: beyond, the
+  // search fitted the noise of a loadcell at rest (slopes of 1/64 on seed-1
+  // development logs) without a better fit on fresh ones.
+  static constexpr double kMinSlope = 0.25, kMaxSlope = 4.0;
+  Eigen::ArrayXd rmse_before = training_rmse.all(before).array().max(1e-12);
+  for (SensorCurve& curve : curves) {
+    const auto slopes_of = [](const SensorCurve& c) {
+      std::vector<double> s;
+      for (std::size_t k = 1; k < c.level.size(); ++k)
+        s.push_back((c.reading[k] - c.reading[k - 1]) / (c.level[k] - c.level[k - 1]));
+      return s;
+    };
+    const auto set_slopes = [](SensorCurve& c, const std::vector<double>& s) {
+      for (std::size_t k = 1; k < c.level.size(); ++k)
+        c.reading[k] = c.reading[k - 1] + s[k - 1] * (c.level[k] - c.level[k - 1]);
+    };
+    std::vector<double> slopes = slopes_of(curve);
+    fitted.push_back(slopes.back() / slopes.front());
+    const auto loss = [&] { return (training_rmse.all(sensor_after(before, a)).array() / rmse_before).square().sum(); };
+    double best = loss();
+    bool changed = true;
+    for (int sweep = 0; sweep < 6 && changed; ++sweep) {
+      changed = false;
+      for (std::size_t k = 0; k < slopes.size(); ++k) {
+        const double kept = slopes[k];
+        double best_slope = kept;
+        for (double f : kFactors) {
+          slopes[k] = kept * f;
+          if (slopes[k] < kMinSlope || slopes[k] > kMaxSlope) continue;
+          set_slopes(curve, slopes);
+          const double l = loss();
+          if (l < best) best = l, best_slope = slopes[k], changed = true;
+        }
+        slopes[k] = best_slope;
+        set_slopes(curve, slopes);
+      }
+    }
+  }
+  std::string ratios;
+  char text[96];
+  for (const SensorCurve& c : curves) {
+    const std::size_t n = c.level.size();
+    const double bottom = (c.reading[1] - c.reading[0]) / (c.level[1] - c.level[0]);
+    const double top = (c.reading[n - 1] - c.reading[n - 2]) / (c.level[n - 1] - c.level[n - 2]);
+    std::snprintf(text, sizeof text, "%s%s slope %.3g at %.4g .. %.3g at %.4g", ratios.empty() ? "" : ", ",
+                  c.channel.c_str(), bottom, c.level[0], top, c.level[n - 1]);
+    ratios += text;
+  }
+  a.description += "; re-estimated: " + ratios;
+}
+
+namespace {
+
 // ---- crosstalk: the target picks up a fraction of another channel ----
 namespace crosstalk {
 
@@ -566,7 +780,7 @@ Features features(const Hypothesis& h, const ResidualLog& log) {
 
 // A cross-talk picks up a fraction of its source. (A negative pick-up
 // between neighbouring fingertips is the model's own error: docs/residual.md.)
-bool fraction(double gain) { return gain > 0 && gain < 1; }
+bool fraction(double gain, const Eigen::VectorXd&) { return gain > 0 && gain < 1; }
 
 std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
   return "crosstalk " + source_name(h, data) + " -> " + y_name(data, h.target) + ": gain" + fmt(" %.3g", p);
@@ -728,6 +942,17 @@ const std::vector<EffectInfo>& effect_library() {
        "fine-tuned on the clipped output",
        SourceKind::kNone, saturation::enumerate, saturation::features, first_coefficient, positive,
        saturation::describe, saturation::plan, nullptr},
+      {EffectKind::kSensorCurve, "sensor-curve",
+       "y_hat_c(t), y_c(t-1) and their bends q = (v - m)^2 / (2 w) (m, w: the midpoint and half-width of the "
+       "target's range): a sensor that reports a monotone curve g of its own level, and what the network "
+       "carries over of it from x_{t-1}",
+       "the ratio of g's slopes at the top and the bottom of the range (< 1: compressive; the curve must be "
+       "increasing at both)",
+       "a static calibration curve in the sensor model: the measured y_c read through g^-1 before the "
+       "network, its prediction through g; g piecewise linear through 9 quantile knots, its slopes "
+       "re-estimated on the training rows",
+       SourceKind::kNone, sensor_curve::enumerate, sensor_curve::features, sensor_curve::slope_ratio,
+       sensor_curve::monotone, sensor_curve::describe, sensor_curve::plan, nullptr},
       {EffectKind::kCrosstalk, "crosstalk",
        "y_s(t) and y_s(t-1): another channel's measured value (by default of the target's group or unit) "
        "leaking into the target, and what the network carries over of it from x_{t-1}",
@@ -761,7 +986,9 @@ double main_parameter(const Hypothesis& h, const Eigen::VectorXd& coef) {
   return effect_info(h.kind).main_parameter(coef);
 }
 
-bool plausible(const Hypothesis& h, double parameter) { return effect_info(h.kind).plausible(parameter); }
+bool plausible(const Hypothesis& h, const Eigen::VectorXd& coef) {
+  return effect_info(h.kind).plausible(main_parameter(h, coef), coef);
+}
 
 std::string describe(const Hypothesis& h, const ResidualData& data, const Eigen::VectorXd& coef) {
   return effect_info(h.kind).describe(h, data, main_parameter(h, coef));

@@ -33,6 +33,7 @@ enum class EffectKind {
   kDriftLoad,    // a sensor bias growing with the target's accumulated value (load)
   kDriftTime,    // a sensor bias growing with time
   kSaturation,   // the measured target is clipped at a rail (`side` +1 upper, -1 lower)
+  kSensorCurve,  // the target reports a static monotone curve of its own level
   kCrosstalk,    // the target picks up a fraction of channel `source` (y channel)
   kAuxChannel,   // an unused logged channel (aux `source`) explains the target
 };
@@ -47,6 +48,9 @@ struct Hypothesis {
   // friction: the source is an absolute command, so its motion is its change
   // (regressors and inputs of u's change: derived_inputs.h dsign_/dhyst_)
   bool of_change = false;
+  // sensor-curve: the midpoint and half the width of the target's measured
+  // range over the logs (target units); 0 for the other effects.
+  double centre = 0, half_range = 0;
 };
 
 // Regressors of a hypothesis for one log, aligned with the log's residual
@@ -87,6 +91,13 @@ struct LibraryOptions {
   // Cascaded Tanks' 10 V about 5 %.)
   double min_rail_share = 0.02;
   double rail_band = 0.05;
+  // Whether the calibration curve (sensor-curve) is tested. Its regressors
+  // are the channel's own level now and one row earlier, which explain part
+  // of any model's misfit of that channel (clean mass-spring logs: a curve
+  // on three channels past the absolute floors, outranking a real sensor
+  // delay); only a null, the model's residual on clean logs, tells an effect
+  // from that. analyse() sets it when it has reference logs.
+  bool sensor_curves = false;
 };
 
 // What Hypothesis::source indexes for an effect.
@@ -117,8 +128,9 @@ struct EffectInfo {
   Features (*features)(const Hypothesis& h, const ResidualLog& log);
   // The main fitted parameter from the coefficients (never empty).
   double (*main_parameter)(const Eigen::VectorXd& coef);
-  // Whether the main parameter is in the effect's physical domain.
-  bool (*plausible)(double parameter);
+  // Whether the fit (`parameter` is main_parameter(coef)) is in the effect's
+  // physical domain.
+  bool (*plausible)(double parameter, const Eigen::VectorXd& coef);
   // Human-readable parameters, e.g. "delay = 2 steps on fc3 (gain 0.75)".
   std::string (*describe)(const Hypothesis& h, const ResidualData& data, double parameter);
   // --fix: the augmentation for the significant hypothesis `lead` of this
@@ -146,11 +158,12 @@ std::string describe(const Hypothesis& h, const ResidualData& data, const Eigen:
 double main_parameter(const Hypothesis& h, const Eigen::VectorXd& coef);
 // Whether the main parameter is in the effect's physical domain: a
 // cross-talk picks up a fraction of its source (0 < gain < 1), and a delay
-// or a rail explains the residual with a positive gain. The other effects
+// or a rail explains the residual with a positive gain, and a calibration
+// curve is monotone increasing over the channel's range. The other effects
 // take either sign (friction's sign follows the command convention; a drift
 // may lower a reading). An implausible hypothesis is tested but never
 // significant (attribution.h).
-bool plausible(const Hypothesis& h, double parameter);
+bool plausible(const Hypothesis& h, const Eigen::VectorXd& coef);
 // The name of the hypothesis' source channel (u, y or aux, by the effect's
 // SourceKind); "" for an effect without one.
 std::string source_name(const Hypothesis& h, const ResidualData& data);
@@ -158,7 +171,8 @@ std::string source_name(const Hypothesis& h, const ResidualData& data);
 // Every hypothesis of the library for these logs: per target channel, each
 // effect's in table order (delays per delay, friction per muscle, drift,
 // saturation per side where the signal sits at a rail: min_rail_share,
-// cross-talk per source, aux per aux channel).
+// a curve where the channel's range is not a point and
+// options.sensor_curves, cross-talk per source, aux per aux channel).
 std::vector<Hypothesis> enumerate_hypotheses(const ResidualData& data, const LibraryOptions& options);
 
 }  // namespace hadynet::trainer::residual

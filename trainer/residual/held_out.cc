@@ -25,6 +25,7 @@ struct OutputMap {
   };
   std::vector<Crosstalk> crosstalk;                    // measured y_c = y'_c + gain y'_s
   std::vector<std::pair<Eigen::Index, SensorDrift>> drifts;  // measured y_c = y'_c + b_c
+  std::vector<std::pair<Eigen::Index, SensorCurve>> curves;  // measured y_c = g_c(y'_c)
 };
 
 OutputMap output_map(const HadynetModel& m) {
@@ -39,6 +40,7 @@ OutputMap output_map(const HadynetModel& m) {
   for (const auto& x : m.sensor.delays) map.delay[static_cast<std::size_t>(row(x.channel))] = x.steps;
   for (const auto& x : m.sensor.crosstalk) map.crosstalk.push_back({row(x.target), row(x.source), x.gain});
   for (const auto& drift : m.sensor.drifts) map.drifts.emplace_back(row(drift.channel), drift);
+  for (const auto& curve : m.sensor.curves) map.curves.emplace_back(row(curve.channel), curve);
   return map;
 }
 
@@ -57,6 +59,7 @@ Eigen::MatrixXd measured_predictions(const HadynetModel& model, const LogSequenc
       const Eigen::Index k = d - map.delay[static_cast<std::size_t>(c)];  // step predicting row t - delay_c
       out(c, t) = p(c, k * B + b);
     }
+    for (const auto& [c, curve] : map.curves) out(c, t) = curve_reading(curve, out(c, t));
     for (const auto& x : map.crosstalk) out(x.target, t) += x.gain * p(x.source, b);
   }
   // Drift: the bias state is known up to row t - 1 from the measurements; its
