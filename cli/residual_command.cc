@@ -168,8 +168,8 @@ int run_residual(int argc, char** argv) {
               "channel and horizon, whiteness (autocorrelation, Ljung-Box) and independence (cross-correlation\n"
               "with the inputs) of the 1-step residual, and the effect library's hypotheses (sensor and input\n"
               "delay, friction/hysteresis, drift, saturation, a static calibration curve, cross-talk, unused aux_*\n"
-              "channels) fitted on the first part of each log and tested on the rest. Prints the winner with its parameters, or 'no significant\n"
-              "effect'. Works on any (u, y) logs the model's channels fit.",
+              "channels) fitted on the first part of each log and tested on the rest. Prints the winner with its\n"
+              "parameters, or 'no significant effect'. Works on any (u, y) logs the model's channels fit.",
               "MODEL LOG|DIR... [options]");
   opt.value("pb", "PB",
             "auto (the state's trained PB if the model knows it and it predicts the state's held-out rows\n"
