@@ -9,7 +9,7 @@
 #                sin(2 pi t / 30 s)), t = row * 0.2 s; no effect of the
 #                library is a gain that varies in time (drift is a bias).
 #   curve        fc1 reported as 50 N * (fc1 / 50 N)^0.85 (monotone,
-#                compressive: +60 % at 1 N, +30 % at 10 N). Outside the
+#                compressive: +80 % at 1 N, +27 % at 10 N). Outside the
 #                library until the static calibration curve (sensor-curve)
 #                was added; since, a library effect on one loadcell.
 # Run with the plant's rated ranges.

@@ -232,10 +232,19 @@ SensorModel sensor_from_json(const json& j, const std::string& origin) {
   }
   s.period_s = json_number(j, "period_s", "sensor", origin, 0.0);
   if (j.contains("curves"))
-    for (const json& c : json_array(j, "curves", origin))
-      s.curves.push_back({json_get<std::string>(c, "channel", "sensor curve", origin),
-                          json_get<std::vector<double>>(c, "level", "sensor curve", origin),
-                          json_get<std::vector<double>>(c, "reading", "sensor curve", origin)});
+    for (const json& c : json_array(j, "curves", origin)) {
+      SensorCurve curve{json_get<std::string>(c, "channel", "sensor curve", origin),
+                        json_get<std::vector<double>>(c, "level", "sensor curve", origin),
+                        json_get<std::vector<double>>(c, "reading", "sensor curve", origin)};
+      if (curve.level.size() > static_cast<std::size_t>(ModelLimits::kMaxCurveKnots))
+        fail(origin, "sensor curve of " + curve.channel + " has " + std::to_string(curve.level.size()) +
+                         " knots; at most " + std::to_string(ModelLimits::kMaxCurveKnots));
+      check_magnitude(Eigen::Map<const Eigen::VectorXd>(curve.level.data(), static_cast<Eigen::Index>(curve.level.size())),
+                      "sensor curve level", origin);
+      check_magnitude(Eigen::Map<const Eigen::VectorXd>(curve.reading.data(), static_cast<Eigen::Index>(curve.reading.size())),
+                      "sensor curve reading", origin);
+      s.curves.push_back(std::move(curve));
+    }
   for (const json& c : json_array(j, "clips", origin))
     s.clips.push_back({json_get<std::string>(c, "channel", "sensor clip", origin),
                        static_cast<int>(json_int(c, "side", "sensor clip", origin, -1, 1)),

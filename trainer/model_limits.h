@@ -17,6 +17,7 @@ struct ModelLimits {
   static constexpr std::int64_t kMaxStates = 100000;
   static constexpr std::int64_t kMaxTrainSteps = 4096;   // N_train: 13 min at 0.2 s
   static constexpr std::int64_t kMaxDelaySteps = 4096;   // a sensor delay, rows
+  static constexpr std::int64_t kMaxCurveKnots = 256;    // knots of a calibration curve
   // Largest magnitude of any stored number (weights, means, statistics,
   // sensor-model parameters): beyond it float32 arithmetic overflows.
   static constexpr double kMaxMagnitude = 1e30;

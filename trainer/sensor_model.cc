@@ -159,13 +159,17 @@ datalog::LogTable time_aligned(const datalog::LogTable& t, const std::string& fi
 }
 
 datalog::LogTable crosstalk_removed(const datalog::LogTable& table, const std::string& file,
-                                    const std::vector<SensorCrosstalk>& crosstalk) {
+                                    const std::vector<SensorCrosstalk>& crosstalk,
+                                    const std::vector<SensorCurve>& curves) {
   datalog::LogTable out = table;
   for (const auto& x : crosstalk) {
     // Every pair removes its source's measured value (not a source already
-    // corrected): the sensor model adds the network's sources.
+    // corrected), through the source's curve if it has one: the sensor
+    // model adds the network's sources.
     const std::size_t c = column(out, file, x.target), s = column(table, file, x.source);
-    for (std::size_t r = 0; r < out.rows(); ++r) out.at(r, c) -= x.gain * table.at(r, s);
+    const auto curve = std::find_if(curves.begin(), curves.end(), [&](const SensorCurve& g) { return g.channel == x.source; });
+    for (std::size_t r = 0; r < out.rows(); ++r)
+      out.at(r, c) -= x.gain * (curve == curves.end() ? table.at(r, s) : curve_level(*curve, table.at(r, s)));
   }
   return out;
 }
@@ -193,7 +197,8 @@ datalog::LogTable curves_inverted(const datalog::LogTable& table, const std::str
 
 datalog::LogTable to_model_frame(const SensorModel& sensor, const datalog::LogTable& table, const std::string& file) {
   if (sensor.frame_is_measured()) return table;
-  const datalog::LogTable without_bias = crosstalk_removed(drift_removed(table, file, sensor.drifts), file, sensor.crosstalk);
+  const datalog::LogTable without_bias =
+      crosstalk_removed(drift_removed(table, file, sensor.drifts), file, sensor.crosstalk, sensor.curves);
   return time_aligned(curves_inverted(without_bias, file, sensor.curves), file, sensor.delays);
 }
 

@@ -118,13 +118,16 @@ std::vector<double> drift_driver(const datalog::LogTable& table, const std::stri
 // std::runtime_error naming `file`.
 //   time_aligned: each delayed channel shifted its `steps` rows earlier,
 //                 y'_c(s) = y_c(s + steps); the last max_delay rows are dropped.
-//   crosstalk_removed: target -= gain * source, every row.
+//   crosstalk_removed: target -= gain * source, every row (a source with a
+//                 curve in `curves` read through it: the model frame's
+//                 source, which the sensor model adds back).
 //   drift_removed: y_c -= rate * D_c (D_c from the measured column), every row.
 //   curves_inverted: y_c = g_c^-1(y_c), every row.
 datalog::LogTable time_aligned(const datalog::LogTable& table, const std::string& file,
                                const std::vector<SensorDelay>& delays);
 datalog::LogTable crosstalk_removed(const datalog::LogTable& table, const std::string& file,
-                                    const std::vector<SensorCrosstalk>& crosstalk);
+                                    const std::vector<SensorCrosstalk>& crosstalk,
+                                    const std::vector<SensorCurve>& curves = {});
 datalog::LogTable drift_removed(const datalog::LogTable& table, const std::string& file,
                                 const std::vector<SensorDrift>& drifts);
 datalog::LogTable curves_inverted(const datalog::LogTable& table, const std::string& file,

@@ -12,7 +12,9 @@
 //       frame's values;
 //     drift: D_c += |y_c| kSensorPeriod (load) or kSensorPeriod (time), then
 //       y1_c = y_c - rate D_c;
-//     cross-talk: y2_c = y1_c - gain y1_s (the source after the drift step);
+//     cross-talk: y2_c = y1_c - gain g_s^-1(y1_s) (the source after the
+//       drift step, through its curve if it has one: the model frame's
+//       source, which to_measured adds back);
 //     curves: y'_c = g_c^-1(y2_c) (the identity without a curve).
 //   model-frame prediction -> measured (to_measured):
 //     y_c = clip(g_c(y'_c) + gain y'_s + rate D_c), D_c as of the newest frame.
@@ -97,8 +99,11 @@ class SensorStage {
       drifted[c] -= t_->drift_rate[k] * drift_driver(k);
     }
     for (int i = 0; i < kY; ++i) y_model[i] = drifted[i];
-    for (int k = 0; k < M::kCrosstalkCount; ++k)
-      y_model[M::kCrosstalkTarget[k]] -= t_->crosstalk_gain[k] * drifted[M::kCrosstalkSource[k]];
+    for (int k = 0; k < M::kCrosstalkCount; ++k) {
+      const int s = M::kCrosstalkSource[k], j = curve_of(s);
+      const float source = j < 0 ? drifted[s] : piecewise_linear(t_->curve_reading, t_->curve_level, j, drifted[s]);
+      y_model[M::kCrosstalkTarget[k]] -= t_->crosstalk_gain[k] * source;
+    }
     for (int j = 0; j < M::kCurveCount; ++j) {
       float& v = y_model[M::kCurveChannel[j]];
       v = piecewise_linear(t_->curve_reading, t_->curve_level, j, v);  // g^-1
@@ -136,6 +141,13 @@ class SensorStage {
   // to_model).
   float past_command(int i, int frames_ago) const noexcept {
     return lag_ring_[i][(lag_slot_ + kMaxLag - frames_ago) % kMaxLag];
+  }
+
+  // The curve of y channel c (index into the kCurve* arrays), -1 without one.
+  static constexpr int curve_of(int c) noexcept {
+    for (int j = 0; j < M::kCurveCount; ++j)
+      if (M::kCurveChannel[j] == c) return j;
+    return -1;
   }
 
   static constexpr bool has_derived_inputs() noexcept {

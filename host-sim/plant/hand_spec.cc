@@ -121,9 +121,9 @@ std::string apply_effect_arg(std::string_view arg, Effects& e) {
       return "effect 'input-delay': expected a whole number of steps in 0..20";
     e.command_delay_steps = has_value ? static_cast<int>(value) : 2;
   } else if (name == "sensor-curve") {
-    e.loadcell_curve_exponent = has_value ? value : 0.85;
-    if (!(e.loadcell_curve_exponent > 0.2 && e.loadcell_curve_exponent <= 5))
-      return "effect 'sensor-curve': expected an exponent in (0.2, 5]";
+    const double exponent = has_value ? value : 0.85;
+    if (!(exponent > 0.2 && exponent <= 5)) return "effect 'sensor-curve': expected an exponent in (0.2, 5]";
+    e.loadcell_curve_exponent = exponent;
   } else {
     return "unknown effect '" + std::string(name) +
            "' (expected friction, sensor-delay, drift, saturation, crosstalk, tension-leak, input-delay or "

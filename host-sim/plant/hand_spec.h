@@ -83,7 +83,7 @@ struct Effects {
   int command_delay_steps = 0;
   // A static calibration curve: every loadcell reports R (F / R)^exponent of
   // its force F >= 0, R its rated range (50 N); 1 = linear (off). Below 1
-  // compressive (0.85: +28 % at 10 N, +80 % at 1 N).
+  // compressive (0.85: +27 % at 10 N, +80 % at 1 N).
   double loadcell_curve_exponent = 1.0;
 
   bool any() const;

@@ -202,6 +202,22 @@ TEST(SensorFrame, ACalibrationCurveAndItsInverse) {
   EXPECT_EQ(s.curve_of("fc0"), &s.curves[0]);
   EXPECT_EQ(s.curve_of("fc1"), nullptr);
   EXPECT_NO_THROW(s.check({"fc0", "fc1"}));
+  // Every part at once, a curved cross-talk source included: the sensor
+  // model's forward direction, y_0 = g(y'_0) + 0.2 y'_1 + 0.1 D_0 and
+  // y_1 = h(y'_1), gives the log back from its frame.
+  SensorModel all;
+  const SensorCurve h{"fc1", {0, 10}, {0, 5}};
+  all.curves = {g, h};
+  all.crosstalk = {{"fc0", "fc1", 0.2}};
+  all.drifts = {{"fc0", true, 0.1}};
+  all.period_s = 0.5;
+  const auto both = to_model_frame(all, in, "d.csv");
+  const std::vector<double> load = drift_driver(in, "d.csv", all.drifts[0]);
+  for (std::size_t r = 0; r < 4; ++r) {
+    EXPECT_NEAR(both.at(r, 1), 10.0, 1e-12) << r;  // h^-1(5)
+    EXPECT_NEAR(curve_reading(g, both.at(r, 0)) + 0.2 * both.at(r, 1) + 0.1 * load[r], in.at(r, 0), 1e-12) << r;
+    EXPECT_NEAR(curve_reading(h, both.at(r, 1)), in.at(r, 1), 1e-12) << r;
+  }
   // Not increasing, too few knots, two on one channel: rejected, naming the channel.
   const std::vector<std::vector<SensorCurve>> invalid = {
       {{"fc0", {0, 1, 3}, {0, 2, 2}}}, {{"fc0", {0, 0, 3}, {0, 1, 2}}}, {{"fc0", {0}, {0}}}, {g, g}};

@@ -381,7 +381,7 @@ TEST(CalibratedNull, FrictionBeyondTheNullIsNamedOnATension) {
 
 TEST(PlantEffects, ACalibrationCurveIsNamedOnALoadcellAndItsGroupWithANull) {
   // Plant: every loadcell reads 50 N (F / 50 N)^0.85 of its force F
-  // (sensor-curve, the default: +80 % at 1 N, +28 % at 10 N). Curves are
+  // (sensor-curve, the default: +80 % at 1 N, +27 % at 10 N). Curves are
   // tested only against a null (effects.h, LibraryOptions::sensor_curves):
   // without one the library has no curve hypothesis. The null: the model's
   // stored held-out logs, as `hadynet residual` by default.

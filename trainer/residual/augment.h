@@ -253,7 +253,7 @@ struct FixResult {
   std::vector<CandidateTrial> candidates;          // the screen's candidates, in its order
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
-  std::vector<double> fitted_rates;     // drift: the attribution's rate per channel, before refine()
+  std::vector<double> fitted_rates;     // drift: the attribution's rate per channel, before refine(); else empty
   long train_windows = 0;
 };
 

@@ -665,18 +665,18 @@ void CalibrationCurves::add_to_sensor(SensorModel& s, const Augmentation&) const
 // Each curve is fitted on the training rows: its segment slopes by
 // coordinate search (each slope times 0.5, 0.7, 0.85, 0.93, 1/0.93, 1/0.85,
 // 1/0.7 or 2 within 1/4..4, kept where the loss falls; sweeps until one
-// changes nothing, at most 6), channels in plan order, each with the others' curves so far. The
-// curve stays anchored at its lowest knot. The loss is the unchanged
+// changes nothing, at most 6), channels in plan order, each with the others'
+// curves so far. The curve stays anchored at its lowest knot. The loss is the unchanged
 // network's 1-step error of every channel in the measured frame, each
 // relative to its error before the curves: sum_c (rmse_c / rmse_c,before)^2.
 // The channel's own error alone is no criterion: a flat curve feeds the
 // network an exaggerated level and reads its prediction back compressed,
 // which turns it into persistence (a good 1-step predictor of a slow
 // loadcell); what the network predicts of every other channel from that
-// level shows the distortion. `fitted` gets 1 per channel (the identity the
-// search starts from).
+// level shows the distortion. `fitted` is left as it is: the search starts
+// from the identity, not from a fitted parameter.
 void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
-                               std::vector<double>& fitted) {
+                               std::vector<double>&) {
   static constexpr double kFactors[] = {0.5, 0.7, 0.85, 0.93, 1 / 0.93, 1 / 0.85, 1 / 0.7, 2.0};
   // A segment's slope stays within 1/4..4 of the identity's: beyond, the
   // search fitted the noise of a loadcell at rest (slopes of 1/64 on seed-1
@@ -695,7 +695,6 @@ void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const
         c.reading[k] = c.reading[k - 1] + s[k - 1] * (c.level[k] - c.level[k - 1]);
     };
     std::vector<double> slopes = slopes_of(curve);
-    fitted.push_back(slopes.back() / slopes.front());
     const auto loss = [&] { return (training_rmse.all(sensor_after(before, a)).array() / rmse_before).square().sum(); };
     double best = loss();
     bool changed = true;

@@ -48,8 +48,9 @@ struct Hypothesis {
   // friction: the source is an absolute command, so its motion is its change
   // (regressors and inputs of u's change: derived_inputs.h dsign_/dhyst_)
   bool of_change = false;
-  // sensor-curve: the midpoint and half the width of the target's measured
-  // range over the logs (target units); 0 for the other effects.
+  // sensor-curve: the midpoint and half the width of the 5-95 % range of
+  // the target's values over the logs (target units, the model's frame); 0
+  // for the other effects.
   double centre = 0, half_range = 0;
 };
 

@@ -15,7 +15,10 @@ int index_of(const std::vector<std::string>& names, const std::string& name) {
 }
 
 // How the model's frame maps to the measured channels: its sensor model
-// (sensor_model.h) by y row. The clips are applied by the predictions.
+// (sensor_model.h) by y row. The predictions clip the frame's estimate
+// (output_clip.h); the measured value is clipped again at the end, as the
+// firmware reports it (a curve, cross-talk or drift may carry it past the
+// rail).
 struct OutputMap {
   std::vector<int> delay;  // per y channel: reported this many steps late
   int d = 0;               // the largest delay
@@ -26,6 +29,7 @@ struct OutputMap {
   std::vector<Crosstalk> crosstalk;                    // measured y_c = y'_c + gain y'_s
   std::vector<std::pair<Eigen::Index, SensorDrift>> drifts;  // measured y_c = y'_c + b_c
   std::vector<std::pair<Eigen::Index, SensorCurve>> curves;  // measured y_c = g_c(y'_c)
+  std::vector<std::pair<Eigen::Index, OutputClip>> clips;     // measured y_c = clip_c(...)
 };
 
 OutputMap output_map(const HadynetModel& m) {
@@ -41,6 +45,7 @@ OutputMap output_map(const HadynetModel& m) {
   for (const auto& x : m.sensor.crosstalk) map.crosstalk.push_back({row(x.target), row(x.source), x.gain});
   for (const auto& drift : m.sensor.drifts) map.drifts.emplace_back(row(drift.channel), drift);
   for (const auto& curve : m.sensor.curves) map.curves.emplace_back(row(curve.channel), curve);
+  for (const auto& clip : m.sensor.clips) map.clips.emplace_back(row(clip.channel), clip);
   return map;
 }
 
@@ -74,6 +79,9 @@ Eigen::MatrixXd measured_predictions(const HadynetModel& model, const LogSequenc
       out(c, t) += known + drift.rate * increment;
     }
   }
+  for (const auto& [c, clip] : map.clips)
+    for (int t = d + 2; t < rows_raw; ++t)
+      if (clip.side > 0 ? out(c, t) > clip.rail : out(c, t) < clip.rail) out(c, t) = clip.rail;
   return out;
 }
 
