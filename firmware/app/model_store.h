@@ -48,7 +48,8 @@ const firmware::ModelTensors<M>* tensors_in(std::span<const std::uint8_t> payloa
   return reinterpret_cast<const T*>(payload.data());
 }
 
-// The self-test of an image on trial: runs the fixed synthetic sequence
+// The self-test of an image on trial: refuses curve knots the sensor stage
+// cannot use (curve_tensors_valid), then runs the fixed synthetic sequence
 // (runtime_checksum) on the image's tensors with `runtime` and compares the
 // checksum's low 32 bits with the header's. The runtime is given back on the
 // compiled-in model in its previous mode (the boot then picks the model).
@@ -59,7 +60,7 @@ class RuntimeSelfTest final : public model_update::SelfTest {
 
   bool run(std::span<const std::uint8_t> payload, const model_update::ModelImageHeader& header) noexcept override {
     const firmware::ModelTensors<M>* tensors = tensors_in<M>(payload);
-    if (tensors == nullptr) return false;
+    if (tensors == nullptr || !firmware::curve_tensors_valid<M>(*tensors)) return false;
     const firmware::Mode mode = runtime_.mode();
     runtime_.use_model(*tensors);
     last_checksum_ = runtime_checksum(runtime_);

@@ -182,6 +182,25 @@ constexpr ModelTensors<M> make_compiled_tensors() noexcept {
 template <GeneratedModel M>
 inline constexpr ModelTensors<M> kCompiledTensors = make_compiled_tensors<M>();
 
+// Whether the curve knots of `t` (a model image's: data, unlike the
+// compiled-in model's, which curves_valid() checks at compile time) are
+// finite and strictly increasing, levels and readings: the sensor stage
+// divides by their differences. A signed image is the host's, which checks
+// them; the runtime's self-test of an image refuses one that fails here.
+template <GeneratedModel M>
+constexpr bool curve_tensors_valid(const ModelTensors<M>& t) noexcept {
+  // Finite: v - v is 0 only for a finite v (NaN and infinities give NaN).
+  const auto finite = [](float v) { return v - v == 0.0f; };
+  for (int j = 0; j < M::kCurveCount; ++j)
+    for (int k = j * M::kCurveKnots; k < (j + 1) * M::kCurveKnots; ++k) {
+      if (!finite(t.curve_level[k]) || !finite(t.curve_reading[k])) return false;
+      if (k > j * M::kCurveKnots &&
+          !(t.curve_level[k] > t.curve_level[k - 1] && t.curve_reading[k] > t.curve_reading[k - 1]))
+        return false;
+    }
+  return true;
+}
+
 // The bytes of ModelTensors<M>'s members, each after the previous with no
 // padding, plus tail padding to the struct's alignment: sizeof(ModelTensors<M>)
 // must equal it on every target (no interior padding, so one layout).

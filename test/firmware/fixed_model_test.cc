@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <memory>
 
 #include "codegen/codegen.h"
@@ -334,6 +335,21 @@ void expect_image_carries_the_curve() {
   const auto updated = image_tensors<M>(refitted, loaded.identity);
   for (int k = 0; k < M::kCurveKnots; ++k)
     EXPECT_EQ(updated->curve_reading[k], static_cast<float>(curve.reading[static_cast<std::size_t>(k)])) << k;
+  // Knots a sensor stage cannot use are refused (the self-test of an image
+  // on trial, app/model_store.h): not increasing, or not finite.
+  EXPECT_TRUE(firmware::curve_tensors_valid<M>(*updated));
+  EXPECT_TRUE(firmware::curve_tensors_valid<M>(firmware::kCompiledTensors<M>));
+  {
+    auto bad = std::make_unique<firmware::ModelTensors<M>>(*updated);
+    bad->curve_level[1] = bad->curve_level[0];
+    EXPECT_FALSE(firmware::curve_tensors_valid<M>(*bad));
+    *bad = *updated;
+    bad->curve_reading[M::kCurveKnots - 1] = std::numeric_limits<float>::infinity();
+    EXPECT_FALSE(firmware::curve_tensors_valid<M>(*bad));
+    *bad = *updated;
+    bad->curve_level[0] = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_FALSE(firmware::curve_tensors_valid<M>(*bad));
+  }
   const firmware::SensorStage<M> stage(*updated);
   const int c = static_cast<int>(y_row(refitted, curve.channel));
   for (const double v : {curve.level.front() - 1, curve.level[1], curve.level.back() + 1}) {
