@@ -230,6 +230,20 @@ TEST(FixedModelRuntime, ControlModeHoldsFrictionInputsAndFeedsTheLagInputTheComm
 // (60 rows here): together below 1e-6; 1e-5 leaves a margin of 10.
 constexpr double kStageTolerance = 1e-5;
 
+// The stage reports model-frame level v of channel c through `curve` (g, the
+// trainer's curve_reading), for every v of `levels`.
+template <class M, class Levels>
+void expect_reads_through(const firmware::SensorStage<M>& stage, int c, const trainer::SensorCurve& curve,
+                          const Levels& levels) {
+  for (const double v : levels) {
+    float y_prime[M::kY] = {}, y[M::kY];
+    y_prime[c] = static_cast<float>(v);
+    stage.to_measured(y_prime, y);
+    const double want = trainer::curve_reading(curve, v);
+    EXPECT_NEAR(y[c], want, kStageTolerance * (1 + std::abs(want))) << v;
+  }
+}
+
 // The held-out log's first `rows` rows with the curve's channel replaced by a
 // ramp from 1 (unit) below the curve's first reading knot to 1 beyond its
 // last: the inverse curve is used on both continuations and every segment.
@@ -289,13 +303,9 @@ void expect_stage_as_the_trainer() {
   // g on its own (no drift yet after a reset; fc3 is no cross-talk target)
   // on a finer grid: at and between the knots and 2 N beyond both ends.
   stage.reset();
-  for (double v = curve.level.front() - 2; v <= curve.level.back() + 2; v += 0.0625) {
-    float y_prime[M::kY] = {}, y_out[M::kY];
-    y_prime[fc3] = static_cast<float>(v);
-    stage.to_measured(y_prime, y_out);
-    const double want = trainer::curve_reading(curve, v);
-    EXPECT_NEAR(y_out[fc3], want, kStageTolerance * (1 + std::abs(want))) << v;
-  }
+  std::vector<double> grid;
+  for (double v = curve.level.front() - 2; v <= curve.level.back() + 2; v += 0.0625) grid.push_back(v);
+  expect_reads_through(stage, fc3, curve, grid);
 }
 
 TEST(FixedModelSensorStage, CurveFrameAndOutputTransformsAreTheTrainersF32) { expect_stage_as_the_trainer<F>(); }
@@ -352,13 +362,8 @@ void expect_image_carries_the_curve() {
   }
   const firmware::SensorStage<M> stage(*updated);
   const int c = static_cast<int>(y_row(refitted, curve.channel));
-  for (const double v : {curve.level.front() - 1, curve.level[1], curve.level.back() + 1}) {
-    float y_prime[M::kY] = {}, y[M::kY];
-    y_prime[c] = static_cast<float>(v);
-    stage.to_measured(y_prime, y);
-    const double want = trainer::curve_reading(curve, v);
-    EXPECT_NEAR(y[c], want, kStageTolerance * (1 + std::abs(want))) << v;
-  }
+  expect_reads_through(stage, c, curve,
+                       std::vector<double>{curve.level.front() - 1, curve.level[1], curve.level.back() + 1});
 }
 
 TEST(FixedModelImage, CarriesTheCurveKnotsF32) { expect_image_carries_the_curve<F>(); }

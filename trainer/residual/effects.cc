@@ -520,19 +520,32 @@ namespace {
 // ---- sensor-curve: the target reports a static monotone curve of its own level ----
 namespace sensor_curve {
 
+// Channel c's values over the logs, sorted: every row, or the first half of
+// each log's rows.
+std::vector<double> sorted_values(const ResidualData& data, int c, bool first_half) {
+  std::vector<double> v;
+  for (const auto& log : data.logs) {
+    const auto y = log.seq.y.row(c);
+    for (Eigen::Index t = 0; t < (first_half ? y.size() / 2 : y.size()); ++t) v.push_back(y(t));
+  }
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+// The sorted values' q-quantile, the value at index floor(q (n - 1)); n > 0.
+double lower_quantile(const std::vector<double>& sorted, double q) {
+  return sorted[static_cast<std::size_t>(q * static_cast<double>(sorted.size() - 1))];
+}
+
 // One per channel whose range over the logs is not a point, when curves are
 // tested (LibraryOptions::sensor_curves: with a null only); the range is
 // that of the middle 90 % of its values (5 % to 95 % quantiles), where the
 // fit has data (a loadcell's extremes are a few rows of one grasp).
 void enumerate(const ResidualData& data, const LibraryOptions& options, int c, std::vector<Hypothesis>& out) {
   if (!options.sensor_curves) return;
-  std::vector<double> v;
-  for (const auto& log : data.logs)
-    for (Eigen::Index t = 0; t < log.seq.y.cols(); ++t) v.push_back(log.seq.y(c, t));
+  const std::vector<double> v = sorted_values(data, c, false);
   if (v.empty()) return;
-  std::sort(v.begin(), v.end());
-  const auto quantile = [&](double q) { return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))]; };
-  const double lo = quantile(0.05), hi = quantile(0.95);
+  const double lo = lower_quantile(v, 0.05), hi = lower_quantile(v, 0.95);
   if (!(hi > lo)) return;
   Hypothesis h{EffectKind::kSensorCurve, c, -1, 0, 0, 0};
   h.centre = 0.5 * (hi + lo);
@@ -579,19 +592,14 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
 }
 
 // The knots of a channel's curve: 9 quantiles (0, 1/8, .., 1) of its values
-// in the first half of each log (the fix's training rows begin there),
-// duplicates dropped; fewer than 2 distinct: none.
+// in the first half of each log (inside the fix's training rows, the first
+// 60 %), duplicates dropped; fewer than 2 distinct: none.
 std::vector<double> knot_levels(const ResidualData& data, int c) {
-  std::vector<double> v;
-  for (const auto& log : data.logs) {
-    const auto y = log.seq.y.row(c);
-    for (Eigen::Index t = 0; t < y.size() / 2; ++t) v.push_back(y(t));
-  }
-  std::sort(v.begin(), v.end());
+  const std::vector<double> v = sorted_values(data, c, true);
   std::vector<double> knots;
   if (v.empty()) return knots;
   for (int k = 0; k <= 8; ++k) {
-    const double q = v[static_cast<std::size_t>(k * static_cast<double>(v.size() - 1) / 8.0)];
+    const double q = lower_quantile(v, k / 8.0);
     if (knots.empty() || q > knots.back()) knots.push_back(q);
   }
   if (knots.size() < 2) knots.clear();
@@ -666,8 +674,8 @@ void CalibrationCurves::add_to_sensor(SensorModel& s, const Augmentation&) const
 // coordinate search (each slope times 0.5, 0.7, 0.85, 0.93, 1/0.93, 1/0.85,
 // 1/0.7 or 2 within 1/4..4, kept where the loss falls; sweeps until one
 // changes nothing, at most 6), channels in plan order, each with the others'
-// curves so far. The curve stays anchored at its lowest knot. The loss is the unchanged
-// network's 1-step error of every channel in the measured frame, each
+// curves so far. The curve stays anchored at its lowest knot. The loss is
+// the unchanged network's 1-step error of every channel in the measured frame, each
 // relative to its error before the curves: sum_c (rmse_c / rmse_c,before)^2.
 // The channel's own error alone is no criterion: a flat curve feeds the
 // network an exaggerated level and reads its prediction back compressed,
