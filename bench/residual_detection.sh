@@ -4,19 +4,8 @@
 # grasps of docs/residual.md, 300 rows, the effect switched on and declared
 # nowhere), through `hadynet residual MODEL LOGS --fix` with the plant's
 # datasheet ranges (--rated-range fc=0..50 --rated-range f=0..200). Per run:
-#   named     --fix confirmed the right effect with the right parameter:
-#             sensor-delay: the delay in steps; crosstalk: a plant pair
-#             (fc0<-fc1, fc1<-fc2, fc2<-fc3, fc3<-fc4, fc4<-fc3); tension-leak
-#             (a cross-talk between groups): f5 -> fc6 with a gain within
-#             0.5-1.5 times the plant's (the screen's gain is the plant's
-#             when the network carries little of its input over); friction:
-#             tendon channels (f*); drift: a load drift on a loadcell;
-#             saturation: a loadcell's upper rail within 10 % of the plant's;
-#             input-delay: the commands the plant's delay earlier as inputs
-#             (lag<d>_u*); sensor-curve (every loadcell reads
-#             50 N (F / 50 N)^E): curves on loadcells only, the first (the
-#             winner's) reading within 25 % of the plant's 50 (L / 50)^E at
-#             its highest knot L;
+#   named     --fix confirmed the right effect with the right parameter (one
+#             rule per plant effect: bench/residual_named.py);
 #   cut       the held-out 1-step RMSE on the changed channels (mean ratio
 #             after/before) is at most 0.7;
 #   <control  the augmented model's RMSE there is below fine-tuning alone's.
@@ -95,7 +84,9 @@ for ((k = 0; k < n; ++k)); do
     done_runs=$((done_runs + 1))
     eta=$(( ($(date +%s) - start) * (total - done_runs) / done_runs ))
     python3 - "$c" "$seed" "$d/residual.json" "[$done_runs/$total, ETA ${eta}s]" <<'PY' | tee -a "$runs"
-import json, re, sys
+import json, os, sys
+sys.path.insert(0, os.path.join(os.getcwd(), "bench"))
+from residual_named import names
 case, seed, path, progress = sys.argv[1:5]
 effect, strength = case.split("=")
 strength = float(strength)
@@ -104,34 +95,7 @@ aug = fix.get("augmentation") or {}
 named_effect = aug.get("effect", "-")
 confirmed = bool(fix.get("changed"))
 channels = aug.get("channels", [])
-pairs = {("fc0", "fc1"), ("fc1", "fc2"), ("fc2", "fc3"), ("fc3", "fc4"), ("fc4", "fc3")}
-param_ok = False
-if effect == "sensor-delay":
-    param_ok = named_effect == "sensor-delay" and aug.get("delay_steps") == int(strength)
-elif effect == "crosstalk":
-    param_ok = named_effect == "crosstalk" and bool(channels) and (channels[0], aug.get("source")) in pairs
-elif effect == "tension-leak":
-    gain = aug.get("gain", 0.0)
-    param_ok = (named_effect == "crosstalk" and channels == ["fc6"] and aug.get("source") == "f5"
-                and 0.5 * strength <= gain <= 1.5 * strength)
-elif effect == "friction":
-    param_ok = named_effect == "friction" and bool(channels) and all(re.fullmatch(r"f\d+", c) for c in channels)
-elif effect == "drift":
-    param_ok = named_effect == "drift-load" and bool(channels) and all(c.startswith("fc") for c in channels)
-elif effect == "saturation":
-    rails = [float(x) for x in re.findall(r"fc\d+ <= ([0-9.eE+-]+)", aug.get("description", ""))]
-    param_ok = named_effect == "saturation" and bool(rails) and all(abs(r - strength) <= 0.1 * strength for r in rails)
-elif effect == "input-delay":
-    lags = aug.get("derived_inputs", [])
-    param_ok = (named_effect == "input-delay" and bool(lags)
-                and all(x.startswith("lag%d_" % int(strength)) for x in lags))
-elif effect == "sensor-curve":
-    curves = aug.get("curves", [])
-    def plant_reading(level):
-        return 50.0 * (max(level, 0.0) / 50.0) ** strength
-    param_ok = (named_effect == "sensor-curve" and bool(curves) and all(c["channel"].startswith("fc") for c in curves)
-                and abs(curves[0]["reading"][-1] - plant_reading(curves[0]["level"][-1]))
-                <= 0.25 * plant_reading(curves[0]["level"][-1]))
+param_ok = names(effect, strength, fix)
 named = confirmed and param_ok
 cut = below_control = False
 ratio = float("nan")

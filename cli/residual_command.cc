@@ -217,8 +217,11 @@ int run_residual(int argc, char** argv) {
                   "confirmed (and the model kept) only when it beats fine-tuning alone on the held-out rows of\n"
                   "the channels it changes (one-sided Diebold-Mariano test at --alpha), else 'unexplained structure'");
   opt.value("rounds", "N",
-            "with --fix: repeat analysis and fix on the fixed model until nothing is confirmed, at most N rounds\n"
-            "(so that two effects at once are both found); round k > 1 reports into DIR/round-k", "1");
+            "with --fix: repeat analysis and fix until nothing is confirmed, at most N rounds (so that two\n"
+            "effects at once are both found); the next round analyses the confirmed change on the network\n"
+            "before fine-tuning when the change alone describes the effect (sensor changes, an input dead\n"
+            "time), else the fine-tuned model; the reference logs keep the input model's sensors; round\n"
+            "k > 1 reports into DIR/round-k", "1");
   opt.value("out", "FILE", "with --fix: write the augmented model of the last confirmed round (only when\n"
                            "something was fixed)");
   opt.value("fix-epochs", "N", "with --fix: fine-tuning epochs", "20");
@@ -344,10 +347,16 @@ int run_residual(int argc, char** argv) {
     fo.reference = &reference;
     fo.reference_pb_choice = stored_null ? "state" : "auto";
     fo.library = ao.library;
+    // The reference logs' sensors are the input model's in every round.
+    ao.reference_sensor = &model.sensor;
+    fo.reference_sensor = &model.sensor;
 
-    // Rounds: each analyses `current` (the model of the last confirmed round)
-    // and fixes when asked; the loop ends at the first round that confirms
-    // nothing. Round 1 reports into --report DIR and --json FILE; round k > 1
+    // Rounds: each analyses `current` and fixes when asked; the loop ends at
+    // the first round that confirms nothing. `current` after a confirmed round
+    // is its change on the network before fine-tuning when the change alone
+    // carries its effect (Augmentation::carried_before_tuning: fine-tuning on
+    // these logs would absorb part of a second effect before it is looked
+    // for), else the fine-tuned model. Round 1 reports into --report DIR and --json FILE; round k > 1
     // into DIR/round-k and the JSON's "rounds". --out holds the last
     // confirmed round's model, which carries every earlier round's change.
     json rounds_json = json::array();
@@ -361,12 +370,13 @@ int run_residual(int argc, char** argv) {
     trainer::HadynetModel current = model;
     std::string current_path = model_path;
     std::string written;
+    std::string current_what;  // what `current` is from round 2 on, in words
     int confirmed_rounds = 0;
     std::vector<std::string> confirmed_effects;
     const int round_count = opt.has("fix") ? static_cast<int>(*rounds) : 1;
     json first_json;
     for (int round = 1; round <= round_count; ++round) {
-      if (round > 1) std::printf("\n=== round %d: the model fixed in round %d, on the same logs ===\n", round, round - 1);
+      if (round > 1) std::printf("\n=== round %d: on the same logs, %s ===\n", round, current_what.c_str());
       const rs::Analysis a = rs::analyse(current, inputs, ao, reference);
       print_summary(a, pb_choice, opt.has("fix"));
       json j = analysis_json(a, current_path, pb_choice);
@@ -402,8 +412,14 @@ int run_residual(int argc, char** argv) {
       if (round == 1) first_json = j;
       else rounds_json.push_back(j);
       if (!fixed || !fixed->changed) break;
-      current = fixed->model;
-      current_path = written.empty() ? "(the model of round " + std::to_string(round) + ", not written)" : written;
+      const bool untuned = fixed->augmentation->carried_before_tuning();
+      current = untuned ? fixed->untuned : fixed->model;
+      current_what = untuned ? "the change of round " + std::to_string(round) +
+                                   " on the network before its fine-tuning (the change alone carries the effect)"
+                             : "the model fixed in round " + std::to_string(round);
+      current_path = untuned          ? "(round " + std::to_string(round) + "'s change before fine-tuning, not written)"
+                     : written.empty() ? "(the model of round " + std::to_string(round) + ", not written)"
+                                       : written;
       if (round == round_count && round_count > 1)
         std::printf("\n--rounds %d reached with the last round confirmed: more may remain\n", round_count);
     }

@@ -249,6 +249,12 @@ SensorModel sensor_from_json(const json& j, const std::string& origin) {
     s.clips.push_back({json_get<std::string>(c, "channel", "sensor clip", origin),
                        static_cast<int>(json_int(c, "side", "sensor clip", origin, -1, 1)),
                        json_number(c, "rail", "sensor clip", origin)});
+  // A part this build does not know would be ignored and the model predict
+  // wrongly: refused (a new part comes with a new format version).
+  for (const auto& [key, value] : j.items())
+    if (key != "delays" && key != "crosstalk" && key != "drifts" && key != "period_s" && key != "curves" &&
+        key != "clips")
+      fail(origin, "sensor model has an unknown part '" + key + "'");
   return s;
 }
 
@@ -324,7 +330,8 @@ st::File model_to_safetensors(const HadynetModel& model) {
 
   const HadynetDims& d = model.params.dims;
   file.metadata["format"] = kModelFormat;
-  file.metadata["format_version"] = std::to_string(kModelFormatVersion);
+  file.metadata["format_version"] =
+      std::to_string(model.sensor.curves.empty() ? kModelFormatVersion : kModelFormatVersionCurves);
   file.metadata["dims"] = json{{"x", d.x},         {"u", d.u},           {"y", d.y},
                                {"pb", d.pb},       {"hidden", d.hidden}, {"states", d.states},
                                {"train_steps", model.train_steps}}
@@ -385,10 +392,11 @@ HadynetModel model_from_safetensors(const st::File& file, const std::string& ori
                      "')");
   }
   const auto version = file.metadata.find("format_version");
-  if (version == file.metadata.end() || version->second != std::to_string(kModelFormatVersion)) {
+  const bool curves_allowed = version != file.metadata.end() && version->second == std::to_string(kModelFormatVersionCurves);
+  if (!curves_allowed && (version == file.metadata.end() || version->second != std::to_string(kModelFormatVersion))) {
     fail(origin, "unsupported model format_version '" +
-                     (version == file.metadata.end() ? std::string() : version->second) +
-                     "'; this build reads version " + std::to_string(kModelFormatVersion));
+                     (version == file.metadata.end() ? std::string() : version->second) + "'; this build reads versions " +
+                     std::to_string(kModelFormatVersion) + " and " + std::to_string(kModelFormatVersionCurves));
   }
   HadynetModel model;
   try {
@@ -524,6 +532,9 @@ HadynetModel model_from_safetensors(const st::File& file, const std::string& ori
 
     if (file.metadata.count("sensor") != 0)
       model.sensor = sensor_from_json(parse_metadata_json(file, "sensor", origin), origin);
+    if (!model.sensor.curves.empty() && !curves_allowed)
+      fail(origin, "the sensor model has calibration curves, which need format_version " +
+                       std::to_string(kModelFormatVersionCurves) + " (the file says " + version->second + ")");
 
     if (file.metadata.count("held_out_logs") != 0) {
       model.held_out_logs = held_out_logs_from(file, parse_metadata_json(file, "held_out_logs", origin), origin);

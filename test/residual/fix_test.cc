@@ -185,6 +185,11 @@ TEST(ResidualFix, SensorDelayIsTimeAlignedAndCutsTheDelayedChannelsError) {
   EXPECT_TRUE(r.fix.model.layout == build_model().layout);
   ASSERT_EQ(r.fix.model.sensor.delays.size(), a.channels.size());
   for (const auto& delay : r.fix.model.sensor.delays) EXPECT_EQ(delay.steps, fm::kSensorDelay.delay_steps) << delay.channel;
+  // --rounds analyses the next round with the change on the network before
+  // fine-tuning: the build's weights, the fixed model's sensor model.
+  EXPECT_TRUE(a.carried_before_tuning());
+  EXPECT_TRUE(r.fix.untuned.params.lstm_weight_hh == build_model().params.lstm_weight_hh);
+  EXPECT_TRUE(r.fix.untuned.sensor == r.fix.model.sensor);
   // The plant delays every loadcell: the fix aligns all nine (three pass the
   // floors; the rest join as the same delay in the same group).
   EXPECT_EQ(a.channels.size(), static_cast<std::size_t>(fm::kSensorDelay.aligned_channels));
@@ -241,6 +246,8 @@ TEST(ResidualFix, FrictionGetsDerivedCommandInputsAndCutsTheTendonsError) {
   EXPECT_EQ(m.params.dims.u, build_model().params.dims.u + static_cast<int>(inputs.size()));
   EXPECT_EQ(m.layout.u_names.back(), inputs.back());
   EXPECT_EQ(m.layout.u_names.back().rfind("hyst_u", 0), 0u);
+  // Its inputs start at zero weight: the next --rounds round needs the fine-tuned model.
+  EXPECT_FALSE(a.carried_before_tuning());
   const std::string& c = a.channels.front();
   expect_cut(r.fix, c, fm::kFriction.winner_vs_before, fm::kFriction.winner_vs_control);
   for (const auto& ch : a.channels) expect_cut(r.fix, ch, fm::kFriction.family_vs_before);
@@ -264,6 +271,8 @@ TEST(ResidualFix, InputDelayGetsTheLaggedCommandsAndCutsTheDelayedChannelsError)
   EXPECT_EQ(inputs.front(), "lag2_u0");
   EXPECT_EQ(m.params.dims.u, build_model().params.dims.u + 8);
   EXPECT_EQ(m.layout.u_names.back(), "lag2_u7");
+  // The lag inputs start as the pure dead time (next test): the change alone carries it.
+  EXPECT_TRUE(a.carried_before_tuning());
   const std::string& c = a.channels.front();
   expect_cut(r.fix, c, fm::kInputDelay.winner_vs_before, fm::kInputDelay.winner_vs_control);
   for (const auto& ch : a.channels) expect_cut(r.fix, ch, fm::kInputDelay.family_vs_before);
@@ -446,6 +455,7 @@ TEST(ResidualFix, AuxChannelBecomesAnInputAndCodegenAcceptsTheModel) {
   EXPECT_EQ(m.params.dims.y, build_model().params.dims.y + 1);
   EXPECT_EQ(m.layout.x_names.back(), "aux_temp");
   EXPECT_EQ(std::get<ObservedAuxChannel>(r.fix.augmentation->change).channel, "aux_temp");
+  EXPECT_FALSE(r.fix.augmentation->carried_before_tuning());  // its decoder row starts at zero
   expect_cut(r.fix, "fc3", fm::kAux.winner_vs_before, fm::kAux.winner_vs_control);
   expect_deployable(m);
 }

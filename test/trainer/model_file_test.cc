@@ -186,7 +186,10 @@ TEST(ModelFile, PyTorchNamesAndShapes) {
     EXPECT_EQ(f.tensors.at(name).shape, shape) << name;
   }
   EXPECT_EQ(f.metadata.at("format"), kModelFormat);
-  EXPECT_EQ(f.metadata.at("format_version"), std::to_string(kModelFormatVersion));
+  // This model's sensor model has a calibration curve: version 2; without one, 1.
+  EXPECT_EQ(f.metadata.at("format_version"), std::to_string(kModelFormatVersionCurves));
+  EXPECT_EQ(model_to_safetensors(sample_model(false)).metadata.at("format_version"),
+            std::to_string(kModelFormatVersion));
 }
 
 TEST(ModelFile, InconsistentModelIsNotWritten) {
@@ -248,6 +251,7 @@ TEST_F(ModelFileRejects, SensorModelOnAnUnknownChannelOrWithBadNumbers) {
       {"\"driver\":\"load\"", "\"driver\":\"heat\"", "driver 'heat'"},
       {"\"steps\":2", "\"steps\":0", "sensor delay 'steps' must be a whole number in 1 .. 4096, got 0"},
       {"\"crosstalk\":[", "\"crosstalk\":{\"a\":1},\"x\":[", "'crosstalk' is not an array"},
+      {"\"clips\":", "\"hysteresis\":[],\"clips\":", "unknown part 'hysteresis'"},
   };
   for (const auto& c : cases) {
     st::File f = good_;
@@ -295,8 +299,11 @@ TEST_F(ModelFileRejects, WrongFormatTag) {
 
 TEST_F(ModelFileRejects, UnsupportedFormatVersion) {
   st::File f = good_;
-  f.metadata["format_version"] = "2";
-  expect_rejected(f, "format_version '2'");
+  f.metadata["format_version"] = "3";
+  expect_rejected(f, "format_version '3'; this build reads versions 1 and 2");
+  // Version 1 cannot hold calibration curves: a build that reads only 1 would drop them.
+  f.metadata["format_version"] = "1";
+  expect_rejected(f, "calibration curves, which need format_version 2");
   f.metadata["format_version"] = "1.0";
   expect_rejected(f, "format_version '1.0'");
 }

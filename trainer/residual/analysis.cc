@@ -38,7 +38,9 @@ Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, c
     a.attribution = attribute(d, hypotheses, options.attribution);
   } else {
     const std::string& ref_pb = options.reference_pb_choice.empty() ? options.pb_choice : options.reference_pb_choice;
-    const ResidualData ref = compute_residuals(model, reference, ref_pb);
+    HadynetModel null_model = model;
+    if (options.reference_sensor != nullptr) null_model.sensor = *options.reference_sensor;
+    const ResidualData ref = compute_residuals(null_model, reference, ref_pb);
     a.reference_pb = pb_summary(ref, ref_pb);
     const NullCalibration null = calibrate_null(d, ref, hypotheses, options.attribution);
     a.attribution = attribute(d, hypotheses, options.attribution, &null);

@@ -30,6 +30,12 @@ struct AnalysisOptions {
   // The model's stored held-out logs are rows of its trained states' own
   // recordings, so their trained PBs are theirs ("state"): no PB check.
   std::string reference_pb_choice;
+  // The sensor model the reference logs were recorded through, when it is
+  // not the model's: a --rounds round analyses a model whose sensor model
+  // holds the changes earlier rounds confirmed on the logs under test, which
+  // the clean reference logs do not show (their sensors are the input
+  // model's). nullptr: the model's own.
+  const SensorModel* reference_sensor = nullptr;
 };
 
 // Everything the analysis computes.

@@ -98,6 +98,10 @@ SensorModel sensor_after(const SensorModel& before, const Augmentation& a) {
   return s;
 }
 
+bool Augmentation::carried_before_tuning() const {
+  return std::visit([](const auto& c) { return c.carried_before_tuning(); }, change);
+}
+
 FeatureLayout augmented_layout(const FeatureLayout& layout, const Augmentation& a) {
   std::vector<std::string> y = layout.y_names, u = layout.u_names;
   std::visit([&](const auto& change) { change.add_to_channels(y, u); }, a.change);
@@ -218,13 +222,14 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     std::vector<double> loss_history;
     long train_windows = 0;
   };
-  auto tune = [&](const Augmentation* a, const std::vector<int>& cut) {
+  auto tune = [&](const Augmentation* a, const std::vector<int>& cut, HadynetModel* untuned = nullptr) {
     Tuned t;
     const SensorModel sensor = a != nullptr ? sensor_after(model.sensor, *a) : model.sensor;
     const FeatureLayout layout = a != nullptr ? augmented_layout(model.layout, *a) : model.layout;
     // The augmented layout first (aux adds a channel, friction commands), then its training data.
     const auto seqs = training_rows(sensor, layout, cut);
     t.model = a != nullptr ? augmented_model(model, *a, seqs) : model;
+    if (untuned != nullptr) *untuned = t.model;
     const auto rows = ensure_states(t.model, seqs, before_pbs);
     t.loss_history = fine_tune(t.model, seqs, rows, tuning, &t.train_windows);
     t.model.check_consistent();
@@ -289,7 +294,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // found on (the plan's found_on, of the model's own channels: the aligned,
   // cleaned, clipped, drifting or friction channels; for an aux channel, the
   // channels its significant hypotheses explain).
-  Tuned after = tune(&planned[chosen], split);
+  Tuned after = tune(&planned[chosen], split, &result.untuned);
   result.augmentation = planned[chosen];
   result.fitted_rates = fitted_rates[chosen];
   result.loss_history = after.loss_history;
@@ -320,7 +325,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   library_after.sensor_curves = options.reference != nullptr && !options.reference->empty();
   const std::vector<Hypothesis> hypotheses_after = enumerate_hypotheses(again, library_after);
   if (options.reference != nullptr && !options.reference->empty()) {
-    ResidualData ref = compute_residuals(after.model, *options.reference, options.reference_pb_choice);
+    HadynetModel null_model = after.model;
+    if (options.reference_sensor != nullptr) null_model.sensor = *options.reference_sensor;
+    ResidualData ref = compute_residuals(null_model, *options.reference, options.reference_pb_choice);
     drop_predicted_aux(ref);
     const NullCalibration null = calibrate_null(again, ref, hypotheses_after, attribution.options);
     result.after.verdict = verdict_text(attribute(again, hypotheses_after, attribution.options, &null));

@@ -53,6 +53,9 @@ struct FixOptions {
   const std::vector<LogInput>* reference = nullptr;
   // Their PB rule (compute_residuals): as AnalysisOptions::reference_pb_choice.
   std::string reference_pb_choice = "auto";
+  // The sensor model of the reference logs (AnalysisOptions::reference_sensor);
+  // nullptr: the model's own.
+  const SensorModel* reference_sensor = nullptr;
   // The analysis's effect library options (AnalysisOptions::library): the
   // augmented model's verdict tests the same hypotheses.
   LibraryOptions library;
@@ -86,6 +89,10 @@ struct ModelChange {
   // fix(), before fine-tuning: re-estimates the change's parameters on the
   // training rows; appends what the attribution had fitted to `fitted`.
   void refine(Augmentation&, const SensorModel&, const TrainingRmse&, std::vector<double>&) {}
+  // Whether the change alone, on the network before fine-tuning, already
+  // describes the effect (Augmentation::carried_before_tuning): the sensor
+  // model's changes do; new inputs or outputs that start at zero weight do not.
+  bool carried_before_tuning() const { return true; }
 };
 
 // sensor-delay: time alignment of Augmentation::channels (the winner's family
@@ -149,6 +156,9 @@ struct DerivedCommandInputs : ModelChange {
   void add_to_channels(std::vector<std::string>& y, std::vector<std::string>& u) const;
   void add_to_network(const Augmentation& a, const HadynetModel& before, HadynetModel& m,
                       const std::vector<LogSequence>& train_seqs) const;
+  // Lag inputs start as the pure dead time (the command's weights move to
+  // its lag); sign and hysteresis inputs start at zero weight.
+  bool carried_before_tuning() const;
 };
 
 // aux-channel: the aux_* column becomes an observed channel: appended to y
@@ -160,6 +170,7 @@ struct ObservedAuxChannel : ModelChange {
   void add_to_channels(std::vector<std::string>& y, std::vector<std::string>& u) const;
   void add_to_network(const Augmentation& a, const HadynetModel& before, HadynetModel& m,
                       const std::vector<LogSequence>& train_seqs) const;
+  bool carried_before_tuning() const { return false; }  // its decoder row starts at zero
 };
 
 // What --fix adds, from the winner and its family (the effect's plan).
@@ -180,6 +191,11 @@ struct Augmentation {
   std::variant<TimeAlignment, CrosstalkRemoval, BiasState, OutputClips, CalibrationCurves, DerivedCommandInputs,
                ObservedAuxChannel>
       change;
+  // The change's carried_before_tuning(): `hadynet residual --rounds` then
+  // analyses the next round with the change on the network before
+  // fine-tuning (FixResult::untuned), so that fine-tuning on the logs under
+  // test cannot absorb a second effect before it is looked for.
+  bool carried_before_tuning() const;
 };
 // Why --fix cannot add significant hypothesis `r` ("" when it can): its
 // effect has no plan, or the effect's not_planned rule declines it (an input
@@ -246,6 +262,11 @@ struct FixResult {
   bool tried = false;          // the augmented model was fine-tuned and evaluated (after is valid)
   bool changed = false;        // confirmed: a new model was produced
   HadynetModel model;          // the augmented, fine-tuned model (the input model if !changed)
+  // The chosen augmentation on the input model's network before fine-tuning
+  // (augmented_model()); valid if tried. Fine-tuning it as fix() does gives
+  // `model` again, so a round that starts from it has the last round's model
+  // as its control.
+  HadynetModel untuned;
   HeldOutError before, after;  // after: the augmented model (valid if tried)
   std::vector<std::string> confirmation_channels;  // where the effect was found (the test's channels)
   std::string reference;                           // "fine-tuning alone" or "the unchanged model"

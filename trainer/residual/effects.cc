@@ -316,6 +316,13 @@ void DerivedCommandInputs::add_to_channels(std::vector<std::string>&, std::vecto
 // zero instead left the undelayed weights in place after fine-tuning, and
 // the stabiliser then planned with a command effect the plant does not
 // have: docs/residual.md, "Input dead time".)
+bool DerivedCommandInputs::carried_before_tuning() const {
+  return std::all_of(inputs.begin(), inputs.end(), [](const std::string& name) {
+    const auto d = parse_derived_input(name);
+    return d && d->kind == DerivedKind::kLag;
+  });
+}
+
 void DerivedCommandInputs::add_to_network(const Augmentation& a, const HadynetModel& before, HadynetModel& m,
                                       const std::vector<LogSequence>& train_seqs) const {
   m.layout = augmented_layout(before.layout, a);

@@ -1,0 +1,116 @@
+#!/usr/bin/env bash
+# Two effects at once (issue 12's "two rounds name both"; not a test): fresh
+# log sets of the four grasps of docs/residual.md (300 rows) with two plant
+# effects switched on and declared nowhere, through
+#   hadynet residual MODEL LOGS --fix --rounds 2 --candidates K
+# with the plant's datasheet ranges (--rated-range fc=0..50 --rated-range
+# f=0..200) and the model's stored null. Per run: which effect each round
+# confirmed, and "both" when the confirmed rounds name both plant effects
+# with the right parameter (bench/residual_named.py: the same rules as
+# bench/residual_detection.sh).
+# Seeds: 511-515 were run by hand before this script (docs/residual.md,
+# "Rounds"); 631-632 development of the rounds' analysis model (the change
+# before fine-tuning); 641-650 measured (used for nothing else).
+#
+# Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
+#          [--pair A=X+B=Y]...
+#   defaults: models/hand.safetensors, build/residual-two-effects, 5, 641, --candidates 3, the pairs
+#   sensor-delay=2+crosstalk=0.35, sensor-delay=2+friction=4, input-delay=2+crosstalk=0.35,
+#   input-delay=2+saturation=2 (--pair: only those; repeatable)
+# Environment: HADYNET (default build/release/cli/hadynet).
+# Prints one line per run with an ETA, then the table (OUT/summary.txt).
+set -euo pipefail
+usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
+model=models/hand.safetensors
+out=build/residual-two-effects
+n=5
+first_seed=641
+candidates=3
+pairs=()
+while (($#)); do
+  case "$1" in
+    -h | --help) usage; exit 0 ;;
+    --model) model=$2; shift 2 ;;
+    --out) out=$2; shift 2 ;;
+    --seeds) n=$2; shift 2 ;;
+    --first-seed) first_seed=$2; shift 2 ;;
+    --candidates) candidates=$2; shift 2 ;;
+    --pair) pairs+=("$2"); shift 2 ;;
+    *) echo "residual_two_effects: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
+cd "$(dirname "$0")/.."
+source bench/residual_grasps.sh
+hadynet="${HADYNET:-build/release/cli/hadynet}"
+[[ -x "$hadynet" ]] || { echo "residual_two_effects: $hadynet not found" >&2; exit 2; }
+((${#pairs[@]})) || pairs=(sensor-delay=2+crosstalk=0.35 sensor-delay=2+friction=4 input-delay=2+crosstalk=0.35
+  input-delay=2+saturation=2)
+mkdir -p "$out"
+runs="$out/runs.txt"
+: >"$runs"
+total=$((n * ${#pairs[@]})) done_runs=0 start=$(date +%s)
+for ((k = 0; k < n; ++k)); do
+  seed=$((first_seed + k))
+  for pair in "${pairs[@]}"; do
+    a=${pair%%+*} b=${pair#*+}
+    d="$out/$pair/seed$seed"
+    rm -rf "$d" && mkdir -p "$d"
+    collect_residual_grasps "$hadynet" "$d/logs" "$seed" --effect "$a" --effect "$b"
+    "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 --fix --rounds 2 \
+      --candidates "$candidates" --json "$d/residual.json" >"$d/out.txt" 2>&1 ||
+      { echo "$pair seed $seed: residual failed" >>"$runs"; continue; }
+    done_runs=$((done_runs + 1))
+    eta=$(( ($(date +%s) - start) * (total - done_runs) / done_runs ))
+    python3 - "$pair" "$seed" "$d/residual.json" "[$done_runs/$total, ETA ${eta}s]" <<'PY' | tee -a "$runs"
+import json, os, sys
+sys.path.insert(0, os.path.join(os.getcwd(), "bench"))
+from residual_named import names
+pair, seed, path, progress = sys.argv[1:5]
+effects = [(e.split("=")[0], float(e.split("=")[1])) for e in pair.split("+")]
+j = json.load(open(path))
+rounds = [j] + j.get("rounds", [])
+found = set()  # plant effects a round confirmed with the right parameter
+tried = set()  # ... that a round tried (fine-tuned and judged), confirmed or not
+said = []
+for r in rounds:
+    fix = r.get("fix", {})
+    aug = fix.get("augmentation") or {}
+    hit = [e for e, s in effects if names(e, s, fix)] if fix.get("after") else []
+    tried.update(hit)
+    what = f"{aug.get('effect')} ({aug.get('description', '')[:50]}) = {hit[0] if hit else 'neither'}"
+    if fix.get("changed"):
+        found.update(hit)
+        said.append(f"round {r.get('round')}: confirmed {what}")
+    elif fix.get("after"):
+        said.append(f"round {r.get('round')}: tried, not confirmed (p {fix['confirmation']['p_value']:.2g}): {what}")
+    else:
+        said.append(f"round {r.get('round')}: {fix.get('status', '-')[:70]}")
+both = all(e in found for e, _ in effects)
+second = effects[1][0]
+print(f"{pair} seed {seed}: both {'yes' if both else 'no '} first {'yes' if effects[0][0] in found else 'no '} "
+      f"second {'yes' if second in found else 'no '} second-tried {'yes' if second in tried else 'no '} | "
+      + "; ".join(said) + f"   {progress}")
+PY
+  done
+done
+
+python3 - "$runs" "${pairs[@]}" <<'PY' | tee "$out/summary.txt"
+import re, sys
+path, pairs = sys.argv[1], sys.argv[2:]
+rows = {p: [0, 0, 0, 0, 0] for p in pairs}
+for line in open(path):
+    m = re.match(r"(\S+) seed \d+: both (yes|no) +first (yes|no) +second (yes|no) +second-tried (yes|no)", line)
+    if not m:
+        continue
+    r = rows[m.group(1)]
+    r[0] += 1
+    r[1] += m.group(3) == "yes"
+    r[2] += m.group(4) == "yes"
+    r[3] += m.group(2) == "yes"
+    r[4] += m.group(5) == "yes"
+print("| effects | runs | first named and confirmed | second named and confirmed | both | second tried by a round (named, confirmed or not) |")
+print("|---|---|---|---|---|---|")
+for p in pairs:
+    r = rows[p]
+    print(f"| {p.replace('+', ' + ')} | {r[0]} | {r[1]} | {r[2]} | {r[3]} | {r[4]} |")
+PY
