@@ -4,14 +4,15 @@
 residual_grasps=("Cylinder random2 1" "Ball random2 2" "Gripper random2 0" "Cylinder random1 0")
 
 # collect_residual_grasps HADYNET OUT SEED [collect options...]: the four
-# grasps, 300 rows each, recorded with SEED into OUT (collect's layout:
-# OUT/train/*.csv and a manifest).
+# grasps, 300 rows each (environment RESIDUAL_ROWS: another length, e.g. to
+# measure what longer logs give), recorded with SEED into OUT (collect's
+# layout: OUT/train/*.csv and a manifest).
 collect_residual_grasps() {
   local hadynet=$1 out=$2 seed=$3 g
   shift 3
   for g in "${residual_grasps[@]}"; do
     set -- $g "$@"
-    "$hadynet" collect --object "$1" --motion "$2" --init "$3" --rows 300 --seed "$seed" --out "$out" \
+    "$hadynet" collect --object "$1" --motion "$2" --init "$3" --rows "${RESIDUAL_ROWS:-300}" --seed "$seed" --out "$out" \
       "${@:4}" --quiet >/dev/null
     shift 3
   done

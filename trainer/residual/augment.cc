@@ -75,6 +75,10 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
     a.kind = r.hypothesis.kind;
     a.effect = r.effect;
     effect_info(a.kind).plan(data, attribution, r, a);
+    if (!a.not_fixable.empty()) {  // the plan found nothing to add (a curve without two distinct levels)
+      if (r.label == winner->label) winner_not_fixable = a.not_fixable;
+      continue;
+    }
     if (out.empty() && r.label != winner->label)
       a.description = "the winner (" + winner->effect + ": " + winner->label + ") is not added (" +
                       winner_not_fixable + "); the best significant effect that can be: " + r.label + "; " +
@@ -85,7 +89,7 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
     Augmentation a;
     a.kind = winner->hypothesis.kind;
     a.effect = winner->effect;
-    a.not_fixable = why_not_fixable(data, attribution, *winner);
+    a.not_fixable = winner_not_fixable.empty() ? why_not_fixable(data, attribution, *winner) : winner_not_fixable;
     a.description = winner->label;
     out.push_back(std::move(a));
   }

@@ -205,7 +205,8 @@ std::string why_not_fixable(const ResidualData& data, const Attribution& attribu
 // The screen's candidates for --fix: the augmentations (each with its
 // family: the effect's plan, effects.cc) of the significant hypotheses in
 // ranking order that --fix can add (why_not_fixable), the best of each
-// effect, at most `count`. When the winner cannot be added, the first
+// effect, at most `count`; a plan that finds nothing to add (it sets
+// not_fixable) is skipped like an unfixable hypothesis. When the winner cannot be added, the first
 // candidate's description says why; when no significant hypothesis can, the
 // winner's alone with Augmentation::not_fixable set (fix() then reports
 // "not supported"). Empty without a winner.

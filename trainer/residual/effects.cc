@@ -600,14 +600,17 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
 
 // The knots of a channel's curve: 9 quantiles (0, 1/8, .., 1) of its values
 // in the first half of each log (inside the fix's training rows, the first
-// 60 %), duplicates dropped; fewer than 2 distinct: none.
+// 60 %); a quantile within 1e-4 of the values' range above the last knot is
+// dropped (equal once rounded to float, codegen would refuse the model);
+// fewer than 2 knots: none.
 std::vector<double> knot_levels(const ResidualData& data, int c) {
   const std::vector<double> v = sorted_values(data, c, true);
   std::vector<double> knots;
   if (v.empty()) return knots;
+  const double min_gap = 1e-4 * (v.back() - v.front());
   for (int k = 0; k <= 8; ++k) {
     const double q = lower_quantile(v, k / 8.0);
-    if (knots.empty() || q > knots.back()) knots.push_back(q);
+    if (knots.empty() || q > knots.back() + min_gap) knots.push_back(q);
   }
   if (knots.size() < 2) knots.clear();
   return knots;
@@ -644,6 +647,10 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
     curve.reading = curve.level;
     a.channels.push_back(curve.channel);
     change.curves.push_back(std::move(curve));
+  }
+  if (change.curves.empty()) {
+    a.not_fixable = "no channel of the curve's group takes two distinct levels for its knots";
+    return;
   }
   a.description = "a static calibration curve of " + join(a.channels) +
                   (extended.empty() ? "" : " (" + join(extended) + ": a curve in the same group)") +
