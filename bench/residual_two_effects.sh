@@ -9,8 +9,10 @@
 # with the right parameter (bench/residual_named.py: the same rules as
 # bench/residual_detection.sh).
 # Seeds: 511-515 were run by hand before this script (docs/residual.md,
-# "Rounds"); 631-632 development of the rounds' analysis model (the change
-# before fine-tuning); 641-650 measured (used for nothing else).
+# "Rounds"); 631 development of the rounds' analysis model (the change
+# before fine-tuning); 641-645 measured, with the binary before and after
+# that change; 691-695 measured with RESIDUAL_ROWS=600 (used for nothing
+# else).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]...
@@ -71,12 +73,15 @@ j = json.load(open(path))
 rounds = [j] + j.get("rounds", [])
 found = set()  # plant effects a round confirmed with the right parameter
 tried = set()  # ... that a round tried (fine-tuned and judged), confirmed or not
+later = set()  # ... that a round after the first tried
 said = []
 for r in rounds:
     fix = r.get("fix", {})
     aug = fix.get("augmentation") or {}
     hit = [e for e, s in effects if names(e, s, fix)] if fix.get("after") else []
     tried.update(hit)
+    if r.get("round", 1) > 1:
+        later.update(hit)
     what = f"{aug.get('effect')} ({aug.get('description', '')[:50]}) = {hit[0] if hit else 'neither'}"
     if fix.get("changed"):
         found.update(hit)
@@ -88,7 +93,8 @@ for r in rounds:
 both = all(e in found for e, _ in effects)
 second = effects[1][0]
 print(f"{pair} seed {seed}: both {'yes' if both else 'no '} first {'yes' if effects[0][0] in found else 'no '} "
-      f"second {'yes' if second in found else 'no '} second-tried {'yes' if second in tried else 'no '} | "
+      f"second {'yes' if second in found else 'no '} second-tried {'yes' if second in tried else 'no '} "
+      f"second-tried-later {'yes' if second in later else 'no '} | "
       + "; ".join(said) + f"   {progress}")
 PY
   done
@@ -97,9 +103,10 @@ done
 python3 - "$runs" "${pairs[@]}" <<'PY' | tee "$out/summary.txt"
 import re, sys
 path, pairs = sys.argv[1], sys.argv[2:]
-rows = {p: [0, 0, 0, 0, 0] for p in pairs}
+rows = {p: [0, 0, 0, 0, 0, 0] for p in pairs}
 for line in open(path):
-    m = re.match(r"(\S+) seed \d+: both (yes|no) +first (yes|no) +second (yes|no) +second-tried (yes|no)", line)
+    m = re.match(r"(\S+) seed \d+: both (yes|no) +first (yes|no) +second (yes|no) +second-tried (yes|no) "
+                 r"+second-tried-later (yes|no)", line)
     if not m:
         continue
     r = rows[m.group(1)]
@@ -108,9 +115,11 @@ for line in open(path):
     r[2] += m.group(4) == "yes"
     r[3] += m.group(2) == "yes"
     r[4] += m.group(5) == "yes"
-print("| effects | runs | first named and confirmed | second named and confirmed | both | second tried by a round (named, confirmed or not) |")
-print("|---|---|---|---|---|---|")
+    r[5] += m.group(6) == "yes"
+print("| effects | runs | first named and confirmed | second named and confirmed | both "
+      "| second tried by any round (named, confirmed or not) | ... by round 2 or later |")
+print("|---|---|---|---|---|---|---|")
 for p in pairs:
     r = rows[p]
-    print(f"| {p.replace('+', ' + ')} | {r[0]} | {r[1]} | {r[2]} | {r[3]} | {r[4]} |")
+    print(f"| {p.replace('+', ' + ')} | {r[0]} | {r[1]} | {r[2]} | {r[3]} | {r[4]} | {r[5]} |")
 PY

@@ -347,9 +347,18 @@ int run_residual(int argc, char** argv) {
     fo.reference = &reference;
     fo.reference_pb_choice = stored_null ? "state" : "auto";
     fo.library = ao.library;
-    // The reference logs' sensors are the input model's in every round.
-    ao.reference_sensor = &model.sensor;
-    fo.reference_sensor = &model.sensor;
+    // The sensors the reference logs were recorded through, in every round:
+    // the stored held-out logs are rows of the training logs, which `train`
+    // models without a sensor model (a later --fix changes the model's sensor
+    // model, not those logs), so only the clips (rated ranges, rails) apply;
+    // --reference logs are read through the input model's sensor model.
+    trainer::SensorModel reference_sensor = model.sensor;
+    if (stored_null) {
+      reference_sensor = {};
+      reference_sensor.clips = model.sensor.clips;
+    }
+    ao.reference_sensor = &reference_sensor;
+    fo.reference_sensor = &reference_sensor;
 
     // Rounds: each analyses `current` and fixes when asked; the loop ends at
     // the first round that confirms nothing. `current` after a confirmed round
@@ -412,7 +421,9 @@ int run_residual(int argc, char** argv) {
       if (round == 1) first_json = j;
       else rounds_json.push_back(j);
       if (!fixed || !fixed->changed) break;
-      const bool untuned = fixed->augmentation->carried_before_tuning();
+      // Without a control the next round's reference is its own input model:
+      // it must be the fine-tuned one (else fine-tuning alone would count as the fix's gain).
+      const bool untuned = fo.control && fixed->augmentation->carried_before_tuning();
       current = untuned ? fixed->untuned : fixed->model;
       current_what = untuned ? "the change of round " + std::to_string(round) +
                                    " on the network before its fine-tuning (the change alone carries the effect)"

@@ -534,7 +534,9 @@ HadynetModel model_from_safetensors(const st::File& file, const std::string& ori
       model.sensor = sensor_from_json(parse_metadata_json(file, "sensor", origin), origin);
     if (!model.sensor.curves.empty() && !curves_allowed)
       fail(origin, "the sensor model has calibration curves, which need format_version " +
-                       std::to_string(kModelFormatVersionCurves) + " (the file says " + version->second + ")");
+                       std::to_string(kModelFormatVersionCurves) + " (the file says " +
+                       std::to_string(kModelFormatVersion) +
+                       "; builds before the version existed wrote curves as 1: run its --fix again)");
 
     if (file.metadata.count("held_out_logs") != 0) {
       model.held_out_logs = held_out_logs_from(file, parse_metadata_json(file, "held_out_logs", origin), origin);

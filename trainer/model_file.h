@@ -20,8 +20,8 @@ inline constexpr const char* kModelFormat = "hadynet-model";
 // Format versions. 1: a model without calibration curves; 2: a model whose
 // sensor model has calibration curves (a build that reads version 1 only
 // would load such a file without its curves and predict wrongly, so it must
-// refuse it). A file is written with the lowest version that holds its model
-// (model_format_version()); this build reads both.
+// refuse it). A file is written with the lowest version that holds its
+// model; this build reads both.
 inline constexpr int kModelFormatVersion = 1;
 inline constexpr int kModelFormatVersionCurves = 2;
 

@@ -56,7 +56,10 @@ r2 = rounds[0]
 if not r2["verdict"].startswith("drift-load: drift on fc"):
     fail(f"round 2 should name the load drift on a loadcell: {r2['verdict']}")
 import re
-rate = float(re.search(r"rate ([0-9.eE+-]+)", r2["verdict"]).group(1))
+m = re.search(r"rate ([0-9.eE+-]+)", r2["verdict"])
+if not m:
+    fail(f"round 2's verdict names no drift rate: {r2['verdict']}")
+rate = abs(float(m.group(1)))
 if rate < 0.3 * 0.02:
     fail(f"round 2 reads the drift at rate {rate:g}, below 0.3 x the plant's 0.02: absorbed by round 1's fine-tuning?")
 if "before fine-tuning" not in r2["model"]:

@@ -22,9 +22,11 @@
 #include "codegen/codegen.h"
 #include "datalog/log_reader.h"
 #include "test/residual/fix_margins.h"
+#include "test/trainer/test_batches.h"
 #include "test/residual/plant_logs.h"
 #include "trainer/residual/rated_ranges.h"
 #include "trainer/model_file.h"
+#include "trainer/model_frame.h"
 #include "trainer/residual/augment.h"
 #include "trainer/residual/analysis.h"
 #include "trainer/residual/residuals.h"
@@ -252,6 +254,60 @@ TEST(ResidualFix, FrictionGetsDerivedCommandInputsAndCutsTheTendonsError) {
   expect_cut(r.fix, c, fm::kFriction.winner_vs_before, fm::kFriction.winner_vs_control);
   for (const auto& ch : a.channels) expect_cut(r.fix, ch, fm::kFriction.family_vs_before);
   expect_deployable(m);
+}
+
+// `hadynet residual --rounds` analyses the next round with the confirmed
+// change on the network before fine-tuning (FixResult::untuned). Its
+// contract: fine-tuned as fix() fine-tunes the next round's control (its
+// training rows in its own frame, the default options), it is the last
+// round's fixed model again, bit for bit, so the next round's decision asks
+// whether a second change beats the first round's model.
+TEST(ResidualFix, TheUntunedChangeFineTunedIsTheFixedModel) {
+  const std::vector<LogInput> logs = plant_logs("sensor-delay");
+  const FixRun first = run_fix(logs, "sensor-delay, round 1");
+  ASSERT_TRUE(fixed_as(first, EffectKind::kSensorDelay));
+  trainer::HadynetModel control = first.fix.untuned;
+  const FixOptions defaults;
+  std::vector<trainer::LogSequence> seqs;
+  std::vector<Eigen::VectorXf> pbs;
+  for (const auto& l : logs) {
+    // fix()'s split: the first train_fraction of the rows, less the delay's rows in the aligned frame.
+    const int T = static_cast<int>(l.table.rows());
+    const int split = std::max(static_cast<int>(std::floor(defaults.train_fraction * T)), control.sensor.max_delay() + 2);
+    trainer::LogSequence s = trainer::in_model_frame(control.sensor, control.layout, l.table, l.file).sequence;
+    const int keep = split - control.sensor.max_delay();
+    s.y = s.y.leftCols(keep).eval();
+    s.u = s.u.leftCols(keep).eval();
+    pbs.push_back(control.params.pb.row(control.state_index(s.state)).transpose());
+    seqs.push_back(std::move(s));
+  }
+  const std::vector<int> rows = ensure_states(control, seqs, pbs);
+  long windows = 0;
+  fine_tune(control, seqs, rows, {defaults.epochs, defaults.batch, defaults.lr, defaults.seed}, &windows);
+  EXPECT_TRUE(trainer::testing::bit_identical(control.params, first.fix.model.params));
+  EXPECT_FALSE(trainer::testing::bit_identical(first.fix.untuned.params, first.fix.model.params));
+}
+
+// The null is read through the sensors it was recorded with
+// (AnalysisOptions::reference_sensor): a model with a sensor delay, analysed
+// with the build model's sensors for its reference, calibrates exactly the
+// build model's null; through its own delay, the clean reference reads
+// differently (so the comparison can fail).
+TEST(ResidualFix, TheNullIsReadThroughTheReferenceSensors) {
+  const trainer::HadynetModel& base = build_model();
+  trainer::HadynetModel delayed = base;
+  for (const auto& y : base.layout.y_names)
+    if (y.rfind("fc", 0) == 0) delayed.sensor.delays.push_back({y, 2});
+  const std::vector<LogInput> logs = plant_logs("sensor-delay");
+  AnalysisOptions ao;
+  ao.reference_pb_choice = "state";
+  const Analysis plain = analyse(base, logs, ao, stored_null());
+  const Analysis own = analyse(delayed, logs, ao, stored_null());
+  ao.reference_sensor = &base.sensor;
+  const Analysis through_base = analyse(delayed, logs, ao, stored_null());
+  ASSERT_TRUE(plain.attribution.null && own.attribution.null && through_base.attribution.null);
+  EXPECT_EQ(through_base.attribution.null->residual_level, plain.attribution.null->residual_level);
+  EXPECT_NE(own.attribution.null->residual_level, plain.attribution.null->residual_level);
 }
 
 TEST(ResidualFix, InputDelayGetsTheLaggedCommandsAndCutsTheDelayedChannelsError) {

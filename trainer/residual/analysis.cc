@@ -38,15 +38,19 @@ Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, c
     a.attribution = attribute(d, hypotheses, options.attribution);
   } else {
     const std::string& ref_pb = options.reference_pb_choice.empty() ? options.pb_choice : options.reference_pb_choice;
-    HadynetModel null_model = model;
-    if (options.reference_sensor != nullptr) null_model.sensor = *options.reference_sensor;
-    const ResidualData ref = compute_residuals(null_model, reference, ref_pb);
+    const ResidualData ref = compute_residuals(with_reference_sensor(model, options.reference_sensor), reference, ref_pb);
     a.reference_pb = pb_summary(ref, ref_pb);
     const NullCalibration null = calibrate_null(d, ref, hypotheses, options.attribution);
     a.attribution = attribute(d, hypotheses, options.attribution, &null);
   }
   a.verdict = verdict_text(a.attribution);
   return a;
+}
+
+HadynetModel with_reference_sensor(const HadynetModel& model, const SensorModel* reference_sensor) {
+  HadynetModel m = model;
+  if (reference_sensor != nullptr) m.sensor = *reference_sensor;
+  return m;
 }
 
 std::string floors_summary(const Analysis& a) {

@@ -62,6 +62,10 @@ struct Analysis {
 Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, const AnalysisOptions& options,
                  const std::vector<LogInput>& reference = {});
 
+// `model` with the sensor model of the reference logs (nullptr: its own):
+// the model that computes the null's residuals (AnalysisOptions::reference_sensor).
+HadynetModel with_reference_sensor(const HadynetModel& model, const SensorModel* reference_sensor);
+
 // What the floors of an analysis were, in words: the calibrated null (logs,
 // PBs) or the absolute floors assumed without one.
 std::string floors_summary(const Analysis& analysis);

@@ -233,8 +233,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     // The augmented layout first (aux adds a channel, friction commands), then its training data.
     const auto seqs = training_rows(sensor, layout, cut);
     t.model = a != nullptr ? augmented_model(model, *a, seqs) : model;
-    if (untuned != nullptr) *untuned = t.model;
     const auto rows = ensure_states(t.model, seqs, before_pbs);
+    if (untuned != nullptr) *untuned = t.model;
     t.loss_history = fine_tune(t.model, seqs, rows, tuning, &t.train_windows);
     t.model.check_consistent();
     return t;
@@ -329,9 +329,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   library_after.sensor_curves = options.reference != nullptr && !options.reference->empty();
   const std::vector<Hypothesis> hypotheses_after = enumerate_hypotheses(again, library_after);
   if (options.reference != nullptr && !options.reference->empty()) {
-    HadynetModel null_model = after.model;
-    if (options.reference_sensor != nullptr) null_model.sensor = *options.reference_sensor;
-    ResidualData ref = compute_residuals(null_model, *options.reference, options.reference_pb_choice);
+    ResidualData ref = compute_residuals(with_reference_sensor(after.model, options.reference_sensor),
+                                         *options.reference, options.reference_pb_choice);
     drop_predicted_aux(ref);
     const NullCalibration null = calibrate_null(again, ref, hypotheses_after, attribution.options);
     result.after.verdict = verdict_text(attribute(again, hypotheses_after, attribution.options, &null));

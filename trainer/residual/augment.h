@@ -89,10 +89,11 @@ struct ModelChange {
   // fix(), before fine-tuning: re-estimates the change's parameters on the
   // training rows; appends what the attribution had fitted to `fitted`.
   void refine(Augmentation&, const SensorModel&, const TrainingRmse&, std::vector<double>&) {}
-  // Whether the change alone, on the network before fine-tuning, already
-  // describes the effect (Augmentation::carried_before_tuning): the sensor
-  // model's changes do; new inputs or outputs that start at zero weight do not.
-  bool carried_before_tuning() const { return true; }
+  // Every alternative declares carried_before_tuning(): whether the change
+  // alone, on the network before fine-tuning, already describes the effect
+  // (Augmentation::carried_before_tuning). The sensor model's changes do; new
+  // inputs or outputs that start at zero weight do not. No default: a new
+  // alternative must say.
 };
 
 // sensor-delay: time alignment of Augmentation::channels (the winner's family
@@ -102,6 +103,7 @@ struct ModelChange {
 struct TimeAlignment : ModelChange {
   int delay = 0;  // steps
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;
+  bool carried_before_tuning() const { return true; }
 };
 
 // crosstalk: removal of the winner's pair: the target picks up `gain` times
@@ -110,6 +112,7 @@ struct TimeAlignment : ModelChange {
 struct CrosstalkRemoval : ModelChange {
   SensorCrosstalk pair;  // target, source, gain (target units per source unit)
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;
+  bool carried_before_tuning() const { return true; }
 };
 
 // drift-load, drift-time: a bias state b_c(t) = rate * D_c(t) per family
@@ -123,6 +126,7 @@ struct BiasState : ModelChange {
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;
   void refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
               std::vector<double>& fitted);
+  bool carried_before_tuning() const { return true; }  // refine() fitted it
 };
 
 // saturation: clipping: each family channel's prediction passes through
@@ -132,6 +136,7 @@ struct BiasState : ModelChange {
 struct OutputClips : ModelChange {
   std::vector<OutputClip> clips;  // one per channel
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;
+  bool carried_before_tuning() const { return true; }
 };
 
 // sensor-curve: a static calibration curve per family channel: the logs are
@@ -142,6 +147,7 @@ struct CalibrationCurves : ModelChange {
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;
   void refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
               std::vector<double>& fitted);
+  bool carried_before_tuning() const { return true; }  // refine() fitted it
 };
 
 // friction: a hysteresis state as an input: for every muscle m of the
@@ -206,7 +212,8 @@ std::string why_not_fixable(const ResidualData& data, const Attribution& attribu
 // family: the effect's plan, effects.cc) of the significant hypotheses in
 // ranking order that --fix can add (why_not_fixable), the best of each
 // effect, at most `count`; a plan that finds nothing to add (it sets
-// not_fixable) is skipped like an unfixable hypothesis. When the winner cannot be added, the first
+// not_fixable) is skipped like an unfixable hypothesis. When the winner
+// cannot be added, the first
 // candidate's description says why; when no significant hypothesis can, the
 // winner's alone with Augmentation::not_fixable set (fix() then reports
 // "not supported"). Empty without a winner.
@@ -264,9 +271,10 @@ struct FixResult {
   bool changed = false;        // confirmed: a new model was produced
   HadynetModel model;          // the augmented, fine-tuned model (the input model if !changed)
   // The chosen augmentation on the input model's network before fine-tuning
-  // (augmented_model()); valid if tried. Fine-tuning it as fix() does gives
+  // (augmented_model(), with a PB row for every state of the logs:
+  // ensure_states()); valid if tried. Fine-tuning it as fix() does gives
   // `model` again, so a round that starts from it has the last round's model
-  // as its control.
+  // as its control (tested: ResidualFix.TheUntunedChangeFineTunedIsTheFixedModel).
   HadynetModel untuned;
   HeldOutError before, after;  // after: the augmented model (valid if tried)
   std::vector<std::string> confirmation_channels;  // where the effect was found (the test's channels)

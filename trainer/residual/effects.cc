@@ -316,13 +316,6 @@ void DerivedCommandInputs::add_to_channels(std::vector<std::string>&, std::vecto
 // zero instead left the undelayed weights in place after fine-tuning, and
 // the stabiliser then planned with a command effect the plant does not
 // have: docs/residual.md, "Input dead time".)
-bool DerivedCommandInputs::carried_before_tuning() const {
-  return std::all_of(inputs.begin(), inputs.end(), [](const std::string& name) {
-    const auto d = parse_derived_input(name);
-    return d && d->kind == DerivedKind::kLag;
-  });
-}
-
 void DerivedCommandInputs::add_to_network(const Augmentation& a, const HadynetModel& before, HadynetModel& m,
                                       const std::vector<LogSequence>& train_seqs) const {
   m.layout = augmented_layout(before.layout, a);
@@ -358,6 +351,15 @@ void DerivedCommandInputs::add_to_network(const Augmentation& a, const HadynetMo
   p.lstm_weight_ih = ih;
   p.dims.u += static_cast<int>(k);
   p.check_shapes();
+}
+
+// Only lag inputs of the model's own commands start with weights (above); an
+// empty change carries nothing.
+bool DerivedCommandInputs::carried_before_tuning() const {
+  return !inputs.empty() && std::all_of(inputs.begin(), inputs.end(), [](const std::string& name) {
+    const auto d = parse_derived_input(name);
+    return d && d->kind == DerivedKind::kLag && !parse_derived_input(d->base);
+  });
 }
 
 namespace {
@@ -600,9 +602,9 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
 
 // The knots of a channel's curve: 9 quantiles (0, 1/8, .., 1) of its values
 // in the first half of each log (inside the fix's training rows, the first
-// 60 %); a quantile within 1e-4 of the values' range above the last knot is
-// dropped (equal once rounded to float, codegen would refuse the model);
-// fewer than 2 knots: none.
+// 60 %); a quantile within 1e-4 of the values' range above the last knot,
+// or equal to it once rounded to float (codegen would refuse the model), is
+// dropped; fewer than 2 knots: none.
 std::vector<double> knot_levels(const ResidualData& data, int c) {
   const std::vector<double> v = sorted_values(data, c, true);
   std::vector<double> knots;
@@ -610,7 +612,8 @@ std::vector<double> knot_levels(const ResidualData& data, int c) {
   const double min_gap = 1e-4 * (v.back() - v.front());
   for (int k = 0; k <= 8; ++k) {
     const double q = lower_quantile(v, k / 8.0);
-    if (knots.empty() || q > knots.back() + min_gap) knots.push_back(q);
+    if (knots.empty() || (q > knots.back() + min_gap && static_cast<float>(q) > static_cast<float>(knots.back())))
+      knots.push_back(q);
   }
   if (knots.size() < 2) knots.clear();
   return knots;
