@@ -1,7 +1,8 @@
 // Writes the seed corpus of model_fuzzer (fuzz/corpus/model): small model
 // files that exercise every part of the reader: a model with detection
 // statistics, value ranges, a sensor model (delay, cross-talk, drift,
-// clip) and held-out logs, and a bare one. Small (a few KiB) so that the fuzzer mutates them
+// calibration curve: format_version 2, clip) and held-out logs, and a bare
+// one (format_version 1). Small (a few KiB) so that the fuzzer mutates them
 // thousands of times per second; the hand's 0.36 MiB model is read by the
 // reader's unit tests.
 //   make_model_corpus OUT_DIR
@@ -57,6 +58,7 @@ int main(int argc, char** argv) {
   full.sensor.delays.push_back({"v0", 2});
   full.sensor.crosstalk.push_back({"q1", "q0", 0.25});
   full.sensor.drifts.push_back({"q0", true, 0.01});
+  full.sensor.curves.push_back({"q0", {0.0, 1.0, 4.0}, {0.0, 1.5, 3.5}});  // format_version 2
   full.sensor.clips.push_back({"q1", 1, 3.0});
   full.sensor.period_s = 0.2;
   full.held_out_logs = {{"seed.csv rows 8..11", "# format: hadynet-log\n# format_version: 1\n# dt_s: 0.2\nt,q0,q1,v0,u0\n"
