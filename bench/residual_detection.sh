@@ -27,7 +27,10 @@
 # Static calibration curve (sensor-curve, its fix added): seeds 1, 521-522,
 # 531-540 and 581-590 development (the slope bounds of its fit were chosen
 # on 531-540, the plan's restriction to the winner's group on 581-590),
-# 591-600 measured.
+# 591-600 measured. Stop 37: 681-690 measured with 300-row and with
+# 600-row logs (RESIDUAL_ROWS=600), then used to choose the curve's
+# plausibility (end slopes >= 1/4); 711-720 measured with and without that
+# rule (the same logs, two binaries).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...

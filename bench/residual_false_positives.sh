@@ -32,7 +32,11 @@
 # development (run before the plan took the winner's group only), 601-620
 # measured, with and without --candidates 3 (seeds 521-522, 531-540 and
 # 581-590 were its development, 591-600 its detection, 561-580 and 621-630
-# the unknown-effect runs).
+# the unknown-effect runs). Stop 37: 661-680 measured with 600-row logs
+# (RESIDUAL_ROWS=600); 721-740 measured with the curve's plausibility at
+# slopes >= 1/4 (chosen on the detection seeds 681-690); 631-650 and
+# 691-695 belong to bench/residual_two_effects.sh, 681-690 and 711-720 to
+# bench/residual_detection.sh.
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
