@@ -11,8 +11,8 @@
 # Seeds: 511-515 were run by hand before this script (docs/residual.md,
 # "Rounds"); 631 development of the rounds' analysis model (the change
 # before fine-tuning); 641-645 measured, with the binary before and after
-# that change; 691-695 measured with RESIDUAL_ROWS=600 (used for nothing
-# else).
+# that change; 691-695 measured with RESIDUAL_ROWS=600; 751-755 measured
+# with the final binary of stop 37 (used for nothing else).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]...

@@ -19,7 +19,8 @@
 # sources of the target's unit: 391-400 (measured again, unchanged, after
 # input delays became fixable; nothing was chosen on them); with
 # sensor-curve in the library: 561-570. Seeds (gain-wobble): 571-580 (before
-# the curve's plan took the winner's group only), 621-630.
+# the curve's plan took the winner's group only), 621-630, 741-750 (after
+# the curve's plausibility bound and the rounds' changes of stop 37).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve]
