@@ -30,7 +30,8 @@
 # 591-600 measured. Stop 37: 681-690 measured with 300-row and with
 # 600-row logs (RESIDUAL_ROWS=600), then used to choose the curve's
 # plausibility (end slopes >= 1/4); 711-720 measured with and without that
-# rule (the same logs, two binaries).
+# rule (the same logs, two binaries); 761-770 every effect at its larger
+# strength with the final code of stop 37.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...
