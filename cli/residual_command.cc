@@ -220,8 +220,8 @@ int run_residual(int argc, char** argv) {
             "with --fix: repeat analysis and fix until nothing is confirmed, at most N rounds (so that two\n"
             "effects at once are both found); the next round analyses the confirmed change on the network\n"
             "before fine-tuning when the change alone describes the effect (sensor changes, an input dead\n"
-            "time), else the fine-tuned model; the reference logs keep the input model's sensors; round\n"
-            "k > 1 reports into DIR/round-k", "1");
+            "time), else the fine-tuned model; the reference logs are read through the sensors they were\n"
+            "recorded with in every round; round k > 1 reports into DIR/round-k", "1");
   opt.value("out", "FILE", "with --fix: write the augmented model of the last confirmed round (only when\n"
                            "something was fixed)");
   opt.value("fix-epochs", "N", "with --fix: fine-tuning epochs", "20");
@@ -365,9 +365,10 @@ int run_residual(int argc, char** argv) {
     // is its change on the network before fine-tuning when the change alone
     // carries its effect (Augmentation::carried_before_tuning: fine-tuning on
     // these logs would absorb part of a second effect before it is looked
-    // for), else the fine-tuned model. Round 1 reports into --report DIR and --json FILE; round k > 1
-    // into DIR/round-k and the JSON's "rounds". --out holds the last
-    // confirmed round's model, which carries every earlier round's change.
+    // for), else the fine-tuned model. Round 1 reports into --report DIR and
+    // --json FILE; round k > 1 into DIR/round-k and the JSON's "rounds". --out
+    // holds the last confirmed round's model, which carries every earlier
+    // round's change.
     json rounds_json = json::array();
     auto write_json = [](const json& j, const std::string& path) {
       std::ofstream out(path);

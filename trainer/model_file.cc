@@ -391,11 +391,11 @@ HadynetModel model_from_safetensors(const st::File& file, const std::string& ori
     fail(origin, std::string("not a HADYNET model (metadata 'format' must be '") + kModelFormat +
                      "')");
   }
-  const auto version = file.metadata.find("format_version");
-  const bool curves_allowed = version != file.metadata.end() && version->second == std::to_string(kModelFormatVersionCurves);
-  if (!curves_allowed && (version == file.metadata.end() || version->second != std::to_string(kModelFormatVersion))) {
-    fail(origin, "unsupported model format_version '" +
-                     (version == file.metadata.end() ? std::string() : version->second) + "'; this build reads versions " +
+  const auto version_it = file.metadata.find("format_version");
+  const std::string version = version_it == file.metadata.end() ? std::string() : version_it->second;
+  const bool curves_allowed = version == std::to_string(kModelFormatVersionCurves);
+  if (!curves_allowed && version != std::to_string(kModelFormatVersion)) {
+    fail(origin, "unsupported model format_version '" + version + "'; this build reads versions " +
                      std::to_string(kModelFormatVersion) + " and " + std::to_string(kModelFormatVersionCurves));
   }
   HadynetModel model;

@@ -33,8 +33,9 @@ struct AnalysisOptions {
   // The sensor model the reference logs were recorded through, when it is
   // not the model's: a --rounds round analyses a model whose sensor model
   // holds the changes earlier rounds confirmed on the logs under test, which
-  // the clean reference logs do not show (their sensors are the input
-  // model's). nullptr: the model's own.
+  // the clean reference logs do not show (`hadynet residual`: the stored
+  // held-out logs' sensors are the training logs', no sensor model but the
+  // clips; --reference logs', the input model's). nullptr: the model's own.
   const SensorModel* reference_sensor = nullptr;
 };
 

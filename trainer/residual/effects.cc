@@ -592,9 +592,8 @@ double slope_top(const Eigen::VectorXd& coef) { return 1 + coef(0) + coef(2); }
 // The main parameter: the ratio of the slopes, top / bottom (< 1: the curve
 // flattens with the level, a compressive sensor; > 1: it steepens).
 double slope_ratio(const Eigen::VectorXd& coef) { return slope_top(coef) / slope_bottom(coef); }
-// A segment slope of a fitted curve stays within 1/4..4 of the identity's
-// (CalibrationCurves::refine: beyond, its search fitted the noise of a
-// loadcell at rest).
+// The bounds of a fitted curve's segment slopes, relative to the identity's
+// (CalibrationCurves::refine says why).
 constexpr double kMinSlope = 0.25, kMaxSlope = 4.0;
 
 // A calibration curve is increasing over the range, and no flatter than a
@@ -718,9 +717,9 @@ void CalibrationCurves::add_to_sensor(SensorModel& s, const Augmentation&) const
 void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
                                std::vector<double>&) {
   static constexpr double kFactors[] = {0.5, 0.7, 0.85, 0.93, 1 / 0.93, 1 / 0.85, 1 / 0.7, 2.0};
-  // A segment's slope stays within 1/4..4 of the identity's: beyond, the
-  // search fitted the noise of a loadcell at rest (slopes of 1/64 on seed-1
-  // development logs) without a better fit on fresh ones.
+  // A segment's slope stays within kMinSlope..kMaxSlope of the identity's:
+  // beyond, the search fitted the noise of a loadcell at rest (slopes of
+  // 1/64 on seed-1 development logs) without a better fit on fresh ones.
   using sensor_curve::kMaxSlope, sensor_curve::kMinSlope;
   Eigen::ArrayXd rmse_before = training_rmse.all(before).array().max(1e-12);
   for (SensorCurve& curve : curves) {
