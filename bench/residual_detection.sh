@@ -31,11 +31,14 @@
 # 600-row logs (RESIDUAL_ROWS=600), then used to choose the curve's
 # plausibility (end slopes >= 1/4); 711-720 measured with and without that
 # rule (the same logs, two binaries); 761-770 every effect at its larger
-# strength with the final code of stop 37.
+# strength with the final code of stop 37. Stop 38: 771-775 development of
+# the candidates' selection (--candidates 1, 3 and 5, the rule among them),
+# 781-790 every effect at its larger strength measured with --candidates 1
+# and 5 (the same logs; nothing was chosen on them).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...
-#   defaults: models/hand.safetensors, build/residual-detection, 10, 231, --candidates 1, every case
+#   defaults: models/hand.safetensors, build/residual-detection, 10, 231, the tool's --candidates (5), every case
 #   (--case: only those; repeatable), the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
 # Environment: HADYNET (default build/release/cli/hadynet).

@@ -36,7 +36,9 @@
 # (RESIDUAL_ROWS=600); 721-740 measured with the curve's plausibility at
 # slopes >= 1/4 (chosen on the detection seeds 681-690); 631-650 and
 # 691-695 belong to bench/residual_two_effects.sh, 681-690 and 711-720 to
-# bench/residual_detection.sh.
+# bench/residual_detection.sh. Stop 38: 791-810 measured with five
+# candidates (the new default; 771-790 and 811-825 belong to the detection,
+# unknown-effect and two-effect benches).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

@@ -20,7 +20,8 @@
 # input delays became fixable; nothing was chosen on them); with
 # sensor-curve in the library: 561-570. Seeds (gain-wobble): 571-580 (before
 # the curve's plan took the winner's group only), 621-630, 741-750 (after
-# the curve's plausibility bound and the rounds' changes of stop 37).
+# the curve's plausibility bound and the rounds' changes of stop 37),
+# 811-820 (stop 38: --candidates 1 and 5, the same logs).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve]

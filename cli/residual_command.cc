@@ -148,11 +148,12 @@ void print_fix(const rs::FixResult& fixed) {
     std::printf(": Diebold-Mariano p %.2g: %s\n", fixed.confirmation.p_value,
                 fixed.changed ? "confirmed" : "not confirmed, nothing applied");
     if (fixed.candidates.size() > 1) {
-      std::printf("candidates (the screen's order; * the one tested: the first whose gain over fine-tuning alone on\n"
-                  "the training rows' last 25 %% is significant, else the screen's first):\n");
+      std::printf("candidates (the screen's order; * the one tested: the first whose gain over fine-tuning alone\n"
+                  "on the training rows' last 25 %% is significant, else the clearest gain, else the screen's first):\n");
       for (const auto& c : fixed.candidates) {
         std::printf("  %c %-74.74s", c.chosen ? '*' : ' ', (c.effect + ": " + c.description).c_str());
-        if (c.selected_by_training_rows) std::printf(" training rows: p %.2g\n", c.selection.p_value);
+        if (c.selected_by_training_rows)
+          std::printf(" training rows: DM %.2f, p %.2g\n", c.selection.stat, c.selection.p_value);
         else std::printf(" not judged\n");
       }
     }
@@ -227,10 +228,10 @@ int run_residual(int argc, char** argv) {
   opt.value("fix-epochs", "N", "with --fix: fine-tuning epochs", "20");
   opt.value("fix-lr", "X", "with --fix: Adam learning rate", "0.001");
   opt.value("fix-seed", "N", "with --fix: seed of the window order", "1");
-  opt.value("candidates", "K", "with --fix: how many of the screen's candidates may be tried: in its order, each added,\n"
-                              "fine-tuned on the first 75 % of the training rows and compared with fine-tuning alone\n"
-                              "on the rest; the first significant there (else the screen's first) is the one the\n"
-                              "decision tests on the held-out rows (1: the screen's winner)", "1");
+  opt.value("candidates", "K", "with --fix: how many of the screen's candidates may be tried (the best of each effect):\n"
+                              "each added, fine-tuned on the first 75 % of the training rows and compared with\n"
+                              "fine-tuning alone on the rest; the first significant there, else the clearest gain, is\n"
+                              "the one the decision tests on the held-out rows (1: the screen's winner)", "5");
   opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
                         "unchanged model, a weaker guard)");
   if (!opt.parse(argc, argv)) return 2;

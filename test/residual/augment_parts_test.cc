@@ -1,8 +1,9 @@
 // The parts --fix builds on (docs/residual.md, "--fix"), against hand-computed
 // answers: derived command channels, output clips (physical and on the
 // training loss), and the sensor model's frame transforms (alignment,
-// cross-talk and drift removal, calibration curves). All exact: integer-valued or closed-form cases,
-// tolerance 1e-12.
+// cross-talk and drift removal, calibration curves), and which candidate the
+// decision tests. All exact: integer-valued or closed-form cases, tolerance
+// 1e-12.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 #include "trainer/derived_inputs.h"
 #include "trainer/log_dataset.h"
 #include "trainer/output_clip.h"
+#include "trainer/residual/augment.h"
 #include "trainer/sensor_model.h"
 
 namespace hadynet::test {
@@ -231,6 +233,35 @@ TEST(SensorFrame, ACalibrationCurveAndItsInverse) {
       EXPECT_NE(std::string(e.what()).find("fc0"), std::string::npos) << e.what();
     }
   }
+}
+
+// Which candidate the decision tests: the first, in the screen's order,
+// whose gain over fine-tuning alone on the selection's rows is significant;
+// else the clearest gain (the largest positive Diebold-Mariano statistic),
+// not the screen's first, which on fresh logs is often the model's own
+// misfit (docs/residual.md, "Detection on fresh logs"); not judged or no
+// gain: the screen's first.
+TEST(FixCandidates, TheFirstSignificantElseTheClearestGainIsTested) {
+  auto trial = [](double stat, bool judged = true) {
+    residual::CandidateTrial c;
+    c.selection.mean = stat / 100;  // the sign of the statistic
+    c.selection.stat = stat;
+    c.selection.p_value = 0.5 * std::erfc(stat / std::sqrt(2.0));  // one-sided normal
+    c.selected_by_training_rows = judged;
+    return c;
+  };
+  const auto chosen = [](const std::vector<residual::CandidateTrial>& c) { return residual::chosen_candidate(c, 0.01); };
+  // The first significant at 0.01 (statistic 2.6, p 0.0047) before a clearer later one.
+  EXPECT_EQ(chosen({trial(-1.0), trial(2.6), trial(3.5)}), 1u);
+  // None significant: the clearest gain, wherever it is.
+  EXPECT_EQ(chosen({trial(1.2), trial(2.0), trial(-3.0)}), 1u);
+  EXPECT_EQ(chosen({trial(-1.0), trial(0.4)}), 1u);
+  // Nothing gains: the screen's first.
+  EXPECT_EQ(chosen({trial(-1.0), trial(-4.0)}), 0u);
+  EXPECT_EQ(chosen({trial(0), trial(0)}), 0u);
+  // Candidates that were not judged (logs too short for the selection) are not chosen.
+  EXPECT_EQ(chosen({trial(0.0, false), trial(5.0, false)}), 0u);
+  EXPECT_EQ(chosen({}), 0u);
 }
 
 }  // namespace

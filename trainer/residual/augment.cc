@@ -36,6 +36,34 @@ Segments standardised_loss(const HadynetModel& model, const HeldOutError& e, con
   return out;
 }
 
+// Training data: raw rows [0, cut[i]) of each log in the measured frame; a
+// frame aligned by a delay of s rows holds them in rows [0, cut[i] - s).
+std::vector<LogSequence> training_rows(const std::vector<LogInput>& logs, const SensorModel& sensor,
+                                       const FeatureLayout& layout, const std::vector<int>& cut) {
+  std::vector<LogSequence> seqs;
+  for (std::size_t i = 0; i < logs.size(); ++i) {
+    LogSequence s = in_model_frame(sensor, layout, logs[i].table, logs[i].file).sequence;
+    const int keep = cut[i] - sensor.max_delay();
+    s.y = s.y.leftCols(keep).eval();
+    s.u = s.u.leftCols(keep).eval();
+    seqs.push_back(std::move(s));
+  }
+  return seqs;
+}
+
+// The first held-out row of each log: the first train_fraction of its rows
+// are training rows, and at least d + 2 (d: the rows a sensor delay costs).
+std::vector<int> held_out_starts(const std::vector<LogInput>& logs, double train_fraction, int d) {
+  std::vector<int> split;
+  for (const auto& in : logs) {
+    const int T = static_cast<int>(in.table.rows());
+    const int first = std::max(static_cast<int>(std::floor(train_fraction * T)), d + 2);
+    if (first >= T - d) throw std::runtime_error(in.file + ": too short for --fix's time split");
+    split.push_back(first);
+  }
+  return split;
+}
+
 }  // namespace
 
 std::string why_not_fixable(const ResidualData& data, const Attribution& attribution, const HypothesisResult& r) {
@@ -48,6 +76,23 @@ double TrainingRmse::operator()(const SensorModel& sensor, const std::string& ch
   const auto it = std::find(y_names.begin(), y_names.end(), channel);
   if (it == y_names.end()) throw std::logic_error("--fix: refine probes " + channel + ", not a y channel");
   return all(sensor)(it - y_names.begin());
+}
+
+std::size_t chosen_candidate(const std::vector<CandidateTrial>& candidates, double alpha) {
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    const DieboldMariano& s = candidates[k].selection;
+    if (candidates[k].selected_by_training_rows && s.mean > 0 && s.p_value < alpha) return k;
+  }
+  std::size_t chosen = 0;
+  double best = 0;
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    const DieboldMariano& s = candidates[k].selection;
+    if (candidates[k].selected_by_training_rows && s.mean > 0 && s.stat > best) {
+      best = s.stat;
+      chosen = k;
+    }
+  }
+  return chosen;
 }
 
 std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attribution& attribution, int count) {
@@ -141,13 +186,10 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // kSelectionFraction trains, rows [inner, split - d) judge.
   constexpr double kSelectionFraction = 0.75;
   constexpr int kMinSelectionRows = 20;
-  std::vector<int> split, inner;
+  const std::vector<int> split = held_out_starts(logs, options.train_fraction, d);
+  std::vector<int> inner;
   bool can_select = true;
-  for (const auto& in : logs) {
-    const int T = static_cast<int>(in.table.rows());
-    const int first = std::max(static_cast<int>(std::floor(options.train_fraction * T)), d + 2);
-    if (first >= T - d) throw std::runtime_error(in.file + ": too short for --fix's time split");
-    split.push_back(first);
+  for (const int first : split) {
     inner.push_back(static_cast<int>(std::floor(kSelectionFraction * first)));
     if (inner.back() < d + 2 + kMinSelectionRows || first - d - inner.back() < kMinSelectionRows) can_select = false;
   }
@@ -191,35 +233,28 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     return result;
   }
 
-  // What an augmentation re-estimates on the training rows before
-  // fine-tuning (drift: the rates), probing the unchanged network with a
-  // sensor model.
+  // What an augmentation re-estimates before fine-tuning (drift: the rates;
+  // curve: the slopes), probing the unchanged network with a sensor model on
+  // the rows before cut[i] of each log: the rows its fine-tuning will see.
   HadynetModel probe = model;
-  TrainingRmse training_rmse;
-  training_rmse.y_names = model.layout.y_names;
-  training_rmse.all = [&](const SensorModel& sensor) {
-    probe.sensor = sensor;
-    std::vector<HeldOutLog> train = eval_logs(probe, before_pbs);
-    for (std::size_t i = 0; i < train.size(); ++i) {
-      train[i].end = train[i].first;
-      train[i].first = ResidualLog::kFirstRow + d;
-    }
-    return Eigen::VectorXd(held_out_error(probe, train).rmse);
+  auto refined = [&](Augmentation a, const std::vector<int>& cut, std::vector<double>* fitted) {
+    TrainingRmse training_rmse;
+    training_rmse.y_names = model.layout.y_names;
+    training_rmse.all = [&](const SensorModel& sensor) {
+      probe.sensor = sensor;
+      std::vector<HeldOutLog> train = eval_logs(probe, before_pbs);
+      for (std::size_t i = 0; i < train.size(); ++i) {
+        train[i].first = ResidualLog::kFirstRow + d;
+        train[i].end = cut[i];
+      }
+      return Eigen::VectorXd(held_out_error(probe, train).rmse);
+    };
+    std::vector<double> rates;
+    std::visit([&](auto& change) { change.refine(a, model.sensor, training_rmse, rates); }, a.change);
+    if (fitted != nullptr) *fitted = std::move(rates);
+    return a;
   };
 
-  // Training data: raw rows [0, cut[i]) in the measured frame; a frame
-  // aligned by a delay of s rows holds them in rows [0, cut[i] - s).
-  auto training_rows = [&](const SensorModel& sensor, const FeatureLayout& layout, const std::vector<int>& cut) {
-    std::vector<LogSequence> seqs;
-    for (std::size_t i = 0; i < logs.size(); ++i) {
-      LogSequence s = in_model_frame(sensor, layout, logs[i].table, logs[i].file).sequence;
-      const int keep = cut[i] - sensor.max_delay();
-      s.y = s.y.leftCols(keep).eval();
-      s.u = s.u.leftCols(keep).eval();
-      seqs.push_back(std::move(s));
-    }
-    return seqs;
-  };
   // A model fine-tuned on rows [0, cut) (the control: no augmentation).
   struct Tuned {
     HadynetModel model;
@@ -231,7 +266,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     const SensorModel sensor = a != nullptr ? sensor_after(model.sensor, *a) : model.sensor;
     const FeatureLayout layout = a != nullptr ? augmented_layout(model.layout, *a) : model.layout;
     // The augmented layout first (aux adds a channel, friction commands), then its training data.
-    const auto seqs = training_rows(sensor, layout, cut);
+    const auto seqs = training_rows(logs, sensor, layout, cut);
     t.model = a != nullptr ? augmented_model(model, *a, seqs) : model;
     const auto rows = ensure_states(t.model, seqs, before_pbs);
     if (untuned != nullptr) *untuned = t.model;
@@ -248,17 +283,12 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     return out;
   };
 
-  std::vector<std::vector<double>> fitted_rates(planned.size());
-  for (std::size_t k = 0; k < planned.size(); ++k)
-    std::visit([&](auto& change) { change.refine(planned[k], model.sensor, training_rmse, fitted_rates[k]); },
-               planned[k].change);
-
-  // Selection (several candidates), on the training rows alone: each
-  // candidate in the screen's order and the control are fine-tuned on the
-  // first 75 % of the training rows and compared on the rest; the first
-  // candidate whose gain there is significant at alpha (one-sided
-  // Diebold-Mariano) is chosen, else the screen's first. The held-out rows
-  // play no part, so the decision below tests one candidate at the full alpha.
+  // Selection (several candidates), on the training rows alone: in the
+  // screen's order, each candidate and the control are fine-tuned on the
+  // first 75 % of the training rows and compared on the rest (one-sided
+  // Diebold-Mariano); the first significant at alpha is chosen, else the
+  // clearest gain (chosen_candidate). The held-out rows play no part, so
+  // the decision below tests one candidate at the full alpha.
   std::size_t chosen = 0;
   for (std::size_t k = 0; k < planned.size(); ++k) {
     CandidateTrial c;
@@ -272,17 +302,17 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     const HeldOutError control_rows =
         held_out_error(control.model, eval_rows(control.model, state_pbs(control.model), inner, false));
     for (std::size_t k = 0; k < planned.size(); ++k) {
-      const Tuned t = tune(&planned[k], inner);
+      // Re-estimated on the selection's training rows alone (the rows it is judged on stay unseen).
+      const Augmentation a = refined(planned[k], inner, nullptr);
+      const Tuned t = tune(&a, inner);
       const HeldOutError rows = held_out_error(t.model, eval_rows(t.model, state_pbs(t.model), inner, false));
       CandidateTrial& c = result.candidates[k];
       c.selection = diebold_mariano(standardised_loss(model, control_rows, c.channels),
                                     standardised_loss(model, rows, c.channels));
       c.selected_by_training_rows = true;
-      if (c.selection.mean > 0 && c.selection.p_value < attribution.options.alpha) {
-        chosen = k;
-        break;  // the rest are not needed
-      }
+      if (c.selection.mean > 0 && c.selection.p_value < attribution.options.alpha) break;  // the rest are not needed
     }
+    chosen = chosen_candidate(result.candidates, attribution.options.alpha);
   }
   result.candidates[chosen].chosen = true;
 
@@ -298,9 +328,10 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // found on (the plan's found_on, of the model's own channels: the aligned,
   // cleaned, clipped, drifting or friction channels; for an aux channel, the
   // channels its significant hypotheses explain).
-  Tuned after = tune(&planned[chosen], split, &result.untuned);
-  result.augmentation = planned[chosen];
-  result.fitted_rates = fitted_rates[chosen];
+  const Augmentation tested = refined(planned[chosen], split, &result.fitted_rates);
+  result.candidates[chosen].description = tested.description;
+  Tuned after = tune(&tested, split, &result.untuned);
+  result.augmentation = tested;
   result.loss_history = after.loss_history;
   result.train_windows = after.train_windows;
   result.after = held_out_error(after.model, eval_logs(after.model, state_pbs(after.model)));
