@@ -34,7 +34,8 @@
 # strength with the final code of stop 37. Stop 38: 771-775 development of
 # the candidates' selection (--candidates 1, 3 and 5, the rule among them),
 # 781-790 every effect at its larger strength measured with --candidates 1
-# and 5 (the same logs; nothing was chosen on them).
+# and 5 (the same logs; nothing was chosen on them); 841-850 every effect at
+# its smaller strength with --candidates 5.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...
@@ -74,8 +75,8 @@ record_reference "$hadynet" "$out" "$reference_seed"
 runs="$out/runs.txt"
 : >"$runs"
 # effect=strength, weaker first; the second is the larger strength.
-cases=(sensor-delay=1 sensor-delay=2 friction=2 friction=4 crosstalk=0.2 crosstalk=0.35 tension-leak=0.02
-  tension-leak=0.05 drift=0.01 drift=0.02 saturation=3 saturation=2 input-delay=1 input-delay=2 sensor-curve=0.85
+cases=(sensor-delay=1 sensor-delay=2 friction=2 friction=4 crosstalk=0.2 crosstalk=0.35 tension-leak=0.1
+  tension-leak=0.2 drift=0.01 drift=0.02 saturation=3 saturation=2 input-delay=1 input-delay=2 sensor-curve=0.85
   sensor-curve=0.7)
 ((${#only_cases[@]})) && cases=("${only_cases[@]}")
 total=$((n * ${#cases[@]})) done_runs=0 start=$(date +%s)
