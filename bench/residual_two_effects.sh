@@ -17,7 +17,8 @@
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]...
-#   defaults: models/hand.safetensors, build/residual-two-effects, 5, 641, --candidates 3, the pairs
+#   defaults: models/hand.safetensors, build/residual-two-effects, 5, 641, --candidates 3 (the earlier
+#   runs' setting, for comparison; the tool's default is 5), the pairs
 #   sensor-delay=2+crosstalk=0.35, sensor-delay=2+friction=4, input-delay=2+crosstalk=0.35,
 #   input-delay=2+saturation=2 (--pair: only those; repeatable)
 # Environment: HADYNET (default build/release/cli/hadynet).

@@ -230,8 +230,9 @@ int run_residual(int argc, char** argv) {
   opt.value("fix-seed", "N", "with --fix: seed of the window order", "1");
   opt.value("candidates", "K", "with --fix: how many of the screen's candidates may be tried (the best of each effect):\n"
                               "each added, fine-tuned on the first 75 % of the training rows and compared with\n"
-                              "fine-tuning alone on the rest; the first significant there, else the clearest gain, is\n"
-                              "the one the decision tests on the held-out rows (1: the screen's winner)", "5");
+                              "fine-tuning alone on the rest; the first significant there, else the clearest gain,\n"
+                              "else the screen's first, is the one the decision tests on the held-out rows (1: the\n"
+                              "screen's winner)", "5");
   opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
                         "unchanged model, a weaker guard)");
   if (!opt.parse(argc, argv)) return 2;

@@ -259,8 +259,10 @@ TEST(FixCandidates, TheFirstSignificantElseTheClearestGainIsTested) {
   // Nothing gains: the screen's first.
   EXPECT_EQ(chosen({trial(-1.0), trial(-4.0)}), 0u);
   EXPECT_EQ(chosen({trial(0), trial(0)}), 0u);
-  // Candidates that were not judged (logs too short for the selection) are not chosen.
+  // Candidates that were not judged (logs too short for the selection, or
+  // after the first significant one) are not chosen.
   EXPECT_EQ(chosen({trial(0.0, false), trial(5.0, false)}), 0u);
+  EXPECT_EQ(chosen({trial(1.0), trial(2.6), trial(9.0, false)}), 1u);
   EXPECT_EQ(chosen({}), 0u);
 }
 

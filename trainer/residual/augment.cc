@@ -78,11 +78,13 @@ double TrainingRmse::operator()(const SensorModel& sensor, const std::string& ch
   return all(sensor)(it - y_names.begin());
 }
 
+bool gains_significantly(const CandidateTrial& c, double alpha) {
+  return c.selected_by_training_rows && c.selection.mean > 0 && c.selection.p_value < alpha;
+}
+
 std::size_t chosen_candidate(const std::vector<CandidateTrial>& candidates, double alpha) {
-  for (std::size_t k = 0; k < candidates.size(); ++k) {
-    const DieboldMariano& s = candidates[k].selection;
-    if (candidates[k].selected_by_training_rows && s.mean > 0 && s.p_value < alpha) return k;
-  }
+  for (std::size_t k = 0; k < candidates.size(); ++k)
+    if (gains_significantly(candidates[k], alpha)) return k;
   std::size_t chosen = 0;
   double best = 0;
   for (std::size_t k = 0; k < candidates.size(); ++k) {
@@ -310,7 +312,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       c.selection = diebold_mariano(standardised_loss(model, control_rows, c.channels),
                                     standardised_loss(model, rows, c.channels));
       c.selected_by_training_rows = true;
-      if (c.selection.mean > 0 && c.selection.p_value < attribution.options.alpha) break;  // the rest are not needed
+      c.description = a.description;  // as judged: re-estimated on the selection's training rows
+      if (gains_significantly(c, attribution.options.alpha)) break;  // chosen_candidate's choice: the rest are not needed
     }
     chosen = chosen_candidate(result.candidates, attribution.options.alpha);
   }
@@ -329,7 +332,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // cleaned, clipped, drifting or friction channels; for an aux channel, the
   // channels its significant hypotheses explain).
   const Augmentation tested = refined(planned[chosen], split, &result.fitted_rates);
-  result.candidates[chosen].description = tested.description;
+  if (!result.candidates[chosen].selected_by_training_rows) result.candidates[chosen].description = tested.description;
   Tuned after = tune(&tested, split, &result.untuned);
   result.augmentation = tested;
   result.loss_history = after.loss_history;

@@ -244,7 +244,11 @@ HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
 
 // One of the screen's candidates (FixResult::candidates).
 struct CandidateTrial {
-  std::string effect, description;
+  std::string effect;
+  // A judged candidate: as judged (re-estimated on the selection's training
+  // rows); the tested candidate, not judged: as tested (re-estimated on all
+  // the training rows, as FixResult::augmentation always is); else the plan.
+  std::string description;
   std::vector<std::string> channels;  // where it was found: the decision's channels
   // The selection on the training rows alone (several candidates, logs long
   // enough): the control's loss minus the candidate's on the last 25 % of
@@ -261,6 +265,9 @@ struct CandidateTrial {
 // on fresh logs is often the model's own misfit); 0 (the screen's first)
 // when none is judged or none gains.
 std::size_t chosen_candidate(const std::vector<CandidateTrial>& candidates, double alpha);
+// Whether `c` was judged and its gain over the control is significant at
+// `alpha` (chosen_candidate's first rule; fix() judges no further candidate).
+bool gains_significantly(const CandidateTrial& c, double alpha);
 
 // The decision (issue 12, "decide by what the fix does"): the screen only
 // proposes. Of its first FixOptions::candidates candidates, one is chosen
