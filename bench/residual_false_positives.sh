@@ -38,7 +38,8 @@
 # 691-695 belong to bench/residual_two_effects.sh, 681-690 and 711-720 to
 # bench/residual_detection.sh. Stop 38: 791-810 measured with five
 # candidates (the new default; 771-790 and 811-825 belong to the detection,
-# unknown-effect and two-effect benches).
+# unknown-effect and two-effect benches); 851-870 the same without rated
+# ranges (841-850: detection).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
