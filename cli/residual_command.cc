@@ -120,6 +120,7 @@ void print_summary(const rs::Analysis& a, const std::string& pb_choice, bool fix
 void print_fix(const rs::FixResult& fixed) {
   std::printf("\nfix: %s%s\n", fixed.status.c_str(),
               fixed.augmentation ? (": " + fixed.augmentation->description).c_str() : "");
+  if (!fixed.look_alike.empty()) std::printf("note: %s\n", fixed.look_alike.c_str());
   const rs::HeldOutError& e = fixed.tried ? fixed.after : fixed.before;
   std::printf("held-out 1-step RMSE (%ld rows)   %-10s %11s %11s %11s   LB p before/after\n", fixed.before.samples,
               "channel", "before", "fine-tune", "after");

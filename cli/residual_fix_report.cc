@@ -32,6 +32,7 @@ json held_out_json(const rs::HeldOutError& e) {
 nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
   json j = {{"status", f.status},
             {"changed", f.changed},
+            {"look_alike", f.look_alike},
             {"train_fraction", o.train_fraction},
             {"epochs", o.epochs},
             {"lr", o.lr},
@@ -123,6 +124,7 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
                          const std::string& png) {
   std::string m = "\n## Fix (--fix)\n\n**" + f.status + "**";
   if (f.augmentation) m += ": " + f.augmentation->effect + ", " + f.augmentation->description;
+  if (!f.look_alike.empty()) m += "\n\nNote: " + f.look_alike + ".";
   m += "\n\nFine-tuned " + std::to_string(o.epochs) + " epochs (batch norm frozen, Adam lr " + num("%g", o.lr) +
        ", seed " + std::to_string(o.seed) + ") on the first " + num("%.0f", 100 * o.train_fraction) +
        " % of each log's rows; every number below is on the remaining rows (" + std::to_string(f.before.samples) +

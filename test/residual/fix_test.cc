@@ -187,6 +187,8 @@ TEST(ResidualFix, SensorDelayIsTimeAlignedAndCutsTheDelayedChannelsError) {
   // Plant: every loadcell reported 2 steps late (sensor-delay=2).
   const FixRun r = run_fix(plant_logs("sensor-delay"), "sensor-delay");
   ASSERT_TRUE(fixed_as(r, EffectKind::kSensorDelay));
+  // Its look-alike is said (one signature in 1-step residuals; docs/residual.md, "Open").
+  EXPECT_NE(r.fix.look_alike.find("an input dead time"), std::string::npos) << r.fix.look_alike;
   const Augmentation& a = *r.fix.augmentation;
   EXPECT_EQ(std::get<TimeAlignment>(a.change).delay, fm::kSensorDelay.delay_steps);
   // Same network: dims and layout unchanged, the delay in the sensor model.
@@ -246,6 +248,7 @@ TEST(ResidualFix, FrictionGetsDerivedCommandInputsAndCutsTheTendonsError) {
   // Plant: 4 N of dry friction on every tendon (friction, the default).
   const FixRun r = run_fix(plant_logs("friction"), "friction");
   ASSERT_TRUE(fixed_as(r, EffectKind::kFriction));
+  EXPECT_EQ(r.fix.look_alike, "");  // none is known for hysteresis inputs
   const Augmentation& a = *r.fix.augmentation;
   // Two derived command channels per muscle of the family, appended to u and
   // computed from the logged commands (the logs have no such column).
@@ -325,6 +328,7 @@ TEST(ResidualFix, InputDelayGetsTheLaggedCommandsAndCutsTheDelayedChannelsError)
   // time").
   const FixRun r = run_fix(plant_logs("input-delay"), "input-delay", build_model(), &stored_null());
   ASSERT_TRUE(fixed_as(r, EffectKind::kInputDelay));
+  EXPECT_NE(r.fix.look_alike.find("a sensor delay"), std::string::npos) << r.fix.look_alike;
   const Augmentation& a = *r.fix.augmentation;
   // Every command 2 steps earlier, appended to u and computed from the
   // logged commands (the logs have no such column).

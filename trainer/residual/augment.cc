@@ -82,6 +82,20 @@ bool gains_significantly(const CandidateTrial& c, double alpha) {
   return c.selected_by_training_rows && c.selection.mean > 0 && c.selection.p_value < alpha;
 }
 
+std::string look_alike(const Augmentation& a) {
+  std::string channels;
+  for (const auto& c : a.found_on) channels += (channels.empty() ? "" : ", ") + c;
+  if (a.kind == EffectKind::kSensorDelay)
+    return "an input dead time of the same steps leaves nearly the same 1-step residual on " + channels +
+           " (the model predicts their change from their last measured value); channels the delay does not touch, "
+           "or the free-run error, tell them apart";
+  if (a.kind == EffectKind::kInputDelay)
+    return "a sensor delay of the same steps on " + channels +
+           " leaves nearly the same 1-step residual there (the model predicts their change from their last measured "
+           "value); channels with no sensor delay, or the free-run error, tell them apart";
+  return "";
+}
+
 std::size_t chosen_candidate(const std::vector<CandidateTrial>& candidates, double alpha) {
   for (std::size_t k = 0; k < candidates.size(); ++k)
     if (gains_significantly(candidates[k], alpha)) return k;
@@ -386,6 +400,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.model = std::move(after.model);
   result.changed = true;
   result.status = "fixed";
+  result.look_alike = look_alike(*result.augmentation);
   return result;
 }
 

@@ -300,8 +300,20 @@ struct FixResult {
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
   std::vector<double> fitted_rates;     // drift: the attribution's rate per channel, before refine(); else empty
+  // Confirmed: what the data's 1-step residuals do not tell apart from the
+  // confirmed change (look_alike()); "" otherwise.
+  std::string look_alike;
   long train_windows = 0;
 };
+
+// What leaves nearly the same 1-step residual as the change `a`, in words,
+// for a report next to a confirmed change; "" when no such effect is known.
+// A sensor delay of d steps and an input dead time of d steps: the model
+// predicts a channel's change from its last measured value, so a channel
+// reported d steps late leaves D(t - d) - D(t) (D: the change the commands
+// cause), which is what commands acting d steps late leave
+// (docs/residual.md, "Open").
+std::string look_alike(const Augmentation& a);
 
 // The whole --fix step for the analysed `logs` (`data` and `attribution` are
 // the analysis of `model` on them, as `hadynet residual` computes them).
