@@ -13,7 +13,8 @@
 # before fine-tuning); 641-645 measured, with the binary before and after
 # that change; 691-695 measured with RESIDUAL_ROWS=600; 751-755 measured
 # with the final binary of stop 37 (used for nothing else); 821-825
-# measured with --candidates 3 (stop-37 binary) and 5 (stop 38), the same logs.
+# measured with --candidates 3 (stop-37 binary) and 5 (stop 38), the same logs;
+# 641-645 again with --candidates 5 (stop 38).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]...
