@@ -13,8 +13,9 @@
 # now: drift-load on fc3, rate 0.0083, confirmation p 0.033, above alpha,
 # so it is reported as unexplained structure and the model of round 1 stays
 # the written one. (The same with the default five candidates: the sensor
-# delay, then the drift, is the first significant on the training rows.) Round 2's report goes to DIR/round-2 and the JSON's
-# "rounds". Also: --rounds without --fix is a usage error.
+# delay, then the drift, is the first significant on the training rows.)
+# Round 2's report goes to DIR/round-2 and the JSON's "rounds". Also:
+# --rounds without --fix is a usage error.
 # Run with the absolute floors (--reference none) the measurement used; with
 # the model's stored null the screen ranks the drift first (docs/residual.md,
 # "Rounds").

@@ -83,17 +83,8 @@ bool gains_significantly(const CandidateTrial& c, double alpha) {
 }
 
 std::string look_alike(const Augmentation& a) {
-  std::string channels;
-  for (const auto& c : a.found_on) channels += (channels.empty() ? "" : ", ") + c;
-  if (a.kind == EffectKind::kSensorDelay)
-    return "an input dead time of the same steps leaves nearly the same 1-step residual on " + channels +
-           " (the model predicts their change from their last measured value); channels the delay does not touch, "
-           "or the free-run error, tell them apart";
-  if (a.kind == EffectKind::kInputDelay)
-    return "a sensor delay of the same steps on " + channels +
-           " leaves nearly the same 1-step residual there (the model predicts their change from their last measured "
-           "value); channels with no sensor delay, or the free-run error, tell them apart";
-  return "";
+  const EffectInfo& info = effect_info(a.kind);
+  return info.look_alike != nullptr ? info.look_alike(a.found_on) : "";
 }
 
 std::size_t chosen_candidate(const std::vector<CandidateTrial>& candidates, double alpha) {

@@ -307,12 +307,12 @@ struct FixResult {
 };
 
 // What leaves nearly the same 1-step residual as the change `a`, in words,
-// for a report next to a confirmed change; "" when no such effect is known.
-// A sensor delay of d steps and an input dead time of d steps: the model
-// predicts a channel's change from its last measured value, so a channel
-// reported d steps late leaves D(t - d) - D(t) (D: the change the commands
-// cause), which is what commands acting d steps late leave
-// (docs/residual.md, "Open").
+// for a report next to a confirmed change (its effect's EffectInfo::look_alike
+// on its found_on); "" when no such effect is known. A sensor delay of d
+// steps and an input dead time of d steps: the model predicts a channel's
+// change from its last measured value, so a channel reported d steps late
+// leaves D(t - d) - D(t) (D: the change the commands cause), which is what
+// commands acting d steps late leave (docs/residual.md, "Open").
 std::string look_alike(const Augmentation& a);
 
 // The whole --fix step for the analysed `logs` (`data` and `attribution` are

@@ -125,6 +125,13 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   a.found_on = a.channels;
 }
 
+// One signature with an input dead time (augment.h, look_alike()).
+std::string look_alike(const std::vector<std::string>& channels) {
+  return "an input dead time of the same steps leaves nearly the same 1-step residual on " + join(channels) +
+         " (the model predicts their change from their last measured value); channels the delay does not touch, "
+         "or the free-run error, tell them apart";
+}
+
 }  // namespace sensor_delay
 }  // namespace
 
@@ -229,6 +236,13 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   a.description = "add the commands " + steps(d) + " earlier as inputs (" + join(change.inputs) + "; input delay on " +
                   join(a.channels) + ")";
   a.found_on = a.channels;
+}
+
+// One signature with a sensor delay (augment.h, look_alike()).
+std::string look_alike(const std::vector<std::string>& channels) {
+  return "a sensor delay of the same steps on " + join(channels) +
+         " leaves nearly the same 1-step residual there (the model predicts their change from their last measured "
+         "value); channels with no sensor delay, or the free-run error, tell them apart";
 }
 
 }  // namespace input_delay
@@ -945,14 +959,14 @@ const std::vector<EffectInfo>& effect_library() {
        "time alignment: train on y_c shifted d steps earlier (the network predicts the true-time signal), "
        "with the winner's group where the same delay tests significant; the delay goes into the sensor model",
        SourceKind::kNone, sensor_delay::enumerate, sensor_delay::features, first_coefficient, positive,
-       sensor_delay::describe, sensor_delay::plan, nullptr},
+       sensor_delay::describe, sensor_delay::plan, nullptr, sensor_delay::look_alike},
       {EffectKind::kInputDelay, "input-delay",
        "u(t-1-d) - u(t-1), every command channel: commands that act d steps later than the model assumes",
        "delay d (steps)",
        "dead time as inputs: the commands d steps earlier, lag<d>_<c> for every command c, appended to u "
        "(not when it is seen on one group only and a sensor delay is significant there)",
        SourceKind::kNone, input_delay::enumerate, input_delay::features, input_delay::norm, finite,
-       input_delay::describe, input_delay::plan, input_delay::not_planned},
+       input_delay::describe, input_delay::plan, input_delay::not_planned, input_delay::look_alike},
       {EffectKind::kFriction, "friction",
        "sign(u_m(t-1)) and the hysteresis state h_m(t) (sign of the last non-zero command of muscle m): dry "
        "friction acting against the motion of muscle m",

@@ -143,6 +143,10 @@ struct EffectInfo {
   // Why the plan declines the significant hypothesis `lead` ("" when it does
   // not); nullptr: never.
   std::string (*not_planned)(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead);
+  // --fix, after a confirmed change of this effect on `channels` (its
+  // found_on): the effect that leaves nearly the same 1-step residual there
+  // and what tells them apart, in words; nullptr: none is known.
+  std::string (*look_alike)(const std::vector<std::string>& channels) = nullptr;
 };
 // The table, in EffectKind order (the order hypotheses are enumerated in).
 const std::vector<EffectInfo>& effect_library();
