@@ -8,6 +8,9 @@
 # confirmed, and "both" when the confirmed rounds name both plant effects
 # with the right parameter (bench/residual_named.py: the same rules as
 # bench/residual_detection.sh).
+# Disjoint roles: the model is trained on seed 1 (collect --preset paper;
+# its stored null is held-out rows of those logs); the null's floor was
+# chosen on seeds 11, 13-16 and 181-184; no seed below is any of those.
 # Seeds: 511-515 were run by hand before this script (docs/residual.md,
 # "Rounds"); 631 development of the rounds' analysis model (the change
 # before fine-tuning); 641-645 measured, with the binary before and after
