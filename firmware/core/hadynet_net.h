@@ -113,27 +113,30 @@ class HadynetNet {
         gates[r] = (r >= 2 * kH && r < 3 * kH) ? N::tanh(pre) : N::sigmoid(pre);
       }
     }
-    for (int j = 0; j < kH; ++j) {
-      const Value i = gates[j], f = gates[kH + j], g = gates[2 * kH + j], o = gates[3 * kH + j];
-      if (trace != nullptr) trace->c_prev[j] = c_[j];
-      Value c_new;
-      if constexpr (N::kFixed) {
-        // f c + i g with one rounding: f c is Q(15 + C), i g is Q30; both
-        // exact in int64 at Q(30 + C), then narrowed to Q(C).
-        constexpr int C = M::kFracC;
-        const std::int64_t fc = std::int64_t{f} * c_[j] * (std::int64_t{1} << 15);
-        const std::int64_t ig = std::int64_t{i} * g * (std::int64_t{1} << C);
-        c_new = fixed::requantize_i16<30 + C, C>(fc + ig);
-      } else {
-        c_new = f * c_[j] + i * g;
-      }
-      c_[j] = c_new;
-      const Value tc = N::tanh(N::template narrow<M::kFracC, M::kFracGate>(c_new));
-      h_[j] = N::template mul<kFracOut, kFracOut, M::kFracH>(o, tc);
-      if (trace != nullptr) trace->tanh_c[j] = tc;
-    }
+    // c' = f c + i g, h' = o tanh(c'); the tanh of all units in one block.
+    Value tanh_c_local[kH];
+    Value* const tc = trace != nullptr ? trace->tanh_c : tanh_c_local;
     if (trace != nullptr) {
+      for (int j = 0; j < kH; ++j) trace->c_prev[j] = c_[j];
       for (int r = 0; r < kGates; ++r) trace->gates[r] = gates[r];
+    }
+    if constexpr (N::kFixed) {
+      constexpr int C = M::kFracC;
+      static_assert(C <= 15, "c is int16");
+      for (int j = 0; j < kH; ++j) {
+        // f c + i g with one rounding (Q(15 + C) and Q30 products, exact).
+        c_[j] = fixed::bounded::cell_update<C>(gates[kH + j], c_[j], gates[j], gates[2 * kH + j]);
+        tc[j] = fixed::bounded::rescale_i16<C, M::kFracGate>(c_[j]);
+      }
+      kernels::tanh_q15_block(tc, kH);
+      for (int j = 0; j < kH; ++j) h_[j] = fixed::bounded::mul<kFracOut, kFracOut, M::kFracH>(gates[3 * kH + j], tc[j]);
+    } else {
+      for (int j = 0; j < kH; ++j) {
+        const Value i = gates[j], f = gates[kH + j], g = gates[2 * kH + j], o = gates[3 * kH + j];
+        c_[j] = f * c_[j] + i * g;
+        tc[j] = N::tanh(c_[j]);
+        h_[j] = o * tc[j];
+      }
     }
     decode(y);
   }

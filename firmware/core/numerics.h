@@ -14,6 +14,7 @@
 #include <type_traits>
 
 #include "firmware/core/activation.h"
+#include "firmware/core/bounded_rounding.h"
 #include "firmware/core/fixed_point.h"
 #include "firmware/core/kernels/dot_q15.h"
 #include "firmware/core/model_contract.h"
@@ -51,12 +52,13 @@ constexpr std::int32_t grad_scaled(std::int64_t v, int shift) noexcept {
 // g / 2^s, 2^-15 of the largest. The caller multiplies the kernel's sums by
 // 2^s (exact in int64: |sum| < 2^46 for < 2^16 rows, s <= 17).
 inline int grad_block_q15(const std::int32_t* g, int n, std::int16_t* out) noexcept {
-  std::int64_t max_abs = 0;
-  for (int i = 0; i < n; ++i) {
-    const std::int64_t a = g[i] < 0 ? -std::int64_t{g[i]} : std::int64_t{g[i]};
-    if (a > max_abs) max_abs = a;
-  }
-  const int s = bit_length(max_abs) > 15 ? bit_length(max_abs) - 15 : 0;
+  // The bit length of the largest |g| is that of the OR of all |g| (the
+  // same highest bit), which needs no compare per value.
+  std::uint32_t magnitude_bits = 0;
+  for (int i = 0; i < n; ++i)
+    magnitude_bits |= g[i] < 0 ? 0u - static_cast<std::uint32_t>(g[i]) : static_cast<std::uint32_t>(g[i]);
+  const int length = static_cast<int>(std::bit_width(magnitude_bits));
+  const int s = length > 15 ? length - 15 : 0;
   if (s == 0) {
     for (int i = 0; i < n; ++i) out[i] = static_cast<std::int16_t>(g[i]);
     return 0;
@@ -155,7 +157,7 @@ struct Numerics {
   template <int AFrac>
   static constexpr Grad grad_mul(Grad g, Value a) noexcept {
     if constexpr (kFixed) {
-      return fixed::requantize_i32<AFrac, 0>(std::int64_t{g} * a);
+      return fixed::bounded::requantize_i32<AFrac, 0>(std::int64_t{g} * a);  // |g a| < 2^47
     } else {
       return g * a;
     }
@@ -163,14 +165,14 @@ struct Numerics {
   // g * s with s a Q15 factor held in int32 (may be 1.0 = 32768).
   static constexpr Grad grad_mul_q15(Grad g, std::conditional_t<kFixed, std::int32_t, float> s) noexcept {
     if constexpr (kFixed) {
-      return fixed::requantize_i32<15, 0>(std::int64_t{g} * s);
+      return fixed::bounded::requantize_i32<15, 0>(std::int64_t{g} * s);  // |g s| <= 2^62
     } else {
       return g * s;
     }
   }
   static constexpr Grad grad_add(Grad a, Grad b) noexcept {
     if constexpr (kFixed) {
-      return fixed::add_sat32(a, b);
+      return fixed::bounded::saturate_i32(std::int64_t{a} + b);  // fixed::add_sat32
     } else {
       return a + b;
     }
@@ -178,8 +180,9 @@ struct Numerics {
   // sigma'(z) from the activated value s = sigma(z): s (1 - s), Q15 in int32.
   static constexpr auto sigmoid_slope(Value s) noexcept {
     if constexpr (kFixed) {
+      // s (2^15 - s) is in [-2^31, 2^28] for every int16 s: exact in int32.
       const std::int32_t one = 1 << 15;
-      return static_cast<std::int32_t>(fixed::rounding_shift_right(std::int64_t{s} * (one - s), 15));
+      return fixed::bounded::rounding_shift_right_i32<15>(std::int32_t{s} * (one - s));
     } else {
       return s * (1.0f - s);
     }
@@ -187,8 +190,8 @@ struct Numerics {
   // tanh'(z) from t = tanh(z): 1 - t^2, Q15 in int32.
   static constexpr auto tanh_slope(Value t) noexcept {
     if constexpr (kFixed) {
-      const std::int32_t one = 1 << 15;
-      return one - static_cast<std::int32_t>(fixed::rounding_shift_right(std::int64_t{t} * t, 15));
+      const std::int32_t one = 1 << 15;  // t^2 <= 2^30: exact in int32
+      return one - fixed::bounded::rounding_shift_right_i32<15>(std::int32_t{t} * t);
     } else {
       return 1.0f - t * t;
     }

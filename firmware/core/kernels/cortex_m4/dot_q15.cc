@@ -17,7 +17,8 @@
 // term the accumulators are shifted by the difference of the two terms'
 // shifts, the second term accumulates on top, then bias, rounding (half away
 // from zero), the shift to the output format and the saturation to int16 run
-// in registers.
+// in registers: in 32 bits (QADD, ASR, SSAT) when the exact sum fits int32,
+// which the gates' sums do, else on the 64-bit sum out of line.
 //
 // sigmoid_q15_block / tanh_q15_block: activation.h's table interpolation
 // without branches or calls: |x|, one unaligned LDR for both table entries,
@@ -67,19 +68,17 @@ struct HadynetMatvecJob {
   const std::int32_t* bias;    // 0
   std::int16_t* out;           // 1
   std::int32_t half;           // 2: 2^(out_shift - 1)
-  std::int32_t out_shift;      // 3: 1..31
+  std::int32_t out_shift;      // 3: 1..15
   std::int32_t out_shift_rest; // 4: 32 - out_shift
-  const std::int16_t* a_pair;  // 5: first term's current row pair
+  const std::int16_t* a_pair;  // 5: first term's current row pair (the loop ends at the next)
   const std::int16_t* b_pair;  // 6: second term's current row pair
   std::int32_t pairs;          // 7: row pairs left (>= 1)
-  std::int32_t a_pair_bytes;   // 8: bytes per row pair of A
-  std::int32_t b_pair_bytes;   // 9
-  const std::int16_t* a_x;     // 10
-  std::uint32_t a_entry;       // 11: where the unrolled loop starts, | 1 (Thumb)
-  const std::int16_t* b_x;     // 12
-  std::uint32_t b_entry;       // 13
-  std::int32_t a_shift;        // 14: first term's shift relative to the second
-  std::int32_t a_shift_rest;   // 15: 32 - a_shift
+  const std::int16_t* a_x;     // 8
+  std::uint32_t a_entry;       // 9: where the unrolled loop starts, | 1 (Thumb)
+  const std::int16_t* b_x;     // 10
+  std::uint32_t b_entry;       // 11
+  std::int32_t a_shift;        // 12: first term's shift relative to the second
+  std::int32_t a_shift_rest;   // 13: 32 - a_shift
 };
 
 // For each row pair: out = sat16(round((((A . a_x) << a_shift) + B . b_x + bias) >> out_shift)).
@@ -128,8 +127,6 @@ static_assert(offsetof(HadynetMatvecJob, out_shift_rest) == HADYNET_MVP_OUT_SHIF
 static_assert(offsetof(HadynetMatvecJob, a_pair) == HADYNET_MVP_A_PAIR);
 static_assert(offsetof(HadynetMatvecJob, b_pair) == HADYNET_MVP_B_PAIR);
 static_assert(offsetof(HadynetMatvecJob, pairs) == HADYNET_MVP_PAIRS);
-static_assert(offsetof(HadynetMatvecJob, a_pair_bytes) == HADYNET_MVP_A_PAIR_BYTES);
-static_assert(offsetof(HadynetMatvecJob, b_pair_bytes) == HADYNET_MVP_B_PAIR_BYTES);
 static_assert(offsetof(HadynetMatvecJob, a_x) == HADYNET_MVP_A_X);
 static_assert(offsetof(HadynetMatvecJob, a_entry) == HADYNET_MVP_A_ENTRY);
 static_assert(offsetof(HadynetMatvecJob, b_x) == HADYNET_MVP_B_X);
@@ -186,7 +183,7 @@ void matvec_requantize_q15(const MatvecTerm& a, const MatvecTerm& b, const std::
   const MatvecTerm& first = swap ? b : a;
   const MatvecTerm& second = swap ? a : b;
   const bool fast = fast_term(first) && fast_term(second) && (second.cols <= 0 || second.shift == 0) &&
-                    out_shift >= 1 && out_shift <= 31 && bias != nullptr;
+                    out_shift >= 1 && out_shift <= 15 && bias != nullptr;
   if (!fast) {
     reference::matvec_requantize_q15(a, b, bias, rows, out_shift, out);
     return;
@@ -201,8 +198,6 @@ void matvec_requantize_q15(const MatvecTerm& a, const MatvecTerm& b, const std::
       first.w,
       second.w,
       rows / 2,
-      4 * first.cols,
-      4 * second.cols,
       first.x,
       entry(hadynet_mvp_end_a, first.cols / 8, kMvpBlockBytes),
       second.x,

@@ -63,9 +63,9 @@
         smlald  r12, lr, r9, r5
         .endm
 
-@ One row's rounding: acc (lo:hi) + half - (acc < 0), >> out_shift,
-@ saturated to int16 into lo. r2 = half, r3 = out_shift, r4 = 32 - out_shift;
-@ clobbers r5.
+@ One row's rounding, the general case: acc (lo:hi) + half - (acc < 0),
+@ >> out_shift, saturated to int16 into lo. r2 = half, r3 = out_shift,
+@ r4 = 32 - out_shift; clobbers r5.
         .macro  HADYNET_MVP_ROUND lo, hi
         asr     r5, \hi, #31
         adds    \lo, \lo, r2
@@ -83,6 +83,21 @@
         eorne   \lo, \lo, \hi, asr #31
         .endm
 
+@ The same when the sum fits int32 (hi is lo's sign), else a branch to
+@ `general` (HADYNET_MVP_ROUND out of line, which branches back to `done`).
+@ lo + half saturates (QADD) only where the result saturates to int16
+@ anyway (out_shift <= 15: INT32_MAX >> out_shift >= 32767); adding hi
+@ subtracts 1 from a negative sum. r2 = half, r3 = out_shift.
+        .macro  HADYNET_MVP_ROUND_INT32 lo, hi, general, done
+        cmp     \hi, \lo, asr #31
+        bne     \general
+        qadd    \lo, \lo, r2
+        add     \lo, \lo, \hi
+        asr     \lo, \lo, r3
+        ssat    \lo, #16, \lo
+\done:
+        .endm
+
         .global hadynet_matvec_pairs
         .type   hadynet_matvec_pairs, %function
         .thumb_func
@@ -90,11 +105,11 @@
 hadynet_matvec_pairs:
         push    {r4-r11, lr}
         sub     sp, sp, #HADYNET_MVP_JOB_BYTES
-        ldmia   r0!, {r1-r8}                    @ the job (16 words) onto the stack
-        stmia   sp, {r1-r8}
-        ldmia   r0, {r1-r8}
-        add     r9, sp, #32
-        stmia   r9, {r1-r8}
+        ldmia   r0!, {r1-r7}                    @ the job (14 words) onto the stack
+        stmia   sp, {r1-r7}
+        ldmia   r0, {r1-r7}
+        add     r8, sp, #28
+        stmia   r8, {r1-r7}
 .Lmvp_pair:
         ldr     r1, [sp, #HADYNET_MVP_A_PAIR]
         ldr     r0, [sp, #HADYNET_MVP_A_X]
@@ -110,6 +125,7 @@ hadynet_matvec_pairs:
         .global hadynet_mvp_end_a
 hadynet_mvp_end_a:
         HADYNET_CHECK_BLOCKS .Lmvp_a_start, hadynet_mvp_end_a, HADYNET_MVP_BLOCKS, HADYNET_MVP_BLOCK_BYTES
+        str     r1, [sp, #HADYNET_MVP_A_PAIR]   @ the loop ends at A's next row pair
         ldrd    r8, r9, [sp, #HADYNET_MVP_A_SHIFT]  @ both accumulators <<= a_shift (a_shift, a_shift_rest)
         lsl     r11, r11, r8
         lsr     r2, r10, r9
@@ -129,26 +145,32 @@ hadynet_mvp_end_a:
         .global hadynet_mvp_end_b
 hadynet_mvp_end_b:
         HADYNET_CHECK_BLOCKS .Lmvp_b_start, hadynet_mvp_end_b, HADYNET_MVP_BLOCKS, HADYNET_MVP_BLOCK_BYTES
-        ldmia   sp, {r0-r4}                     @ bias, out, half, out_shift, 32 - out_shift (offsets 0..16)
+        str     r1, [sp, #HADYNET_MVP_B_PAIR]   @ and B's
+        ldmia   sp, {r0-r3}                     @ bias, out, half, out_shift (offsets 0..12)
         ldrd    r6, r7, [r0], #8                @ the pair's biases, sign-extended in
         adds    r10, r10, r6
         adc     r11, r11, r6, asr #31
         adds    r12, r12, r7
         adc     lr, lr, r7, asr #31
-        HADYNET_MVP_ROUND r10, r11
-        HADYNET_MVP_ROUND r12, lr
+        HADYNET_MVP_ROUND_INT32 r10, r11, .Lmvp_general_first, .Lmvp_first_done
+        HADYNET_MVP_ROUND_INT32 r12, lr, .Lmvp_general_second, .Lmvp_second_done
         strh    r10, [r1], #2
         strh    r12, [r1], #2
+        ldr     r8, [sp, #HADYNET_MVP_PAIRS]
         stmia   sp, {r0-r1}
-        add     r5, sp, #HADYNET_MVP_A_PAIR     @ next row pair
-        ldmia   r5, {r6-r10}                    @ A pair, B pair, pairs, A/B pair bytes (consecutive)
-        add     r6, r6, r9
-        add     r7, r7, r10
         subs    r8, r8, #1
-        stmia   r5, {r6-r8}
+        str     r8, [sp, #HADYNET_MVP_PAIRS]
         bne     .Lmvp_pair
         add     sp, sp, #HADYNET_MVP_JOB_BYTES
         pop     {r4-r11, pc}
+.Lmvp_general_first:                            @ a sum beyond int32: the general rounding
+        ldr     r4, [sp, #HADYNET_MVP_OUT_SHIFT_REST]
+        HADYNET_MVP_ROUND r10, r11
+        b       .Lmvp_first_done
+.Lmvp_general_second:
+        ldr     r4, [sp, #HADYNET_MVP_OUT_SHIFT_REST]
+        HADYNET_MVP_ROUND r12, lr
+        b       .Lmvp_second_done
         .size   hadynet_matvec_pairs, . - hadynet_matvec_pairs
 
 @ ---------------------------------------------------------------------------
