@@ -18,7 +18,8 @@ cd "$(dirname "$0")/.."
 
 images="${1:-build/cortex-m4/images}"
 qemu="${QEMU:-qemu-system-arm}"
-target_per_mac=1.5  # issue 5: q15 control period
+target_per_mac=1.5  # issue 5: q15 control period (the script fails above it)
+goal_per_mac=1.0    # issue 16: reported, not enforced (docs/boards.md: why it is out of reach)
 
 for numeric in q15 f32; do
   if [[ ! -f "$images/mps2-an386/hadynet-bench-$numeric.elf" ]]; then
@@ -43,7 +44,7 @@ for numeric in q15 f32; do
     echo "$out" >&2
     exit 1
   fi
-  awk -v numeric="$numeric" -v target="$target_per_mac" '
+  awk -v numeric="$numeric" -v target="$target_per_mac" -v goal="$goal_per_mac" '
     /^bench / { for (i = 2; i <= NF; ++i) { split($i, kv, "="); if (kv[1] == "tick_hz") hz = kv[2] } }
     /^job / {
       for (i = 2; i <= NF; ++i) { split($i, kv, "="); f[kv[1]] = kv[2] }
@@ -60,7 +61,7 @@ for numeric in q15 f32; do
       printf "         %s worst periods: detect + adaptation %.1f M instructions, control %.1f M: %.0f %% and %.0f %% of 33.6 M\n", numeric, adapt / 1e6, control_rep / 1e6, 100 * adapt / 33.6e6, 100 * control_rep / 33.6e6
       if (numeric == "q15") {
         verdict = control <= target ? "met" : "NOT met"
-        printf "         q15 control period: %.3f instructions/MAC, target <= %s: %s\n", control, target, verdict
+        printf "         q15 control period: %.3f instructions/MAC, target <= %s: %s; issue 16 goal <= %s: %s\n", control, target, verdict, goal, control <= goal ? "met" : "not met"
         if (control > target) exit 3
       }
       split(memory, m, /[ =]/)
