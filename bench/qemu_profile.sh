@@ -6,7 +6,7 @@
 # (`-d in_asm,exec,nochain`, streamed through a FIFO, nothing on disk) and
 # counts the instructions of each function during one job of
 # firmware/app/bench.h (default: control_full, its warm-up period and its
-# timed periods); bench/qemu_profile.py does the counting. About a minute on
+# timed periods); bench/qemu_profile.py does the counting. About 15 s on
 # the development VM.
 #
 # Usage: bench/qemu_profile.sh [--job N] [--top K] [IMAGE_DIR]
@@ -24,7 +24,7 @@ while [[ $# -gt 0 ]]; do
   case "$1" in
     --job) job="$2"; shift 2 ;;
     --top) top="$2"; shift 2 ;;
-    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) echo "qemu_profile: unknown option $1 (see --help)" >&2; exit 2 ;;
     *) images="$1"; shift ;;
   esac

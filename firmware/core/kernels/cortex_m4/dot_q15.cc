@@ -22,7 +22,7 @@
 //
 // sigmoid_q15_block / tanh_q15_block: activation.h's table interpolation
 // without branches or calls: |x|, one unaligned LDR for both table entries,
-// one multiply, the sign by EOR/SUB; about 16 (tanh) and 19 (sigmoid)
+// one multiply-add, the sign by EOR/SUB; 16 (tanh) and 17 (sigmoid)
 // instructions per value. tanh clamps |x| = 32768 (x = -32768) to 32767 so it
 // never reads past the table: exact because the table's last two entries are
 // both 32767 (checked, with every other input, by the exhaustive test).
@@ -70,15 +70,16 @@ struct HadynetMatvecJob {
   std::int32_t half;           // 2: 2^(out_shift - 1)
   std::int32_t out_shift;      // 3: 1..15
   std::int32_t out_shift_rest; // 4: 32 - out_shift
-  const std::int16_t* a_pair;  // 5: first term's current row pair (the loop ends at the next)
-  const std::int16_t* b_pair;  // 6: second term's current row pair
-  std::int32_t pairs;          // 7: row pairs left (>= 1)
-  const std::int16_t* a_x;     // 8
-  std::uint32_t a_entry;       // 9: where the unrolled loop starts, | 1 (Thumb)
-  const std::int16_t* b_x;     // 10
-  std::uint32_t b_entry;       // 11
-  std::int32_t a_shift;        // 12: first term's shift relative to the second
-  std::int32_t a_shift_rest;   // 13: 32 - a_shift
+  std::int32_t pairs;          // 5: row pairs left (>= 1)
+  const std::int16_t* a_x;     // 6
+  const std::int16_t* a_pair;  // 7: first term's current row pair (the loop ends at the next)
+  std::int32_t zeros[4];       // 8..11: 0, the accumulators' start (loaded with a_x and a_pair)
+  const std::int16_t* b_x;     // 12
+  const std::int16_t* b_pair;  // 13: second term's current row pair
+  std::uint32_t a_entry;       // 14: where the unrolled loop starts, | 1 (Thumb)
+  std::uint32_t b_entry;       // 15
+  std::int32_t a_shift;        // 16: first term's shift relative to the second
+  std::int32_t a_shift_rest;   // 17: 32 - a_shift
 };
 
 // For each row pair: out = sat16(round((((A . a_x) << a_shift) + B . b_x + bias) >> out_shift)).
@@ -129,6 +130,7 @@ static_assert(offsetof(HadynetMatvecJob, b_pair) == HADYNET_MVP_B_PAIR);
 static_assert(offsetof(HadynetMatvecJob, pairs) == HADYNET_MVP_PAIRS);
 static_assert(offsetof(HadynetMatvecJob, a_x) == HADYNET_MVP_A_X);
 static_assert(offsetof(HadynetMatvecJob, a_entry) == HADYNET_MVP_A_ENTRY);
+static_assert(offsetof(HadynetMatvecJob, zeros) == HADYNET_MVP_ZEROS);
 static_assert(offsetof(HadynetMatvecJob, b_x) == HADYNET_MVP_B_X);
 static_assert(offsetof(HadynetMatvecJob, b_entry) == HADYNET_MVP_B_ENTRY);
 static_assert(offsetof(HadynetMatvecJob, a_shift) == HADYNET_MVP_A_SHIFT);
@@ -195,12 +197,13 @@ void matvec_requantize_q15(const MatvecTerm& a, const MatvecTerm& b, const std::
       std::int32_t{1} << (out_shift - 1),
       out_shift,
       32 - out_shift,
-      first.w,
-      second.w,
       rows / 2,
       first.x,
-      entry(hadynet_mvp_end_a, first.cols / 8, kMvpBlockBytes),
+      first.w,
+      {0, 0, 0, 0},
       second.x,
+      second.w,
+      entry(hadynet_mvp_end_a, first.cols / 8, kMvpBlockBytes),
       entry(hadynet_mvp_end_b, second.cols / 8, kMvpBlockBytes),
       first_shift,
       32 - first_shift,

@@ -105,18 +105,14 @@
 hadynet_matvec_pairs:
         push    {r4-r11, lr}
         sub     sp, sp, #HADYNET_MVP_JOB_BYTES
-        ldmia   r0!, {r1-r7}                    @ the job (14 words) onto the stack
-        stmia   sp, {r1-r7}
-        ldmia   r0, {r1-r7}
-        add     r8, sp, #28
-        stmia   r8, {r1-r7}
+        ldmia   r0!, {r1-r9}                    @ the job (18 words) onto the stack
+        stmia   sp, {r1-r9}
+        ldmia   r0, {r1-r9}
+        add     r10, sp, #36
+        stmia   r10, {r1-r9}
 .Lmvp_pair:
-        ldr     r1, [sp, #HADYNET_MVP_A_PAIR]
-        ldr     r0, [sp, #HADYNET_MVP_A_X]
-        mov     r10, #0
-        mov     r11, #0
-        mov     r12, #0
-        mov     lr, #0
+        add     r2, sp, #HADYNET_MVP_A_X
+        ldmia   r2, {r0, r1, r10, r11, r12, lr} @ x, W, zeroed accumulators (A_X, A_PAIR, ZEROS)
         ldr     pc, [sp, #HADYNET_MVP_A_ENTRY]  @ into the A loop
 .Lmvp_a_start:
         .rept   HADYNET_MVP_BLOCKS
@@ -135,8 +131,7 @@ hadynet_mvp_end_a:
         lsr     r2, r12, r9
         orr     lr, lr, r2
         lsl     r12, r12, r8
-        ldr     r1, [sp, #HADYNET_MVP_B_PAIR]
-        ldr     r0, [sp, #HADYNET_MVP_B_X]
+        ldrd    r0, r1, [sp, #HADYNET_MVP_B_X]  @ x, W (B_X, B_PAIR)
         ldr     pc, [sp, #HADYNET_MVP_B_ENTRY]  @ into the B loop
 .Lmvp_b_start:
         .rept   HADYNET_MVP_BLOCKS
@@ -180,13 +175,14 @@ hadynet_mvp_end_b:
 @ gives T[i]); negated for x < 0. tanh: shift 7. sigmoid: shift 8, then
 @ (32768 + t + 1) >> 1, at most 32767.
 @   r0 v, r1 n, r2 table, r3 x, r4 m / f, r5 i / d, r6 T[i] | T[i+1] << 16,
-@   r7 y, r8 32769 (sigmoid).
+@   r7 y, r8 64 (tanh) or 32769 (sigmoid), r9 128 (sigmoid).
         .global hadynet_tanh_block
         .type   hadynet_tanh_block, %function
         .thumb_func
         .p2align 2
 hadynet_tanh_block:
-        push    {r4-r7}
+        push    {r4-r8}
+        mov     r8, #64
 1:
         ldrsh   r3, [r0]
         eor     r4, r3, r3, asr #31
@@ -197,15 +193,14 @@ hadynet_tanh_block:
         ldr     r6, [r2, r5, lsl #1]
         sxth    r7, r6
         rsb     r5, r7, r6, asr #16
-        mul     r5, r5, r4
-        add     r5, r5, #64
+        mla     r5, r5, r4, r8                  @ (T[i+1] - T[i]) f + 64
         add     r7, r7, r5, asr #7
         eor     r7, r7, r3, asr #31
         sub     r7, r7, r3, asr #31
         strh    r7, [r0], #2
         subs    r1, r1, #1
         bne     1b
-        pop     {r4-r7}
+        pop     {r4-r8}
         bx      lr
         .size   hadynet_tanh_block, . - hadynet_tanh_block
 
@@ -214,8 +209,9 @@ hadynet_tanh_block:
         .thumb_func
         .p2align 2
 hadynet_sigmoid_block:
-        push    {r4-r8}
+        push    {r4-r9}
         movw    r8, #32769
+        mov     r9, #128
 1:
         ldrsh   r3, [r0]
         eor     r4, r3, r3, asr #31
@@ -225,18 +221,16 @@ hadynet_sigmoid_block:
         ldr     r6, [r2, r5, lsl #1]
         sxth    r7, r6
         rsb     r5, r7, r6, asr #16
-        mul     r5, r5, r4
-        add     r5, r5, #128
+        mla     r5, r5, r4, r9                  @ (T[i+1] - T[i]) f + 128
         add     r7, r7, r5, asr #8
         eor     r7, r7, r3, asr #31
         sub     r7, r7, r3, asr #31
         add     r7, r7, r8
-        asr     r7, r7, #1
-        ssat    r7, #16, r7
+        ssat    r7, #16, r7, asr #1             @ (32768 + t + 1) >> 1, at most 32767
         strh    r7, [r0], #2
         subs    r1, r1, #1
         bne     1b
-        pop     {r4-r8}
+        pop     {r4-r9}
         bx      lr
         .size   hadynet_sigmoid_block, . - hadynet_sigmoid_block
 

@@ -12,22 +12,25 @@
  * instructions; up to 32 blocks (256 columns) per term. */
 #define HADYNET_MVP_BLOCKS 32
 #define HADYNET_MVP_BLOCK_BYTES 44
-/* HadynetMatvecJob (14 words, copied onto the assembly's stack). */
-#define HADYNET_MVP_JOB_BYTES 56
+/* HadynetMatvecJob (18 words, copied onto the assembly's stack). A_X,
+ * A_PAIR and the four zero words are consecutive: one LDM starts a row pair
+ * (x, W, zeroed accumulators); B_X and B_PAIR are consecutive for one LDRD. */
+#define HADYNET_MVP_JOB_BYTES 72
 #define HADYNET_MVP_BIAS 0
 #define HADYNET_MVP_OUT 4
 #define HADYNET_MVP_HALF 8
 #define HADYNET_MVP_OUT_SHIFT 12
 #define HADYNET_MVP_OUT_SHIFT_REST 16
-#define HADYNET_MVP_A_PAIR 20
-#define HADYNET_MVP_B_PAIR 24
-#define HADYNET_MVP_PAIRS 28
-#define HADYNET_MVP_A_X 32
-#define HADYNET_MVP_A_ENTRY 36
-#define HADYNET_MVP_B_X 40
-#define HADYNET_MVP_B_ENTRY 44
-#define HADYNET_MVP_A_SHIFT 48
-#define HADYNET_MVP_A_SHIFT_REST 52
+#define HADYNET_MVP_PAIRS 20
+#define HADYNET_MVP_A_X 24
+#define HADYNET_MVP_A_PAIR 28
+#define HADYNET_MVP_ZEROS 32
+#define HADYNET_MVP_B_X 48
+#define HADYNET_MVP_B_PAIR 52
+#define HADYNET_MVP_A_ENTRY 56
+#define HADYNET_MVP_B_ENTRY 60
+#define HADYNET_MVP_A_SHIFT 64
+#define HADYNET_MVP_A_SHIFT_REST 68
 
 /* hadynet_dot_rows_split: one block = 8 columns, 11 32-bit instructions; up
  * to 64 blocks (512 columns). */
