@@ -180,17 +180,21 @@ class HadynetNet {
     // Requantising a pre-activation is the identity on reals (saturation is
     // not differentiated).
     if constexpr (N::kFixed) {
-      // W^T dgates along the rows of the transposed copies (exact int64 sums,
-      // one rounding per output, as transposed_matvec).
-      const NetworkWeights<M>& kw = t_->weights;
-      kernels::dot_rows_q15_i32(kw.ih_u_t[0], kGates, kU, dgates, kGates, scratch_);
-      for (int k = 0; k < kU; ++k) du[k] = N::grad_add(du[k], fixed::requantize_i32<M::kFracLstmW, 0>(scratch_[k]));
+      // dgates as block floating point, for W_ih's command columns (the
+      // packed matrix's first columns) and W_hh^T: exact int64 sums of the
+      // mantissas, one rounding per output.
+      const BlockGrad<kGates> block(dgates);
+      const auto& ih = t_->weights.ih;
+      kernels::dot_cols_packed_q15(ih.data, ih.kCols, kGates, block.mantissa, kU, scratch_);
+      for (int k = 0; k < kU; ++k)
+        du[k] = N::grad_add(du[k], fixed::requantize_i32<M::kFracLstmW, 0>(block.scaled(scratch_[k])));
+      if (dh_prev != nullptr) hidden_gradient(block, dh_prev);
     } else {
       Grad du_step[kU];
       N::template transposed_matvec<M::kFracLstmW>(t_->weights.ih, dgates, kU, du_step, scratch_);
       for (int k = 0; k < kU; ++k) du[k] = N::grad_add(du[k], du_step[k]);
+      if (dh_prev != nullptr) hidden_gradient(dgates, dh_prev);
     }
-    if (dh_prev != nullptr) hidden_gradient(dgates, dh_prev);
   }
 
   // The same step of back-propagation for the PB instead of the command
@@ -324,13 +328,12 @@ class HadynetNet {
     std::int64_t scaled(std::int64_t sum) const noexcept { return sum * (std::int64_t{1} << shift); }
   };
 
-  // dh_prev = W_hh^T dgates (dL/dh before the step).
-  void hidden_gradient(const Grad (&dgates)[kGates], Grad* dh_prev) noexcept {
-    if constexpr (N::kFixed) {
-      hidden_gradient(BlockGrad<kGates>(dgates), dh_prev);
-    } else {
-      N::template transposed_matvec<M::kFracLstmW>(t_->weights.hh, dgates, kH, dh_prev, scratch_);
-    }
+  // dh_prev = W_hh^T dgates (dL/dh before the step); q15 from the gate
+  // gradients' block floating point.
+  void hidden_gradient(const Grad (&dgates)[kGates], Grad* dh_prev) noexcept
+    requires(!N::kFixed)
+  {
+    N::template transposed_matvec<M::kFracLstmW>(t_->weights.hh, dgates, kH, dh_prev, scratch_);
   }
   void hidden_gradient(const BlockGrad<kGates>& block, Grad* dh_prev) noexcept
     requires N::kFixed

@@ -61,8 +61,9 @@ constexpr bool parse_numeric(std::string_view text, Numeric& out) noexcept {
 // and the core rejects other versions at compile time (a stale generated
 // header fails the build, not the robot). 3 added kPeriodUs and kBoardGroup,
 // 4 kShapeId, 5 DerivedKind::kLag and kUDerivedLag, 6 the sensors'
-// calibration curves (kCurve*).
-inline constexpr int kModelContractVersion = 6;
+// calibration curves (kCurve*), 7 no transposed copy of W_ih's command
+// columns in the q15 tensors (model_tensors.h: a payload 8 KiB shorter).
+inline constexpr int kModelContractVersion = 7;
 
 // Loss class of each observed channel for the grasp stabiliser.
 enum class LossClass : std::uint8_t {

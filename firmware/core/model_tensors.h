@@ -31,9 +31,9 @@
 namespace hadynet::firmware {
 
 // The network's matrices. q15: packed for the forward kernel
-// (kernels/dot_q15.h), plus W_ih's command columns transposed (dL/du along
-// contiguous rows); W^T g of the other matrices is computed from the packed
-// copies (kernels::dot_cols_packed_q15). f32: row-major as generated.
+// (kernels/dot_q15.h), one copy each: every W^T g of the backward passes is
+// computed from the packed copies (kernels::dot_cols_packed_q15). f32:
+// row-major as generated.
 template <GeneratedModel M, bool kFixed = (M::kNumeric == Numeric::kQ15)>
 struct NetworkWeights;
 
@@ -44,7 +44,6 @@ struct NetworkWeights<M, true> {
   kernels::PackedMatrix<kGates, M::kU + M::kPb> ih;       // W_ih, input [u ; p]
   kernels::PackedMatrix<kGates, M::kHidden> hh;           // W_hh
   kernels::PackedMatrix<M::kY, M::kHidden> dec;           // W_dec
-  std::int16_t ih_u_t[M::kU][kGates];                     // W_ih[:, :kU]^T
 };
 
 template <GeneratedModel M>
@@ -148,8 +147,6 @@ constexpr void build_tensors(const Source& s, ModelTensors<M>& t) noexcept {
     t.weights.ih = kernels::pack_matrix(s.kLstmWeightIh);
     t.weights.hh = kernels::pack_matrix(s.kLstmWeightHh);
     t.weights.dec = kernels::pack_matrix(s.kDecWeight);
-    for (int r = 0; r < ModelTensors<M>::kGates; ++r)
-      for (int c = 0; c < M::kU; ++c) t.weights.ih_u_t[c][r] = s.kLstmWeightIh[r][c];
   } else {
     for (int r = 0; r < M::kHidden; ++r)
       for (int c = 0; c < M::kX + M::kPb; ++c) t.weights.enc[r][c] = s.kEncWeight[r][c];
