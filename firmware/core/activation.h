@@ -36,11 +36,14 @@
 // (round half up on non-negative values) between entries, odd symmetry for
 // x < 0, and sigmoid(x) = (1 + tanh(x/2)) / 2 with the same table read at
 // double resolution. The table is written as literals generated once by
-// firmware/tools/gen_activation_table.py (formula in activation.cc).
+// firmware/tools/gen_activation_table.py into activation_table.h (formula
+// there).
 #ifndef HADYNET_FIRMWARE_CORE_ACTIVATION_H_
 #define HADYNET_FIRMWARE_CORE_ACTIVATION_H_
 
 #include <cstdint>
+
+#include "firmware/core/activation_table.h"  // detail::kTanhQ15Table
 
 namespace hadynet::fixed {
 
@@ -53,14 +56,6 @@ inline constexpr int kActivationOutputFracBits = 15;
 
 // 1 / (1 + exp(-x / 4096)) in Q0.15; see the contract above.
 [[nodiscard]] std::int16_t sigmoid_q15(std::int16_t x) noexcept;
-
-namespace detail {
-// Number of entries of the tanh table: tanh(i / 32) for i = 0 .. 256.
-inline constexpr int kTanhTableEntries = 257;
-// min(32767, floor(32768 * tanh(i / 32) + 0.5)), i = 0 .. 256. Exposed only
-// so that tests can check it against its formula.
-extern const std::int16_t kTanhQ15Table[kTanhTableEntries];
-}  // namespace detail
 
 }  // namespace hadynet::fixed
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Generates the tanh lookup table of firmware/core/activation.cc.
+"""Generates the tanh lookup table of firmware/core/activation_table.h.
 
-Run once by hand; the output is pasted into activation.cc as literals (the
+Run once by hand; the output is pasted into activation_table.h as literals (the
 firmware never evaluates tanh, at compile time or at run time).
 
 Formula (exactly reproducible): for i = 0 .. 256,

@@ -20,10 +20,11 @@
 // in registers: in 32 bits (QADD, ASR, SSAT) when the exact sum fits int32,
 // which the gates' sums do, else on the 64-bit sum out of line.
 //
-// sigmoid_q15_block / tanh_q15_block: activation.h's table interpolation
-// without branches or calls: |x|, one unaligned LDR for both table entries,
-// one multiply-add, the sign by EOR/SUB; 16 (tanh) and 17 (sigmoid)
-// instructions per value. tanh clamps |x| = 32768 (x = -32768) to 32767 so it
+// sigmoid_q15_block / tanh_q15_block: activation.h's table interpolation on
+// tables indexed by the signed x (SignedActivationTable below, built at
+// compile time from the tanh table), so no |x| and no sign at run time: per
+// value one LDR and one LDRSH of the entry, one multiply-add, one shift (and
+// SSAT for sigmoid): 10 instructions. tanh clamps |x| = 32768 (x = -32768) to 32767 so it
 // never reads past the table: exact because the table's last two entries are
 // both 32767 (checked, with every other input, by the exhaustive test).
 //
@@ -89,9 +90,10 @@ void hadynet_matvec_pairs(const HadynetMatvecJob* job) noexcept;
 extern const char hadynet_mvp_end_a[];
 extern const char hadynet_mvp_end_b[];
 
-// In place: v[i] = tanh_q15(v[i]) / sigmoid_q15(v[i]) for n >= 1 values.
-void hadynet_tanh_block(std::int16_t* v, int n, const std::int16_t* table) noexcept;
-void hadynet_sigmoid_block(std::int16_t* v, int n, const std::int16_t* table) noexcept;
+// In place: v[i] = tanh_q15(v[i]) / sigmoid_q15(v[i]) for n >= 1 values;
+// e and d point at entry 0 of a SignedActivationTable.
+void hadynet_tanh_block(std::int16_t* v, int n, const std::int32_t* e, const std::int16_t* d) noexcept;
+void hadynet_sigmoid_block(std::int16_t* v, int n, const std::int32_t* e, const std::int16_t* d) noexcept;
 
 // Parameter block of hadynet_dot_rows_split.
 struct HadynetSplitJob {
@@ -153,6 +155,57 @@ constexpr int kSplitMaxCols = 8 * HADYNET_SPLIT_BLOCKS;
 constexpr int kSplitBlockBytes = HADYNET_SPLIT_BLOCK_BYTES;
 // g >= 2^31 - 2^15 has no int16 high half (gh would be 2^15).
 constexpr std::int32_t kSplitMax = 0x7FFF7FFF;
+
+// activation.h's interpolation indexed by the signed input. The reference
+// (activation.cc) computes, with m = |x|, i = m >> s, f = m mod 2^s,
+// T the tanh table and D_i = T[i+1] - T[i]:
+//   t(x) = sign(x) (T[i] + floor((D_i f + 2^(s-1)) / 2^s)).
+// With j = floor(x / 2^s) and g = x mod 2^s, t = floor((e_j + d_j g) / 2^s)
+// for the entries
+//   j >= 0 (x >= 0, j = i, g = f):  e_j = 2^s T[j] + 2^(s-1),      d_j = D_j;
+//   j = -k < 0 (x < 0):             e_j = -2^s T[k] + 2^(s-1) - 1, d_j = D_(k-1).
+// For x < 0 with f > 0, k = i + 1 and g = 2^s - f, so the entry gives
+// -T[i+1] + D_i + floor((2^(s-1) - 1 - D_i f) / 2^s)
+// = -T[i] - floor((D_i f + 2^(s-1)) / 2^s) (-floor(a / b) = floor((b - 1 - a) / b)),
+// and with f = 0 (g = 0, k = i) it gives -T[i]. sigmoid's
+// (32768 + t + 1) >> 1 folds in as E_j + 2^s 32769 and a shift by s + 1
+// (exact: floor(floor(a / b) / 2) = floor(a / 2b)). The QEMU kernel test
+// checks all 65 536 inputs of both against activation.cc.
+template <int Shift, bool kSigmoid>
+struct SignedActivationTable {
+  static constexpr int kEntries = 1 << (16 - Shift);          // j in [-kEntries / 2, kEntries / 2)
+  std::int32_t e[kEntries];
+  std::int16_t d[kEntries];
+  const std::int32_t* e_zero() const noexcept { return e + kEntries / 2; }
+  const std::int16_t* d_zero() const noexcept { return d + kEntries / 2; }
+};
+
+template <int Shift, bool kSigmoid>
+constexpr SignedActivationTable<Shift, kSigmoid> signed_activation_table() noexcept {
+  using fixed::detail::kTanhQ15Table;
+  SignedActivationTable<Shift, kSigmoid> t{};
+  constexpr int kMid = SignedActivationTable<Shift, kSigmoid>::kEntries / 2;
+  constexpr std::int32_t kOffset = kSigmoid ? (std::int32_t{32769} << Shift) : 0;
+  for (int j = -kMid; j < kMid; ++j) {
+    std::int32_t e = 0;
+    std::int32_t d = 0;
+    if (j >= 0) {
+      e = (std::int32_t{kTanhQ15Table[j]} << Shift) + (1 << (Shift - 1));
+      d = kTanhQ15Table[j + 1] - kTanhQ15Table[j];
+    } else {
+      const int k = -j;
+      e = -(std::int32_t{kTanhQ15Table[k]} << Shift) + (1 << (Shift - 1)) - 1;
+      d = kTanhQ15Table[k] - kTanhQ15Table[k - 1];
+    }
+    t.e[kMid + j] = e + kOffset;
+    t.d[kMid + j] = static_cast<std::int16_t>(d);
+  }
+  return t;
+}
+
+// tanh reads the table at steps of 2^7 input units, sigmoid at 2^8 (tanh(x / 2)).
+constexpr auto kTanhSigned = signed_activation_table<7, false>();
+constexpr auto kSigmoidSigned = signed_activation_table<8, true>();
 
 inline bool word_aligned(const void* p) noexcept { return (reinterpret_cast<std::uintptr_t>(p) & 3u) == 0; }
 
@@ -226,11 +279,11 @@ void matvec_requantize_q15(const MatvecTerm& a, const MatvecTerm& b, const std::
 }
 
 void sigmoid_q15_block(std::int16_t* v, int n) noexcept {
-  if (n > 0) hadynet_sigmoid_block(v, n, fixed::detail::kTanhQ15Table);
+  if (n > 0) hadynet_sigmoid_block(v, n, kSigmoidSigned.e_zero(), kSigmoidSigned.d_zero());
 }
 
 void tanh_q15_block(std::int16_t* v, int n) noexcept {
-  if (n > 0) hadynet_tanh_block(v, n, fixed::detail::kTanhQ15Table);
+  if (n > 0) hadynet_tanh_block(v, n, kTanhSigned.e_zero(), kTanhSigned.d_zero());
 }
 
 void dot_rows_q15_i32(const std::int16_t* w, int stride, int rows, const std::int32_t* x, int cols,

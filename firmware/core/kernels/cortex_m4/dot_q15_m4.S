@@ -169,38 +169,31 @@ hadynet_mvp_end_b:
         .size   hadynet_matvec_pairs, . - hadynet_matvec_pairs
 
 @ ---------------------------------------------------------------------------
-@ hadynet_tanh_block(v, n, table) / hadynet_sigmoid_block(v, n, table)
-@ activation.h: m = |x|; tanh(m / 2^(shift + 5)) = T[i] + ((T[i+1] - T[i]) f
-@ + 2^(shift - 1)) >> shift with i = m >> shift, f = m mod 2^shift (f = 0
-@ gives T[i]); negated for x < 0. tanh: shift 7. sigmoid: shift 8, then
-@ (32768 + t + 1) >> 1, at most 32767.
-@   r0 v, r1 n, r2 table, r3 x, r4 m / f, r5 i / d, r6 T[i] | T[i+1] << 16,
-@   r7 y, r8 64 (tanh) or 32769 (sigmoid), r9 128 (sigmoid).
+@ hadynet_tanh_block(v, n, e, d) / hadynet_sigmoid_block(v, n, e, d)
+@ activation.h's interpolation on signed table entries (dot_q15.cc builds
+@ them from the tanh table and proves them equal): j = x >> shift (floor,
+@ negative for x < 0), g = x mod 2^shift, y = (E[j] + D[j] g) >> shift for
+@ tanh (shift 7), ssat16((E[j] + D[j] g) >> 9) for sigmoid (shift 8; E holds
+@ sigmoid's offset 32769 and its halving). e and d point at entry j = 0.
+@   r0 v, r1 n, r2 e, r3 d, r4 x / g, r5 j / D, r6 E / y.
         .global hadynet_tanh_block
         .type   hadynet_tanh_block, %function
         .thumb_func
         .p2align 2
 hadynet_tanh_block:
-        push    {r4-r8}
-        mov     r8, #64
+        push    {r4-r6}
 1:
-        ldrsh   r3, [r0]
-        eor     r4, r3, r3, asr #31
-        sub     r4, r4, r3, asr #31
-        usat    r4, #15, r4                     @ m = min(|x|, 32767): i <= 255
-        lsr     r5, r4, #7
-        and     r4, r4, #127
-        ldr     r6, [r2, r5, lsl #1]
-        sxth    r7, r6
-        rsb     r5, r7, r6, asr #16
-        mla     r5, r5, r4, r8                  @ (T[i+1] - T[i]) f + 64
-        add     r7, r7, r5, asr #7
-        eor     r7, r7, r3, asr #31
-        sub     r7, r7, r3, asr #31
-        strh    r7, [r0], #2
+        ldrsh   r4, [r0]
+        asr     r5, r4, #7                      @ j in [-256, 255]
+        and     r4, r4, #127                    @ g
+        ldr     r6, [r2, r5, lsl #2]            @ E[j]
+        ldrsh   r5, [r3, r5, lsl #1]            @ D[j]
+        mla     r6, r5, r4, r6
+        asr     r6, r6, #7
+        strh    r6, [r0], #2
         subs    r1, r1, #1
         bne     1b
-        pop     {r4-r8}
+        pop     {r4-r6}
         bx      lr
         .size   hadynet_tanh_block, . - hadynet_tanh_block
 
@@ -209,28 +202,19 @@ hadynet_tanh_block:
         .thumb_func
         .p2align 2
 hadynet_sigmoid_block:
-        push    {r4-r9}
-        movw    r8, #32769
-        mov     r9, #128
+        push    {r4-r6}
 1:
-        ldrsh   r3, [r0]
-        eor     r4, r3, r3, asr #31
-        sub     r4, r4, r3, asr #31             @ m = |x| <= 32768: i <= 128
-        lsr     r5, r4, #8
-        and     r4, r4, #255
-        ldr     r6, [r2, r5, lsl #1]
-        sxth    r7, r6
-        rsb     r5, r7, r6, asr #16
-        mla     r5, r5, r4, r9                  @ (T[i+1] - T[i]) f + 128
-        add     r7, r7, r5, asr #8
-        eor     r7, r7, r3, asr #31
-        sub     r7, r7, r3, asr #31
-        add     r7, r7, r8
-        ssat    r7, #16, r7, asr #1             @ (32768 + t + 1) >> 1, at most 32767
-        strh    r7, [r0], #2
+        ldrsh   r4, [r0]
+        asr     r5, r4, #8                      @ j in [-128, 127]
+        and     r4, r4, #255                    @ g
+        ldr     r6, [r2, r5, lsl #2]            @ E[j]
+        ldrsh   r5, [r3, r5, lsl #1]            @ D[j]
+        mla     r6, r5, r4, r6
+        ssat    r6, #16, r6, asr #9             @ (32768 + t + 1) >> 1, at most 32767
+        strh    r6, [r0], #2
         subs    r1, r1, #1
         bne     1b
-        pop     {r4-r9}
+        pop     {r4-r6}
         bx      lr
         .size   hadynet_sigmoid_block, . - hadynet_sigmoid_block
 
