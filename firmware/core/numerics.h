@@ -199,28 +199,23 @@ struct Numerics {
   // Wide accumulator of gradient products (int64 / float).
   using GradAcc = std::conditional_t<kFixed, std::int64_t, float>;
 
-  // out[c] = sum_r w[r][c] * g[r] for c < n_cols (first columns of W^T g),
-  // w in Q(WFrac), g and out at the gradient scale. Row-wise (axpy) order so
-  // both w and g are read contiguously; `scratch` holds n_cols accumulators.
-  // q15: exact int64 sums (|w g| < 2^46, Rows < 2^17), one rounding per
-  // output, saturated to int32.
-  // q15: the sums come from the build's kernel (kernels/dot_q15.h).
+  // f32: out[c] = sum_r w[r][c] * g[r] for c < n_cols (first columns of
+  // W^T g). Row-wise (axpy) order so both w and g are read contiguously;
+  // `scratch` holds n_cols accumulators. (q15 computes W^T g with
+  // kernels::dot_cols_packed_q15 on the packed matrices, hadynet_net.h.)
   template <int WFrac, int Rows, int Cols>
   static constexpr void transposed_matvec(const Value (&w)[Rows][Cols], const Grad* g, int n_cols,
-                                          Grad* out, GradAcc* scratch) noexcept {
-    if constexpr (kFixed) {
-      kernels::dot_cols_q15_i32(w[0], Cols, Rows, g, n_cols, scratch);
-      for (int c = 0; c < n_cols; ++c) out[c] = fixed::requantize_i32<WFrac, 0>(scratch[c]);
-    } else {
-      for (int c = 0; c < n_cols; ++c) scratch[c] = 0;
-      for (int r = 0; r < Rows; ++r) {
-        const Grad gr = g[r];
-        if (gr == 0) continue;  // same result, skips dead gates
-        const Value* row = w[r];
-        for (int c = 0; c < n_cols; ++c) scratch[c] += static_cast<GradAcc>(row[c]) * gr;
-      }
-      for (int c = 0; c < n_cols; ++c) out[c] = scratch[c];
+                                          Grad* out, GradAcc* scratch) noexcept
+    requires(!kFixed)
+  {
+    for (int c = 0; c < n_cols; ++c) scratch[c] = 0;
+    for (int r = 0; r < Rows; ++r) {
+      const Grad gr = g[r];
+      if (gr == 0) continue;  // same result, skips dead gates
+      const Value* row = w[r];
+      for (int c = 0; c < n_cols; ++c) scratch[c] += static_cast<GradAcc>(row[c]) * gr;
     }
+    for (int c = 0; c < n_cols; ++c) out[c] = scratch[c];
   }
 };
 

@@ -177,7 +177,7 @@ void test_matvec() noexcept {
     int a, b;
   };
   static constexpr Shifts kShifts[] = {{0, 0}, {2, 0}, {0, 2}, {15, 0}, {0, 31}, {3, 5}};
-  static constexpr int kOutShifts[] = {0, 1, 12, 14, 31, 32, 40};
+  static constexpr int kOutShifts[] = {0, 1, 12, 14, 15, 16, 31, 32, 40};
   for (const int rows : kRows) {
     for (const int cols_a : kColsA) {
       for (const int cols_b : kColsB) {
@@ -192,6 +192,38 @@ void test_matvec() noexcept {
           }
           run_matvec(rows, cols_a, s.a, cols_b, s.b, 12, 1, Pattern::kRandom);  // unaligned: the slow path
         }
+      }
+    }
+  }
+}
+
+// The forward kernel's 32-bit rounding at the edges of int32: sums (a bias
+// plus one product of +-1 or 0) at INT32_MAX, INT32_MIN, within half an
+// output LSB of them (where its saturating add saturates) and just beyond
+// them (the 64-bit rounding), for the output shifts around the 32-bit
+// path's limit of 15.
+void test_matvec_int32_edges() noexcept {
+  constexpr int kRowsEdge = 8;
+  constexpr int kCols = 8;
+  static constexpr int kOutShifts[] = {1, 2, 12, 15, 16};
+  static constexpr std::int16_t kX0[] = {-1, 0, 1};
+  for (const int out_shift : kOutShifts) {
+    const std::int32_t half = std::int32_t{1} << (out_shift - 1);
+    const std::int32_t biases[kRowsEdge] = {INT32_MAX,        INT32_MAX - 1,        INT32_MAX - half, INT32_MAX - half + 1,
+                                            INT32_MIN,        INT32_MIN + 1,        -half,            half - 1};
+    for (const std::int16_t x0 : kX0) {
+      for (int i = 0; i < kRowsEdge * kCols; ++i) g_wb[i] = (i % kCols == 0) ? std::int16_t{1} : std::int16_t{0};
+      pack(g_wb, kRowsEdge, kCols, g_pb);
+      for (int i = 0; i < kCols; ++i) g_xb[i] = i == 0 ? x0 : std::int16_t{0};
+      for (int r = 0; r < kRowsEdge; ++r) g_bias[r] = biases[r];
+      for (int r = 0; r <= kRowsEdge; ++r) g_out[r] = 0x5A5A;
+      const kernels::MatvecTerm b{g_pb, kCols, g_xb, 0};
+      kernels::matvec_requantize_q15({}, b, g_bias, kRowsEdge, out_shift, g_out);
+      ++g_cases;
+      for (int r = 0; r < kRowsEdge; ++r) {
+        const std::int64_t sum = std::int64_t{biases[r]} + x0;
+        const std::int16_t want = fixed::saturate_i16(fixed::rounding_shift_right(sum, out_shift));
+        if (g_out[r] != want) report_failure("matvec_requantize(int32 edges)", kRowsEdge, x0, out_shift, 0, r, g_out[r], want);
       }
     }
   }
@@ -234,70 +266,12 @@ void test_activations() noexcept {
   }
 }
 
-// ---- dot_rows_q15_i32 and dot_cols_q15_i32
+// ---- dot_cols_packed_q15
 
 constexpr int kWtRows = 130;
 constexpr int kWtCols = 520;
 std::int16_t g_wt[kWtRows * kWtCols + 2];
-std::int32_t g_g[kWtCols];
 std::int64_t g_acc[kWtCols];
-
-void test_rows_i32() noexcept {
-  static constexpr int kRows[] = {1, 2, 3, 8, 128};
-  static constexpr int kCols[] = {0, 1, 8, 9, 16, 504, 512, 520};
-  static constexpr int kPad[] = {0, 1, 8};
-  for (const int rows : kRows) {
-    for (const int cols : kCols) {
-      for (const int pad : kPad) {
-        const int stride = cols + pad;
-        if (stride == 0 || rows * stride > kWtRows * kWtCols) continue;
-        for (int p = 0; p < kPatterns; ++p) {
-          if (p != 0 && rows == 128 && cols > 16) continue;  // keep the run short
-          const Pattern pattern = static_cast<Pattern>(p);
-          for (int i = 0; i < rows * stride; ++i) g_wt[i] = value(pattern, i, false);
-          for (int c = 0; c < cols; ++c) g_g[c] = value32(pattern);
-          for (int r = 0; r <= rows; ++r) g_acc[r] = 0x5A5A5A5A5A5A5A5All;
-          kernels::dot_rows_q15_i32(g_wt, stride, rows, g_g, cols, g_acc);
-          ++g_cases;
-          for (int r = 0; r < rows; ++r) {
-            std::int64_t want = 0;
-            for (int c = 0; c < cols; ++c) want += std::int64_t{g_wt[r * stride + c]} * g_g[c];
-            if (g_acc[r] != want) report_failure("dot_rows_i32", rows, cols, stride, p, r, g_acc[r], want);
-          }
-          if (g_acc[rows] != 0x5A5A5A5A5A5A5A5All) report_failure("dot_rows_i32(overrun)", rows, cols, stride, p, rows, g_acc[rows], 0);
-        }
-      }
-    }
-  }
-}
-
-void test_cols_i32() noexcept {
-  static constexpr int kRows[] = {0, 1, 2, 7, 8, 9, 15, 16, 17, 27, 512};
-  static constexpr int kCols[] = {0, 1, 3, 4, 5, 8, 9, 16, 128, 130};
-  static constexpr int kPad[] = {0, 1, 8};
-  for (const int rows : kRows) {
-    for (const int cols : kCols) {
-      for (const int pad : kPad) {
-        const int stride = cols + pad;
-        if (stride == 0 || rows * stride > kWtRows * kWtCols) continue;
-        for (int p = 0; p < kPatterns; ++p) {
-          const Pattern pattern = static_cast<Pattern>(p);
-          for (int i = 0; i < rows * stride; ++i) g_wt[i] = value(pattern, i, false);
-          for (int r = 0; r < rows; ++r) g_g[r] = value32(pattern);
-          for (int c = 0; c <= cols; ++c) g_acc[c] = 0x5A5A5A5A5A5A5A5All;
-          kernels::dot_cols_q15_i32(g_wt, stride, rows, g_g, cols, g_acc);
-          ++g_cases;
-          for (int c = 0; c < cols; ++c) {
-            std::int64_t want = 0;
-            for (int r = 0; r < rows; ++r) want += static_cast<std::int64_t>(g_wt[r * stride + c]) * g_g[r];
-            if (g_acc[c] != want) report_failure("dot_cols_i32", rows, cols, stride, p, c, g_acc[c], want);
-          }
-          if (g_acc[cols] != 0x5A5A5A5A5A5A5A5All) report_failure("dot_cols_i32(overrun)", rows, cols, stride, p, cols, g_acc[cols], 0);
-        }
-      }
-    }
-  }
-}
 
 // W^T g on packed matrices (rows in pairs, columns in chunks of eight) with
 // int16 g: against the plain sum over packed_index. Row counts odd (the
@@ -348,9 +322,8 @@ int run_kernel_exactness(void (*emit)(std::string_view)) noexcept {
   g_cases = 0;
   g_failures = 0;
   test_matvec();
+  test_matvec_int32_edges();
   test_activations();
-  test_rows_i32();
-  test_cols_i32();
   test_cols_packed_q15();
   Text<96> line;
   line << "kernel exactness: " << g_cases << " cases, " << g_failures << " failures\n";

@@ -83,17 +83,6 @@ void tanh_q15_block(std::int16_t* v, int n) noexcept;
 // Backward: products with gradients
 // ---------------------------------------------------------------------------
 
-// acc[r] = sum_{c < cols} w[r * stride + c] * x[c] for r < rows: a row-major
-// int16 matrix (rows `stride` elements apart) times an int32 vector (the
-// controller's gradients: with W^T as `w` this is W^T g).
-void dot_rows_q15_i32(const std::int16_t* w, int stride, int rows, const std::int32_t* x, int cols,
-                      std::int64_t* acc) noexcept;
-
-// acc[c] = sum_{r < rows} w[r * stride + c] * g[r] for c < cols: W^T g from
-// the row-major W itself, for matrices without a transposed copy.
-void dot_cols_q15_i32(const std::int16_t* w, int stride, int rows, const std::int32_t* g, int cols,
-                      std::int64_t* acc) noexcept;
-
 // acc[c] = sum_{r < rows} W(r, c) * g[r] for c < cols, W a packed matrix
 // (`w` = PackedMatrix::data, `padded_cols` = its kCols) and g int16: W^T g
 // from the forward kernel's own storage, so a model keeps one copy of each

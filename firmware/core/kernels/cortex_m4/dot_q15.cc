@@ -24,20 +24,8 @@
 // tables indexed by the signed x (SignedActivationTable below, built at
 // compile time from the tanh table), so no |x| and no sign at run time: per
 // value one LDR and one LDRSH of the entry, one multiply-add, one shift (and
-// SSAT for sigmoid): 10 instructions. tanh clamps |x| = 32768 (x = -32768) to 32767 so it
-// never reads past the table: exact because the table's last two entries are
-// both 32767 (checked, with every other input, by the exhaustive test).
-//
-// dot_rows_q15_i32 (W^T g with a transposed W): the int32 vector is split
-// exactly into int16 halves, g = 2^16 gh + gl with gl the sign-extended low
-// half (so gh = (g - gl) / 2^16 fits int16 unless g >= 2^31 - 2^15), stored
-// eight gh then eight gl at a time; per eight columns one LDM of W, two LDM
-// of g and eight SMLALD into two accumulators: 11 instructions per 8 MACs;
-// sum = 2^16 sum_h + sum_l.
-//
-// dot_cols_q15_i32 (W^T g from a row-major W): SMLAL (32 x 32 + 64) per
-// product, four columns per row of W sharing the load of g[r], eight rows
-// unrolled: about 2.56 instructions per MAC.
+// SSAT for sigmoid): 10 instructions; every input of both is checked against
+// activation.cc by the exhaustive test.
 //
 // dot_cols_packed_q15 (W^T g from the packed forward matrix, g int16 block
 // floating point): a transposed product needs pairs along the rows, which
@@ -46,9 +34,8 @@
 // (no unpacking, no split of g): per row pair one word of g, one LDRD of
 // each row's four columns, eight SMLAL<x><y>: 12 instructions per 8 MACs.
 //
-// Shapes outside the fast paths (column counts not a multiple of 8, odd
-// strides, unaligned rows or vectors, out-of-range shifts, gradients near
-// INT32_MAX) call the reference kernels (reference/dot_q15_reference.h):
+// Shapes outside the fast paths (column counts not a multiple of 8 or 4,
+// unaligned rows or vectors, out-of-range shifts) call the reference kernels (reference/dot_q15_reference.h):
 // slower, equally exact. All of it is tested bit-exactly against
 // fixed_point.h in QEMU (test/boards/kernel_exactness_main.cc).
 #include "firmware/core/kernels/dot_q15.h"
@@ -95,23 +82,6 @@ extern const char hadynet_mvp_end_b[];
 void hadynet_tanh_block(std::int16_t* v, int n, const std::int32_t* e, const std::int16_t* d) noexcept;
 void hadynet_sigmoid_block(std::int16_t* v, int n, const std::int32_t* e, const std::int16_t* d) noexcept;
 
-// Parameter block of hadynet_dot_rows_split.
-struct HadynetSplitJob {
-  const std::int16_t* row;     // 0: current row of W
-  std::int32_t rows;           // 1: rows left (>= 1)
-  std::int64_t* out;           // 2
-  std::int32_t stride;         // 3: bytes
-  const std::int16_t* split;   // 4: 8 gh, 8 gl, 8 gh, ... (int16)
-  std::uint32_t entry;         // 5: | 1
-};
-// out[r] = 2^16 * sum W_r gh + sum W_r gl.
-void hadynet_dot_rows_split(const HadynetSplitJob* job) noexcept;
-extern const char hadynet_split_end[];
-
-// out[j] = sum_{r < rows} w[r * stride + j] g[r] for j = 0..3; rows >= 1.
-void hadynet_dot_cols4(const std::int16_t* w, int stride_bytes, const std::int32_t* g, int rows,
-                       std::int64_t* out) noexcept;
-
 // out[j] = sum over the `pairs` row pairs p (pairs >= 1) of
 // W(2p, j) g[2p] + W(2p + 1, j) g[2p + 1] for j = 0..3, w pointing at
 // W(0, j0) of a packed matrix (row 2p + 1 sixteen bytes after row 2p, pairs
@@ -137,13 +107,6 @@ static_assert(offsetof(HadynetMatvecJob, b_x) == HADYNET_MVP_B_X);
 static_assert(offsetof(HadynetMatvecJob, b_entry) == HADYNET_MVP_B_ENTRY);
 static_assert(offsetof(HadynetMatvecJob, a_shift) == HADYNET_MVP_A_SHIFT);
 static_assert(offsetof(HadynetMatvecJob, a_shift_rest) == HADYNET_MVP_A_SHIFT_REST);
-static_assert(sizeof(HadynetSplitJob) == HADYNET_SPLIT_JOB_BYTES);
-static_assert(offsetof(HadynetSplitJob, row) == HADYNET_SPLIT_ROW);
-static_assert(offsetof(HadynetSplitJob, rows) == HADYNET_SPLIT_ROWS);
-static_assert(offsetof(HadynetSplitJob, out) == HADYNET_SPLIT_OUT);
-static_assert(offsetof(HadynetSplitJob, stride) == HADYNET_SPLIT_STRIDE);
-static_assert(offsetof(HadynetSplitJob, split) == HADYNET_SPLIT_G);
-static_assert(offsetof(HadynetSplitJob, entry) == HADYNET_SPLIT_ENTRY);
 
 
 namespace hadynet::kernels {
@@ -151,11 +114,6 @@ namespace {
 
 constexpr int kMvpMaxCols = 8 * HADYNET_MVP_BLOCKS;
 constexpr int kMvpBlockBytes = HADYNET_MVP_BLOCK_BYTES;
-constexpr int kSplitMaxCols = 8 * HADYNET_SPLIT_BLOCKS;
-constexpr int kSplitBlockBytes = HADYNET_SPLIT_BLOCK_BYTES;
-// g >= 2^31 - 2^15 has no int16 high half (gh would be 2^15).
-constexpr std::int32_t kSplitMax = 0x7FFF7FFF;
-
 // activation.h's interpolation indexed by the signed input. The reference
 // (activation.cc) computes, with m = |x|, i = m >> s, f = m mod 2^s,
 // T the tanh table and D_i = T[i+1] - T[i]:
@@ -223,10 +181,6 @@ bool fast_term(const MatvecTerm& t) noexcept {
          t.shift <= 31;
 }
 
-// The split of g for hadynet_dot_rows_split (static: the firmware is
-// single-threaded and nothing here is reentrant).
-alignas(8) std::int16_t g_split[2 * kSplitMaxCols];
-
 }  // namespace
 
 void matvec_requantize_q15(const MatvecTerm& a, const MatvecTerm& b, const std::int32_t* bias, int rows,
@@ -284,43 +238,6 @@ void sigmoid_q15_block(std::int16_t* v, int n) noexcept {
 
 void tanh_q15_block(std::int16_t* v, int n) noexcept {
   if (n > 0) hadynet_tanh_block(v, n, kTanhSigned.e_zero(), kTanhSigned.d_zero());
-}
-
-void dot_rows_q15_i32(const std::int16_t* w, int stride, int rows, const std::int32_t* x, int cols,
-                      std::int64_t* acc) noexcept {
-  if (rows <= 0) return;
-  bool fast = cols > 0 && cols % 8 == 0 && cols <= kSplitMaxCols && word_aligned(w) && (stride & 1) == 0;
-  if (fast) {
-    // g = 2^16 gh + gl, gl the sign-extended low half; eight gh, eight gl, ...
-    for (int c0 = 0; c0 < cols && fast; c0 += 8) {
-      std::int16_t* block = g_split + 2 * c0;
-      for (int i = 0; i < 8; ++i) {
-        const std::int32_t g = x[c0 + i];
-        if (g > kSplitMax) {
-          fast = false;
-          break;
-        }
-        const auto low = static_cast<std::int16_t>(static_cast<std::uint32_t>(g) & 0xFFFFu);
-        block[i] = static_cast<std::int16_t>((g - low) / 65536);  // exact: g - low is a multiple of 2^16
-        block[8 + i] = low;
-      }
-    }
-  }
-  if (!fast) {
-    reference::dot_rows_q15_i32(w, stride, rows, x, cols, acc);
-    return;
-  }
-  const HadynetSplitJob job = {w, rows, acc, 2 * stride, g_split, entry(hadynet_split_end, cols / 8, kSplitBlockBytes)};
-  hadynet_dot_rows_split(&job);
-}
-
-void dot_cols_q15_i32(const std::int16_t* w, int stride, int rows, const std::int32_t* g, int cols,
-                      std::int64_t* acc) noexcept {
-  int c = 0;
-  if (rows > 0) {
-    for (; c + 4 <= cols; c += 4) hadynet_dot_cols4(w + c, 2 * stride, g, rows, acc + c);
-  }
-  if (c < cols) reference::dot_cols_q15_i32(w + c, stride, rows, g, cols - c, acc + c);  // the last cols % 4
 }
 
 // W^T g on a packed matrix with int16 g: four columns (inside one chunk of

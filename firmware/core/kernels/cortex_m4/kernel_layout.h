@@ -32,22 +32,6 @@
 #define HADYNET_MVP_A_SHIFT 64
 #define HADYNET_MVP_A_SHIFT_REST 68
 
-/* hadynet_dot_rows_split: one block = 8 columns, 11 32-bit instructions; up
- * to 64 blocks (512 columns). */
-#define HADYNET_SPLIT_BLOCKS 64
-#define HADYNET_SPLIT_BLOCK_BYTES 44
-/* HadynetSplitJob (6 words, copied onto the assembly's stack). */
-#define HADYNET_SPLIT_JOB_BYTES 24
-#define HADYNET_SPLIT_ROW 0
-#define HADYNET_SPLIT_ROWS 4
-#define HADYNET_SPLIT_OUT 8
-#define HADYNET_SPLIT_STRIDE 12
-#define HADYNET_SPLIT_G 16
-#define HADYNET_SPLIT_ENTRY 20
-
-/* hadynet_dot_cols4: one row of four columns, 10 32-bit instructions. */
-#define HADYNET_COLS_ROW_BYTES 40
-
 /* hadynet_dot_cols4_q15: one row pair of four columns, 12 32-bit instructions. */
 #define HADYNET_COLS_Q15_PAIR_BYTES 48
 

@@ -15,16 +15,6 @@ void sigmoid_q15_block(std::int16_t* v, int n) noexcept { reference::sigmoid_q15
 
 void tanh_q15_block(std::int16_t* v, int n) noexcept { reference::tanh_q15_block(v, n); }
 
-void dot_rows_q15_i32(const std::int16_t* w, int stride, int rows, const std::int32_t* x, int cols,
-                      std::int64_t* acc) noexcept {
-  reference::dot_rows_q15_i32(w, stride, rows, x, cols, acc);
-}
-
-void dot_cols_q15_i32(const std::int16_t* w, int stride, int rows, const std::int32_t* g, int cols,
-                      std::int64_t* acc) noexcept {
-  reference::dot_cols_q15_i32(w, stride, rows, g, cols, acc);
-}
-
 void dot_cols_packed_q15(const std::int16_t* w, int padded_cols, int rows, const std::int16_t* g, int cols,
                          std::int64_t* acc) noexcept {
   reference::dot_cols_packed_q15(w, padded_cols, rows, g, cols, acc);

@@ -58,26 +58,6 @@ void tanh_q15_block(std::int16_t* v, int n) noexcept {
   for (int i = 0; i < n; ++i) v[i] = fixed::tanh_q15(v[i]);
 }
 
-void dot_rows_q15_i32(const std::int16_t* w, int stride, int rows, const std::int32_t* x, int cols,
-                      std::int64_t* acc) noexcept {
-  for (int r = 0; r < rows; ++r) {
-    const std::int16_t* row = w + static_cast<long>(r) * stride;
-    std::int64_t sum = 0;
-    for (int c = 0; c < cols; ++c) sum += std::int64_t{row[c]} * x[c];
-    acc[r] = sum;
-  }
-}
-
-void dot_cols_q15_i32(const std::int16_t* w, int stride, int rows, const std::int32_t* g, int cols,
-                      std::int64_t* acc) noexcept {
-  for (int c = 0; c < cols; ++c) acc[c] = 0;
-  for (int r = 0; r < rows; ++r) {
-    const std::int64_t gr = g[r];
-    const std::int16_t* row = w + static_cast<long>(r) * stride;
-    for (int c = 0; c < cols; ++c) acc[c] += row[c] * gr;
-  }
-}
-
 void dot_cols_packed_q15(const std::int16_t* w, int padded_cols, int rows, const std::int16_t* g, int cols,
                          std::int64_t* acc) noexcept {
   for (int c = 0; c < cols; ++c) acc[c] = 0;

@@ -17,10 +17,6 @@ void matvec_requantize_q15(const MatvecTerm& a, const MatvecTerm& b, const std::
                            int out_shift, std::int16_t* out) noexcept;
 void sigmoid_q15_block(std::int16_t* v, int n) noexcept;
 void tanh_q15_block(std::int16_t* v, int n) noexcept;
-void dot_rows_q15_i32(const std::int16_t* w, int stride, int rows, const std::int32_t* x, int cols,
-                      std::int64_t* acc) noexcept;
-void dot_cols_q15_i32(const std::int16_t* w, int stride, int rows, const std::int32_t* g, int cols,
-                      std::int64_t* acc) noexcept;
 void dot_cols_packed_q15(const std::int16_t* w, int padded_cols, int rows, const std::int16_t* g, int cols,
                          std::int64_t* acc) noexcept;
 
