@@ -82,7 +82,9 @@ class HadynetNet {
   // One LSTM step with command u (Q(kFracIn)); writes y (Q(kFracY)). If
   // `trace` is not null it receives what backward() needs for this step.
   void step(const Value (&u)[kU], Value (&y)[kY], StepTrace<M>* trace = nullptr) noexcept {
-    Value gates[kGates];
+    // The gates go straight into the trace when there is one.
+    Value gates_local[kGates];
+    Value* const gates = trace != nullptr ? trace->gates : gates_local;
     constexpr int kAccFrac = M::kFracLstmAcc;
     constexpr int kInShift = kAccFrac - (M::kFracLstmW + M::kFracIn);
     constexpr int kHShift = kAccFrac - (M::kFracLstmW + M::kFracH);
@@ -118,7 +120,6 @@ class HadynetNet {
     Value* const tc = trace != nullptr ? trace->tanh_c : tanh_c_local;
     if (trace != nullptr) {
       for (int j = 0; j < kH; ++j) trace->c_prev[j] = c_[j];
-      for (int r = 0; r < kGates; ++r) trace->gates[r] = gates[r];
     }
     if constexpr (N::kFixed) {
       constexpr int C = M::kFracC;
@@ -187,7 +188,7 @@ class HadynetNet {
       const auto& ih = t_->weights.ih;
       kernels::dot_cols_packed_q15(ih.data, ih.kCols, kGates, block.mantissa, kU, scratch_);
       for (int k = 0; k < kU; ++k)
-        du[k] = N::grad_add(du[k], fixed::requantize_i32<M::kFracLstmW, 0>(block.scaled(scratch_[k])));
+        du[k] = N::grad_add(du[k], fixed::bounded::requantize_i32<M::kFracLstmW, 0>(block.scaled(scratch_[k])));
       if (dh_prev != nullptr) hidden_gradient(block, dh_prev);
     } else {
       Grad du_step[kU];
@@ -220,7 +221,7 @@ class HadynetNet {
             scratch_[i] += std::int64_t{ih.data[kernels::packed_index(ih.kCols, r, kU + i)]} * block.mantissa[r];
       }
       for (int i = 0; i < kPb; ++i)
-        dpb[i] = N::grad_add(dpb[i], fixed::requantize_i32<M::kFracLstmW, 0>(block.scaled(scratch_[i])));
+        dpb[i] = N::grad_add(dpb[i], fixed::bounded::requantize_i32<M::kFracLstmW, 0>(block.scaled(scratch_[i])));
       if (dh_prev != nullptr) hidden_gradient(block, dh_prev);
     } else {
       for (int i = 0; i < kPb; ++i) scratch_[i] = 0;
@@ -265,7 +266,7 @@ class HadynetNet {
       const auto& dec = t_->weights.dec;
       const BlockGrad<kY> block(dy);
       kernels::dot_cols_packed_q15(dec.data, dec.kCols, kY, block.mantissa, kH, scratch_);
-      for (int j = 0; j < kH; ++j) d[j] = fixed::requantize_i32<M::kFracDecW, 0>(block.scaled(scratch_[j]));
+      for (int j = 0; j < kH; ++j) d[j] = fixed::bounded::requantize_i32<M::kFracDecW, 0>(block.scaled(scratch_[j]));
     } else {
       N::template transposed_matvec<M::kFracDecW>(t_->weights.dec, dy, kH, d, scratch_);
     }
@@ -324,7 +325,10 @@ class HadynetNet {
     explicit BlockGrad(const Grad (&g)[n]) noexcept : shift(grad_block_q15(g, n, mantissa)) {
       if constexpr (n % 2 != 0) mantissa[n] = 0;
     }
-    // A sum over mantissas back at the gradients' scale (exact).
+    // A sum over mantissas back at the gradients' scale (exact). With at
+    // most 2^13 terms of |W m| <= 2^30 and s <= 17 it stays below 2^60,
+    // inside fixed::bounded's domain.
+    static_assert(n <= 8192, "scaled sums must stay below 2^62 (fixed::bounded)");
     std::int64_t scaled(std::int64_t sum) const noexcept { return sum * (std::int64_t{1} << shift); }
   };
 
@@ -340,7 +344,7 @@ class HadynetNet {
   {
     const NetworkWeights<M>& kw = t_->weights;
     kernels::dot_cols_packed_q15(kw.hh.data, kw.hh.kCols, kGates, block.mantissa, kH, scratch_);
-    for (int j = 0; j < kH; ++j) dh_prev[j] = fixed::requantize_i32<M::kFracLstmW, 0>(block.scaled(scratch_[j]));
+    for (int j = 0; j < kH; ++j) dh_prev[j] = fixed::bounded::requantize_i32<M::kFracLstmW, 0>(block.scaled(scratch_[j]));
   }
 
   // q15: h as the packed kernels read it, kH values then zeros up to a
