@@ -8,10 +8,10 @@ with its instructions ("IN:" listings) and every execution of a block
 over the blocks that start inside a function of the ELF's symbol table, are
 that function's instructions (inlined code counts for its caller).
 
---between SYMBOL N: count only what runs after the N-th and before the
-(N+1)-th entry into SYMBOL (for the benchmark image: Bench<...>::report is
-entered once per job, so N = 2 is the control_full job: its warm-up period
-and its timed periods).
+--between SYMBOL N: count only what runs from the N-th to the (N+1)-th
+entry into SYMBOL (for the benchmark image: Bench<...>::report is entered
+once per job, so N = 2 is the control_full job: its warm-up period and its
+timed periods, plus the N-th report's few hundred instructions).
 
 Run it without -icount: under -icount QEMU translates shortened blocks at the
 end of each instruction budget, and a block's listing would no longer be the
@@ -82,10 +82,12 @@ def main():
                 in_listing = False
             continue
         if line.startswith("Trace"):
-            m = re.search(r"/([0-9a-f]{8})/", line)
+            # "Trace N: host [cs_base/pc/flags/...] name" (the pc unpadded
+            # from QEMU 8.1 on).
+            m = re.search(r"\[([0-9a-f]+)/([0-9a-f]+)/", line)
             if not m:
                 continue
-            pc = int(m.group(1), 16)
+            pc = int(m.group(2), 16)
             if marker is not None:
                 if pc == marker:
                     entries += 1
@@ -93,6 +95,10 @@ def main():
                     continue
             executions[pc] += 1
 
+    if marker is not None and entries < window:
+        sys.exit("qemu_profile: %s was entered %d times, fewer than %d" % (args.between[0], entries, window))
+    if not executions:
+        sys.exit("qemu_profile: no executed blocks in the trace")
     per_function = collections.Counter()
     for pc, n in executions.items():
         per_function[function(pc)] += n * block_size.get(pc, 1)

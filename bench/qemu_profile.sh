@@ -36,7 +36,10 @@ if [[ ! -f "$elf" ]]; then
 fi
 
 work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+counter=
+# The counter blocks opening the FIFO until QEMU opens it: if QEMU never
+# does, it is killed here.
+trap '[[ -n "$counter" ]] && kill "$counter" 2>/dev/null; rm -rf "$work"' EXIT
 mkfifo "$work/trace"
 python3 bench/qemu_profile.py "$elf" --between 'hadynet::app::Bench<hadynet::model_q15::Model>::report' "$job" \
   --top "$top" < "$work/trace" &
@@ -45,4 +48,7 @@ counter=$!
 timeout 1200 "${QEMU:-qemu-system-arm}" -M mps2-an386 -nographic -monitor none -serial null \
   -semihosting-config enable=on,target=native -d in_asm,exec,nochain -D "$work/trace" \
   -kernel "$elf" </dev/null
-wait "$counter"
+status=0
+wait "$counter" || status=$?
+counter=
+exit "$status"

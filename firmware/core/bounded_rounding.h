@@ -3,8 +3,9 @@
 // backward pass, the gradients' block floating point): branch-free, with
 // compile-time shifts, on a stated bounded domain. On that domain each
 // function equals its fixed_point.h reference bit for bit
-// (test/firmware/bounded_rounding_test.cc checks edges, every tie and random
-// values against the reference); outside it, it is not defined, so a caller
+// (test/firmware/bounded_rounding_test.cc checks edges, ties and random
+// values of every magnitude against the reference, the int16 forms on every
+// input); outside it, it is not defined, so a caller
 // states why its values stay inside.
 //
 // fixed_point.h stays the readable reference; these exist because its

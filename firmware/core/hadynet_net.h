@@ -177,7 +177,8 @@ class HadynetNet {
     gate_gradients(trace, dh, dc, dgates);
     // The chain rule runs on real values: a gradient's raw value is its real
     // value times one constant; products with a Q(F) operand divide by 2^F
-    // (grad_mul<F>, transposed_matvec<F>), so the constant never changes.
+    // (grad_mul<F>; the W^T products requantised from Q(F)), so the constant
+    // never changes.
     // Requantising a pre-activation is the identity on reals (saturation is
     // not differentiated).
     if constexpr (N::kFixed) {

@@ -16,7 +16,6 @@
 #include "firmware/core/activation.h"
 #include "firmware/core/bounded_rounding.h"
 #include "firmware/core/fixed_point.h"
-#include "firmware/core/kernels/dot_q15.h"
 #include "firmware/core/model_contract.h"
 
 namespace hadynet::firmware {
@@ -50,7 +49,8 @@ constexpr std::int32_t grad_scaled(std::int64_t v, int shift) noexcept {
 // smallest s for which the largest |g| has at most 15 bits. s = 0 (exact)
 // while every |g| < 2^15; otherwise each mantissa is within half an LSB of
 // g / 2^s, 2^-15 of the largest. The caller multiplies the kernel's sums by
-// 2^s (exact in int64: |sum| < 2^46 for < 2^16 rows, s <= 17).
+// 2^s (exact in int64; for at most 2^13 rows |sum 2^s| < 2^60, the bound
+// HadynetNet's BlockGrad asserts for fixed::bounded's rounding).
 inline int grad_block_q15(const std::int32_t* g, int n, std::int16_t* out) noexcept {
   // The bit length of the largest |g| is that of the OR of all |g| (the
   // same highest bit), which needs no compare per value.

@@ -40,8 +40,8 @@ inline constexpr std::uint32_t kDfuHeaderCheckMs = 250;
 // and again in the mapped view by the slot check), one Ed25519 verification
 // (the slot check), the 256-byte header programmed and read back (6.4 ms
 // worst case), and for a forced downgrade one 16-byte flag (0.4 ms). For
-// the hand's payload (181 032 bytes when measured, 181 048 since contract
-// 6; 69 instructions/byte) 25 M + 3 M instructions, 167 ms at one
+// the hand's payload (181 032 bytes when measured, 172 856 since contract
+// 7; 69 instructions/byte) 25 M + 3 M instructions, 167 ms at one
 // instruction per cycle at 168 MHz; for a payload filling a whole F405
 // slot (261 120 bytes) 39 M, 233 ms. NOT measured on the F405 yet (the
 // colleague writing the crypto measures it on the Cortex-M4); 2000 ms

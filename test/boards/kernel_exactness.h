@@ -9,15 +9,15 @@
 //
 // Cases: shapes around the kernels' fast paths and their edges (column
 // counts below, at and above multiples of 8 and the unrolled maxima, odd row
-// counts (the packed matrices' padding row), row strides with padding, odd
-// strides, matrices and vectors half a word off alignment, junk in x beyond
-// a packed matrix's real columns), shifts and output shifts including 0 and
-// the largest the kernels accept in registers and beyond, and data that
-// stresses the accumulators: uniform random, all (-32768)*(-32768) (the largest product,
-// where a 32-bit SMLAD overflows), (-32768)*32767, alternating rails, random
-// rail values; int32 vectors at INT32_MIN, INT32_MAX and around
-// 2^31 - 2^15 (where the kernel's int16 split of g stops being possible);
-// int16 gradients with junk in the padding entry an odd row count reads.
+// counts (the packed matrices' padding row), matrices and vectors half a
+// word off alignment, junk in x beyond a packed matrix's real columns),
+// shifts and output shifts including 0 and the largest the kernels accept in
+// registers and beyond, and data that stresses the accumulators: uniform
+// random, all (-32768)*(-32768) (the largest product, where a 32-bit SMLAD
+// overflows), (-32768)*32767, alternating rails, random rail values; biases
+// at INT32_MIN and INT32_MAX and sums at the edges of int32 (the forward
+// kernel's 32-bit rounding); int16 gradients with junk in the padding entry
+// an odd row count reads.
 #ifndef HADYNET_TEST_BOARDS_KERNEL_EXACTNESS_H_
 #define HADYNET_TEST_BOARDS_KERNEL_EXACTNESS_H_
 
@@ -77,7 +77,7 @@ std::int32_t value32(Pattern p) noexcept {
     case Pattern::kMinMin:
       return INT32_MIN;
     case Pattern::kMinMax:
-      return 0x7FFF7FFF;  // the largest g the DSP kernel splits
+      return 0x7FFF7FFF;
     case Pattern::kAlternating:
       return (next_random() & 1u) != 0 ? INT32_MIN : 0x7FFF7FFF;
     case Pattern::kRails:
@@ -199,13 +199,12 @@ void test_matvec() noexcept {
 
 // The forward kernel's 32-bit rounding at the edges of int32: sums (a bias
 // plus one product of +-1 or 0) at INT32_MAX, INT32_MIN, within half an
-// output LSB of them (where its saturating add saturates) and just beyond
-// them (the 64-bit rounding), for the output shifts around the 32-bit
-// path's limit of 15.
+// output LSB of them (where adding half overflows and the 64-bit rounding
+// takes over) and just beyond them, for small and large output shifts.
 void test_matvec_int32_edges() noexcept {
   constexpr int kRowsEdge = 8;
   constexpr int kCols = 8;
-  static constexpr int kOutShifts[] = {1, 2, 12, 15, 16};
+  static constexpr int kOutShifts[] = {1, 2, 12, 15, 16, 17, 31};
   static constexpr std::int16_t kX0[] = {-1, 0, 1};
   for (const int out_shift : kOutShifts) {
     const std::int32_t half = std::int32_t{1} << (out_shift - 1);

@@ -1,7 +1,8 @@
 // The hot loops' rounding (bounded_rounding.h) against fixed_point.h's
 // reference, on the domains bounded_rounding.h states: equal bit for bit at
-// the domains' edges, at every tie of small shifts, and on random values of
-// every magnitude. No tolerance: the contract is equality.
+// the domains' edges, at the ties around random values of every magnitude,
+// on those values, and on every int16 input where that is cheap. No
+// tolerance: the contract is equality.
 #include "firmware/core/bounded_rounding.h"
 
 #include <gtest/gtest.h>
@@ -139,9 +140,33 @@ void check_cell_update() {
   for (int n = 0; n < 400000; ++n) {
     const std::int16_t f = draw(), c = draw(), i = draw(), g = draw();
     ASSERT_EQ(bounded::cell_update<C>(f, c, i, g), reference(f, c, i, g)) << f << " " << c << " " << i << " " << g;
-    // A tie: g a multiple of 2^(15 - C) makes i g's low bits zero.
-    const auto g_tie = static_cast<std::int16_t>(g & ~((1 << (15 - C)) - 1));
-    ASSERT_EQ(bounded::cell_update<C>(f, c, i, g_tie), reference(f, c, i, g_tie)) << f << " " << c << " " << i << " " << g_tie;
+    // i g's low bits zero (g a multiple of 2^(15 - C)) ...
+    const auto g_low = static_cast<std::int16_t>(g & ~((1 << (15 - C)) - 1));
+    ASSERT_EQ(bounded::cell_update<C>(f, c, i, g_low), reference(f, c, i, g_low)) << f << " " << c << " " << i << " " << g_low;
+    // ... and a real tie: with f = +-1 the sum is 2^C (2^k a + 0), a tie
+    // when a = +-c + (i g >> k) is 2^14 mod 2^15; c picked to make it so.
+    if constexpr (C < 15) {
+      constexpr int k = 15 - C;
+      const std::int32_t high = (std::int32_t{i} * g_low) >> k;
+      const std::int32_t need = ((std::int32_t{1} << 14) - high) & 0x7FFF;  // c mod 2^15
+      for (const std::int32_t c_tie : {need, need - 32768}) {
+        const auto ct = static_cast<std::int16_t>(c_tie);
+        ASSERT_EQ(bounded::cell_update<C>(1, ct, i, g_low), reference(1, ct, i, g_low)) << ct << " " << i << " " << g_low;
+        const auto cn = static_cast<std::int16_t>(-c_tie == 32768 ? -32768 : -c_tie);
+        ASSERT_EQ(bounded::cell_update<C>(-1, cn, i, g_low), reference(-1, cn, i, g_low)) << cn << " " << i << " " << g_low;
+      }
+    }
+  }
+}
+
+// The gate slopes' roundings (numerics.h: s (2^15 - s) and t^2, both >> 15
+// in int32) on every int16 input.
+TEST(BoundedRounding, SlopeRoundingsEqualTheReferenceOnEveryInput) {
+  for (std::int32_t v = INT16_MIN; v <= INT16_MAX; ++v) {
+    const std::int32_t sigmoid_product = v * (32768 - v);
+    ASSERT_EQ(bounded::rounding_shift_right_i32<15>(sigmoid_product), rounding_shift_right(sigmoid_product, 15)) << v;
+    const std::int32_t tanh_product = v * v;
+    ASSERT_EQ(bounded::rounding_shift_right_i32<15>(tanh_product), rounding_shift_right(tanh_product, 15)) << v;
   }
 }
 

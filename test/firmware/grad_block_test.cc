@@ -53,6 +53,11 @@ TEST(GradBlockQ15, ExponentFollowsTheLargestMagnitude) {
   check({1 << 20, -(1 << 20) + 1, 7});
   check({INT32_MIN, INT32_MAX, 0, -1, 1});  // s = 17
   check({0, 0, 0});
+  // Where the int32 rounding (s <= 15) meets the int64 one (s = 16, 17).
+  check({(1 << 30) - 1, -5, 16385, -16385});        // s = 15
+  check({-(1 << 30) + 1, 5, (1 << 30) - (1 << 14)});  // s = 15, the largest |g| + half
+  check({1 << 30, -3, 32769});                       // s = 16
+  check({-(1 << 30), 3, -32769});                    // s = 16
 }
 
 TEST(GradBlockQ15, TiesRoundAwayFromZero) {

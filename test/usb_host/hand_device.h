@@ -12,7 +12,7 @@
 // The flash has the F405's sector table but its worst-case times scaled to
 // 1 % (8/24/40 ms erases) and 1 us per programmed byte: the DFU clients
 // really sleep every bwPollTimeout, and at the datasheet's figures one
-// 181 KB image asks for 8 s of erase and 4.5 s of programming waits. The
+// 173 KB image asks for 8 s of erase and 4.3 s of programming waits. The
 // exact F405 poll times are test/usb's (dfu_test.cc).
 //
 // Like every EmulatedDevice, call its methods under the bus lock

@@ -10,8 +10,9 @@
 // fixed_point.h and activation.h in QEMU). No core header says #ifdef:
 // firmware/CMakeLists.txt picks the file.
 //
-// Sums are exact in int64: |int16 * int32| <= 2^46 and fewer than 2^16 terms
-// stay far below 2^63, in any order. rows, cols >= 0.
+// Sums are exact in int64: |int16 * int16| <= 2^30 and fewer than 2^16 terms
+// (plus an int32 bias, shifted by at most 31) stay far below 2^63, in any
+// order. rows, cols >= 0.
 #ifndef HADYNET_FIRMWARE_CORE_KERNELS_DOT_Q15_H_
 #define HADYNET_FIRMWARE_CORE_KERNELS_DOT_Q15_H_
 

@@ -17,8 +17,9 @@
 // term the accumulators are shifted by the difference of the two terms'
 // shifts, the second term accumulates on top, then bias, rounding (half away
 // from zero), the shift to the output format and the saturation to int16 run
-// in registers: in 32 bits (QADD, ASR, SSAT) when the exact sum fits int32,
-// which the gates' sums do, else on the 64-bit sum out of line.
+// in registers: in 32 bits (ADDS, ASR, SSAT) when the exact sum plus half an
+// output LSB fits int32, as the gates' sums typically do, else on the 64-bit
+// sum out of line.
 //
 // sigmoid_q15_block / tanh_q15_block: activation.h's table interpolation on
 // tables indexed by the signed x (SignedActivationTable below, built at
@@ -56,7 +57,7 @@ struct HadynetMatvecJob {
   const std::int32_t* bias;    // 0
   std::int16_t* out;           // 1
   std::int32_t half;           // 2: 2^(out_shift - 1)
-  std::int32_t out_shift;      // 3: 1..15
+  std::int32_t out_shift;      // 3: 1..31
   std::int32_t out_shift_rest; // 4: 32 - out_shift
   std::int32_t pairs;          // 5: row pairs left (>= 1)
   const std::int16_t* a_x;     // 6
@@ -192,7 +193,7 @@ void matvec_requantize_q15(const MatvecTerm& a, const MatvecTerm& b, const std::
   const MatvecTerm& first = swap ? b : a;
   const MatvecTerm& second = swap ? a : b;
   const bool fast = fast_term(first) && fast_term(second) && (second.cols <= 0 || second.shift == 0) &&
-                    out_shift >= 1 && out_shift <= 15 && bias != nullptr;
+                    out_shift >= 1 && out_shift <= 31 && bias != nullptr;
   if (!fast) {
     reference::matvec_requantize_q15(a, b, bias, rows, out_shift, out);
     return;

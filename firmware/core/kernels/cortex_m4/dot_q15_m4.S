@@ -83,15 +83,16 @@
         eorne   \lo, \lo, \hi, asr #31
         .endm
 
-@ The same when the sum fits int32 (hi is lo's sign), else a branch to
-@ `general` (HADYNET_MVP_ROUND out of line, which branches back to `done`).
-@ lo + half saturates (QADD) only where the result saturates to int16
-@ anyway (out_shift <= 15: INT32_MAX >> out_shift >= 32767); adding hi
-@ subtracts 1 from a negative sum. r2 = half, r3 = out_shift.
-        .macro  HADYNET_MVP_ROUND_INT32 lo, hi, general, done
+@ The same when the sum fits int32 (hi is lo's sign) and so does sum + half
+@ (ADDS sets V otherwise), else a branch to `general` (lo + half undone
+@ first when only the add overflowed): HADYNET_MVP_ROUND out of line, which
+@ branches back to `done`. Adding hi then subtracts 1 from a negative sum
+@ (no overflow: lo + half - 1 > INT32_MIN). r2 = half, r3 = out_shift.
+        .macro  HADYNET_MVP_ROUND_INT32 lo, hi, general, undo, done
         cmp     \hi, \lo, asr #31
         bne     \general
-        qadd    \lo, \lo, r2
+        adds    \lo, \lo, r2
+        bvs     \undo
         add     \lo, \lo, \hi
         asr     \lo, \lo, r3
         ssat    \lo, #16, \lo
@@ -147,8 +148,8 @@ hadynet_mvp_end_b:
         adc     r11, r11, r6, asr #31
         adds    r12, r12, r7
         adc     lr, lr, r7, asr #31
-        HADYNET_MVP_ROUND_INT32 r10, r11, .Lmvp_general_first, .Lmvp_first_done
-        HADYNET_MVP_ROUND_INT32 r12, lr, .Lmvp_general_second, .Lmvp_second_done
+        HADYNET_MVP_ROUND_INT32 r10, r11, .Lmvp_general_first, .Lmvp_undo_first, .Lmvp_first_done
+        HADYNET_MVP_ROUND_INT32 r12, lr, .Lmvp_general_second, .Lmvp_undo_second, .Lmvp_second_done
         strh    r10, [r1], #2
         strh    r12, [r1], #2
         ldr     r8, [sp, #HADYNET_MVP_PAIRS]
@@ -158,10 +159,14 @@ hadynet_mvp_end_b:
         bne     .Lmvp_pair
         add     sp, sp, #HADYNET_MVP_JOB_BYTES
         pop     {r4-r11, pc}
+.Lmvp_undo_first:                               @ sum + half beyond int32
+        sub     r10, r10, r2
 .Lmvp_general_first:                            @ a sum beyond int32: the general rounding
         ldr     r4, [sp, #HADYNET_MVP_OUT_SHIFT_REST]
         HADYNET_MVP_ROUND r10, r11
         b       .Lmvp_first_done
+.Lmvp_undo_second:
+        sub     r12, r12, r2
 .Lmvp_general_second:
         ldr     r4, [sp, #HADYNET_MVP_OUT_SHIFT_REST]
         HADYNET_MVP_ROUND r12, lr
