@@ -24,9 +24,9 @@
 // sigmoid_q15_block / tanh_q15_block: activation.h's table interpolation on
 // tables indexed by the signed x (SignedActivationTable below, built at
 // compile time from the tanh table), so no |x| and no sign at run time: per
-// value one LDR and one LDRSH of the entry, one multiply-add, one shift (and
-// SSAT for sigmoid): 10 instructions; every input of both is checked against
-// activation.cc by the exhaustive test.
+// value one LDR and one LDRSH of the entry, one multiply-add, one SSAT with
+// the output shift (one assembly macro for both): 10 instructions; every
+// input of both is checked against activation.cc by the exhaustive test.
 //
 // dot_cols_packed_q15 (W^T g from the packed forward matrix, g int16 block
 // floating point): a transposed product needs pairs along the rows, which

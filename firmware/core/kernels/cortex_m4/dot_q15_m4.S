@@ -181,47 +181,34 @@ hadynet_mvp_end_b:
 @ tanh (shift 7), ssat16((E[j] + D[j] g) >> 9) for sigmoid (shift 8; E holds
 @ sigmoid's offset 32769 and its halving). e and d point at entry j = 0.
 @   r0 v, r1 n, r2 e, r3 d, r4 x / g, r5 j / D, r6 E / y.
-        .global hadynet_tanh_block
-        .type   hadynet_tanh_block, %function
+@ One activation's function: entries at steps of 2^shift inputs, result
+@ ssat16(sum >> out_shift) (tanh never reaches the rails: the SSAT is its
+@ plain shift).
+        .macro  HADYNET_ACTIVATION_BLOCK name, shift, out_shift
+        .global \name
+        .type   \name, %function
         .thumb_func
         .p2align 2
-hadynet_tanh_block:
+\name:
         push    {r4-r6}
 1:
         ldrsh   r4, [r0]
-        asr     r5, r4, #7                      @ j in [-256, 255]
-        and     r4, r4, #127                    @ g
+        asr     r5, r4, #\shift                 @ j
+        and     r4, r4, #((1 << \shift) - 1)    @ g
         ldr     r6, [r2, r5, lsl #2]            @ E[j]
         ldrsh   r5, [r3, r5, lsl #1]            @ D[j]
         mla     r6, r5, r4, r6
-        asr     r6, r6, #7
+        ssat    r6, #16, r6, asr #\out_shift
         strh    r6, [r0], #2
         subs    r1, r1, #1
         bne     1b
         pop     {r4-r6}
         bx      lr
-        .size   hadynet_tanh_block, . - hadynet_tanh_block
+        .size   \name, . - \name
+        .endm
 
-        .global hadynet_sigmoid_block
-        .type   hadynet_sigmoid_block, %function
-        .thumb_func
-        .p2align 2
-hadynet_sigmoid_block:
-        push    {r4-r6}
-1:
-        ldrsh   r4, [r0]
-        asr     r5, r4, #8                      @ j in [-128, 127]
-        and     r4, r4, #255                    @ g
-        ldr     r6, [r2, r5, lsl #2]            @ E[j]
-        ldrsh   r5, [r3, r5, lsl #1]            @ D[j]
-        mla     r6, r5, r4, r6
-        ssat    r6, #16, r6, asr #9             @ (32768 + t + 1) >> 1, at most 32767
-        strh    r6, [r0], #2
-        subs    r1, r1, #1
-        bne     1b
-        pop     {r4-r6}
-        bx      lr
-        .size   hadynet_sigmoid_block, . - hadynet_sigmoid_block
+        HADYNET_ACTIVATION_BLOCK hadynet_tanh_block, 7, 7      @ j in [-256, 255]
+        HADYNET_ACTIVATION_BLOCK hadynet_sigmoid_block, 8, 9   @ j in [-128, 127]; (32768 + t + 1) >> 1, at most 32767
 
 @ ---------------------------------------------------------------------------
 @ hadynet_dot_cols4_q15(w, stride_bytes, g, pairs, out)
