@@ -55,6 +55,21 @@ ResidualData synthetic(std::uint64_t seed, Add add) {
 
 Attribution run(const ResidualData& d) { return attribute(d, enumerate_hypotheses(d, {}), {}); }
 
+// Channel c reported d steps late, as the model sees it: it predicts y_t from
+// the measured y_{t-1}, y_hat_t = y_{t-1} + D_t (D: the change it predicts;
+// here c's smooth random series of synthetic()), and the measured change is
+// the true change d steps earlier, so r_t gains D_{t-d} - D_t. Built column
+// by column, since y_{t-1} (y_hat + r in synthetic(), 0 in row 1) holds the
+// residual itself.
+void add_sensor_delay(ResidualLog& log, int c, int d) {
+  const Eigen::VectorXd change = log.y_hat.row(c).transpose();
+  for (Eigen::Index j = 0; j < log.r.cols(); ++j) {
+    const double y_previous = j >= 1 ? log.y_hat(c, j - 1) + log.r(c, j - 1) : 0.0;
+    log.y_hat(c, j) = y_previous + change(j);
+    if (j >= d) log.r(c, j) += change(j - d) - change(j);
+  }
+}
+
 TEST(Attribution, WhiteNoiseResidualGivesNoSignificantEffect) {
   for (std::uint64_t seed : {1, 2, 3}) {
     const Attribution a = run(synthetic(seed, [](ResidualLog&) {}));
@@ -64,10 +79,8 @@ TEST(Attribution, WhiteNoiseResidualGivesNoSignificantEffect) {
 }
 
 TEST(Attribution, SensorDelayWinsWithItsDelay) {
-  // a1 is reported 2 steps late: measured = prediction 2 steps earlier.
-  const Attribution a = run(synthetic(4, [](ResidualLog& log) {
-    for (Eigen::Index j = 2; j < log.r.cols(); ++j) log.r(1, j) += log.y_hat(1, j - 2) - log.y_hat(1, j);
-  }));
+  // a1 is reported 2 steps late.
+  const Attribution a = run(synthetic(4, [](ResidualLog& log) { add_sensor_delay(log, 1, 2); }));
   ASSERT_TRUE(a.winner().has_value());
   const auto w = *a.winner();
   EXPECT_EQ(w.hypothesis.kind, EffectKind::kSensorDelay);
@@ -268,12 +281,12 @@ TEST(Attribution, ConstantRegressorIsNotTestable) {
 
 // The residual of a system whose model is very good (noise sd 0.001, as the
 // Cascaded Tanks' whole 1-step residual is about 0.0025 standardised units)
-// with a1 reported 2 steps late at the same tiny scale.
+// with a1 reported 2 steps late, predictions and residual at one scale.
 ResidualData scaled(std::uint64_t seed, double scale, bool delayed) {
   return synthetic(seed, [&](ResidualLog& log) {
     log.r *= scale;
-    if (!delayed) return;
-    for (Eigen::Index j = 2; j < log.r.cols(); ++j) log.r(1, j) += scale * (log.y_hat(1, j - 2) - log.y_hat(1, j));
+    log.y_hat *= scale;  // the whole data at this scale: the delay's regressor holds y_hat and r
+    if (delayed) add_sensor_delay(log, 1, 2);
   });
 }
 

@@ -162,8 +162,9 @@ std::string describe(const Hypothesis& h, const ResidualData& data, const Eigen:
 // rate); NaN without coefficients.
 double main_parameter(const Hypothesis& h, const Eigen::VectorXd& coef);
 // Whether the main parameter is in the effect's physical domain: a
-// cross-talk picks up a fraction of its source (0 < gain < 1), and a delay
-// or a rail explains the residual with a positive gain, and a calibration
+// cross-talk picks up a fraction of its source (0 < gain < 1), a sensor
+// delay explains the residual with a gain of at least 1/2 (1: all of it), a
+// rail with a positive gain, and a calibration
 // curve is increasing over the channel's range with slopes of at least 1/4
 // at both ends (the flattest a fitted curve may be). The other effects
 // take either sign (friction's sign follows the command convention; a drift
