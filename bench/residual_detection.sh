@@ -38,7 +38,15 @@
 # the candidates' selection (--candidates 1, 3 and 5, the rule among them),
 # 781-790 every effect at its larger strength measured with --candidates 1
 # and 5 (the same logs; nothing was chosen on them); 841-850 every effect at
-# its smaller strength with --candidates 5.
+# its smaller strength with --candidates 5. Stop 40 (the sensor delay's
+# regressor on the predicted change, the two delays' rules, the gain bound):
+# 871-875 development (sensor-delay and input-delay at 1 and 2 steps with
+# each version of the rules; 871 also sensor-delay=3 and 4 and some larger
+# strengths of the other effects, the start of a study of strengths that
+# was dropped), 881-890 every effect at its larger strength and 911-920 at
+# its smaller, measured with this code; 881-890 all and 911-920
+# sensor-delay=1 and input-delay=1 also with the stop-38 binary (the same
+# logs; nothing was chosen on them).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...

@@ -39,7 +39,9 @@
 # bench/residual_detection.sh. Stop 38: 791-810 measured with five
 # candidates (the new default; 771-790 and 811-825 belong to the detection,
 # unknown-effect and two-effect benches); 851-870 the same without rated
-# ranges (841-850: detection).
+# ranges (841-850: detection). Stop 40 (the sensor delay's regressor on the
+# predicted change): 891-910 measured with rated ranges, 941-960 without
+# (871-890 and 911-935 belong to the other benches).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

@@ -17,7 +17,9 @@
 # that change; 691-695 measured with RESIDUAL_ROWS=600; 751-755 measured
 # with the final binary of stop 37 (used for nothing else); 821-825
 # measured with --candidates 3 (stop-37 binary) and 5 (stop 38), the same logs;
-# 641-645 again with --candidates 5 (stop 38).
+# 641-645 again with --candidates 5 (stop 38); 931-935 measured with the
+# stop-38 and stop-40 binaries at --candidates 5 (the same logs; stop 40:
+# the sensor delay's regressor on the predicted change).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]...

@@ -24,7 +24,8 @@
 # sensor-curve in the library: 561-570. Seeds (gain-wobble): 571-580 (before
 # the curve's plan took the winner's group only), 621-630, 741-750 (after
 # the curve's plausibility bound and the rounds' changes of stop 37),
-# 811-820 (stop 38: --candidates 1 and 5, the same logs).
+# 811-820 (stop 38: --candidates 1 and 5, the same logs), 921-930 (stop 40:
+# the sensor delay's regressor on the predicted change).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve]
