@@ -201,7 +201,7 @@ TEST(ResidualFix, SensorDelayIsTimeAlignedAndCutsTheDelayedChannelsError) {
   EXPECT_TRUE(a.carried_before_tuning());
   EXPECT_TRUE(r.fix.untuned.params.lstm_weight_hh == build_model().params.lstm_weight_hh);
   EXPECT_TRUE(r.fix.untuned.sensor == r.fix.model.sensor);
-  // The plant delays every loadcell: the fix aligns all nine (three pass the
+  // The plant delays every loadcell: the fix aligns all nine (four pass the
   // floors; the rest join as the same delay in the same group).
   EXPECT_EQ(a.channels.size(), static_cast<std::size_t>(fm::kSensorDelay.aligned_channels));
   for (const auto& ch : a.channels) EXPECT_EQ(ch.rfind("fc", 0), 0u) << ch;

@@ -71,14 +71,15 @@ TEST(PlantEffects, LatencyIsNamedWithItsDelay) {
   for (const auto& r : o.attribution.winner_family()) EXPECT_EQ(channel_group(name_of(o, r.hypothesis.target)), "fc");
 }
 
-// Every loadcell reported 3 steps late, on logs of development seed 871
-// (fresh motions and noise). The sensor delay's regressor before stop 40,
+// Every loadcell reported 3 steps late, on logs of seed 871 (motions and
+// noise the model never saw; a development seed of the sensor delay's rules,
+// bench/residual_detection.sh). The sensor delay's regressor before stop 40,
 // y_hat(t - d) - y_hat(t), also held the last d measured changes: its gain
 // read 0.4-0.7, and the verdict here was "no significant effect".
 // D(t - d) - D(t) on the predicted change D names it with its delay, on the
 // loadcells alone, with a gain the physical domain accepts (>= 1/2,
 // effects.cc).
-TEST(PlantEffects, ALongerLatencyOnFreshLogsIsNamedWithItsDelay) {
+TEST(PlantEffects, ALongerLatencyOnAnotherSeedsLogsIsNamedWithItsDelay) {
   const Outcome o = analyse("sensor-delay=3", 300, 871);
   ASSERT_TRUE(o.attribution.winner().has_value());
   const auto w = *o.attribution.winner();
@@ -376,8 +377,9 @@ TEST(PlantEffects, AnInputDelaySeenOnlyBesideASensorDelayIsNotAdded) {
 // sensor delay's regressor follows the model, so sensor delays are
 // significant on several groups (lengths, tensions, loadcells). No sensor
 // delay may then be added: --fix's candidates hold the input delay and no
-// sensor delay (before stop 40's mirror rule, a time alignment of the
-// loadcells was confirmed on such logs: fresh seeds 871-875).
+// sensor delay (with the new regressor and without this rule, a time
+// alignment of several groups was confirmed on such logs: development seeds
+// 871-875).
 TEST(PlantEffects, CommandsActingLateAreNotAlignedAsASensorDelay) {
   const Outcome o = analyse("input-delay");
   std::set<std::string> delayed_groups;

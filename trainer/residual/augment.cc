@@ -113,8 +113,10 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   // fc4 -> fc3 above a 2-step sensor delay; docs/residual.md). A sensor delay on a
   // channel the commands drive directly leaves nearly the residual of an
   // input delay on that channel alone, so the two can swap places
-  // (docs/residual.md): an input-delay winner seen on one group only, with a
-  // sensor delay significant there, is skipped and said.
+  // (docs/residual.md): an input-delay winner seen on one group only, the
+  // only group where sensor delays are significant, or a sensor-delay winner
+  // where sensor delays are significant on several groups beside an input
+  // delay, is skipped and said (why_not_fixable).
   std::string winner_not_fixable;
   for (const auto& r : attribution.ranked) {
     if (!r.significant || static_cast<int>(out.size()) >= count) break;

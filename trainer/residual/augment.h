@@ -207,7 +207,9 @@ struct Augmentation {
 };
 // Why --fix cannot add significant hypothesis `r` ("" when it can): its
 // effect has no plan, or the effect's not_planned rule declines it (an input
-// delay seen on one group only, beside a sensor delay there; effects.cc).
+// delay seen on one group only, the only group where sensor delays are
+// significant; a sensor delay where sensor delays are significant on two
+// groups or more beside an input delay that can be added; effects.cc).
 std::string why_not_fixable(const ResidualData& data, const Attribution& attribution, const HypothesisResult& r);
 
 // The screen's candidates for --fix: the augmentations (each with its
@@ -311,7 +313,7 @@ struct FixResult {
 // on its found_on); "" when no such effect is known. A sensor delay of d
 // steps and an input dead time of d steps: the model predicts a channel's
 // change from its last measured value, so a channel reported d steps late
-// leaves D(t - d) - D(t) (D: the change the commands cause), which is what
+// leaves C(t - d) - C(t) (C: the change the commands cause), which is what
 // commands acting d steps late leave (docs/residual.md, "Open").
 std::string look_alike(const Augmentation& a);
 
