@@ -1027,7 +1027,8 @@ const std::vector<EffectInfo>& effect_library() {
        "time alignment: train on y_c shifted d steps earlier (the network predicts the true-time signal), "
        "with the winner's group where the same delay passes the test without the floors; the delay goes into the "
        "sensor model "
-       "(not when sensor delays are significant on two groups or more and an input delay is significant too)",
+       "(not when sensor delays are significant on two groups or more and an input delay that can be added is "
+       "significant too)",
        SourceKind::kNone, sensor_delay::enumerate, sensor_delay::features, first_coefficient, sensor_delay::plausible,
        sensor_delay::describe, sensor_delay::plan, sensor_delay::not_planned, sensor_delay::look_alike},
       {EffectKind::kInputDelay, "input-delay",
