@@ -46,7 +46,8 @@
 # was dropped), 881-890 every effect at its larger strength and 911-920 at
 # its smaller, measured with this code; 881-890 all and 911-920
 # sensor-delay=1 and input-delay=1 also with the stop-38 binary (the same
-# logs; nothing was chosen on them).
+# logs; nothing was chosen on them); 961-970 sensor-delay=3 and 4 with
+# both binaries (the same logs).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...
