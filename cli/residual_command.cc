@@ -212,7 +212,8 @@ int run_residual(int argc, char** argv) {
                "bound may be left out (f=0..)");
   opt.value("report", "DIR", "write DIR/REPORT.md with PNG plots (gnuplot) and DIR/residual.json");
   opt.value("json", "FILE", "write every number as JSON");
-  opt.flag("fix", "add the winning effect (sensor delay: time alignment; cross-talk: removal; drift: a bias state;\n"
+  opt.flag("fix", "add the winning effect (sensor delay: time alignment, or the commands' dead time when the delay\n"
+                  "shows on other groups too; cross-talk: removal; drift: a bias state;\n"
                   "saturation: clipping; sensor curve: a calibration curve; friction: hysteresis inputs; input\n"
                   "delay: the commands d steps earlier as inputs; aux channel: an observed channel), fine-tune\n"
                   "on the first --train-fraction of each log and report before/after on the rest; the effect is\n"

@@ -118,12 +118,16 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   // where sensor delays are significant on several groups beside an input
   // delay, is skipped and said (why_not_fixable).
   std::string winner_not_fixable;
+  std::vector<EffectKind> leads;
   for (const auto& r : attribution.ranked) {
     if (!r.significant || static_cast<int>(out.size()) >= count) break;
     const std::string why = why_not_fixable(data, attribution, r);
     if (r.label == winner->label) winner_not_fixable = why;
     if (!why.empty()) continue;
-    const bool seen = std::any_of(out.begin(), out.end(), [&](const Augmentation& b) { return b.kind == r.hypothesis.kind; });
+    // One candidate per effect, by the effect of the hypothesis that led to
+    // it as well as by the effect planned (a sensor delay can plan a dead time).
+    const bool seen = std::any_of(out.begin(), out.end(), [&](const Augmentation& b) { return b.kind == r.hypothesis.kind; }) ||
+                      std::find(leads.begin(), leads.end(), r.hypothesis.kind) != leads.end();
     if (seen) continue;
     Augmentation a;
     a.kind = r.hypothesis.kind;
@@ -137,6 +141,7 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
       a.description = "the winner (" + winner->effect + ": " + winner->label + ") is not added (" +
                       winner_not_fixable + "); the best significant effect that can be: " + r.label + "; " +
                       a.description;
+    leads.push_back(r.hypothesis.kind);
     out.push_back(std::move(a));
   }
   if (out.empty()) {  // nothing significant can be added: fix() says "not supported"

@@ -209,7 +209,9 @@ struct Augmentation {
 // effect has no plan, or the effect's not_planned rule declines it (an input
 // delay seen on one group only, the only group where sensor delays are
 // significant; a sensor delay where sensor delays are significant on two
-// groups or more beside an input delay that can be added; effects.cc).
+// groups or more beside an input delay that can be added; effects.cc). A
+// sensor delay whose delay shows on other groups too is planned as the
+// commands' dead time (an input-delay augmentation; effects.cc).
 std::string why_not_fixable(const ResidualData& data, const Attribution& attribution, const HypothesisResult& r);
 
 // The screen's candidates for --fix: the augmentations (each with its

@@ -100,6 +100,9 @@ std::vector<std::string> sensor_delay_groups(const ResidualData& data, const Att
 
 namespace input_delay {
 std::string not_planned(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead);
+std::string not_addable(const ResidualData& data, int d);
+void plan_for_sensor_delay(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead,
+                           const std::string& evidence, Augmentation& a);
 }  // namespace input_delay
 
 // ---- sensor-delay: the target is reported `delay` steps late ----
@@ -130,32 +133,6 @@ Features features(const Hypothesis& h, const ResidualLog& log) {
   return f;
 }
 
-// A sensor delay belongs to one acquisition chain. Commands that act late
-// delay every channel they drive and leave the same residual there, so a
-// sensor delay is declined (--fix then takes the input delay) when sensor
-// delays are significant on two groups or more and an input delay is
-// significant too and can be added (input_delay::not_planned: not when the
-// model has its lagged commands already, or its delay is longer than a lag
-// input states). On plant logs of development seeds 871-875 (motions and
-// noise the model never saw) the sensor delays of loadcells reported late
-// were significant on their group only, those of commands acting late on
-// 2-4 groups, while the input delay's own regressors (linear in the
-// commands) were often significant on the tendons alone.
-// input_delay::not_planned is the mirror rule.
-std::string not_planned(const ResidualData& data, const Attribution& attribution, const HypothesisResult&) {
-  const auto groups = sensor_delay_groups(data, attribution);
-  if (groups.size() < 2) return "";
-  for (const auto& r : attribution.ranked) {
-    if (!r.significant) break;
-    if (r.hypothesis.kind != EffectKind::kInputDelay) continue;
-    if (!input_delay::not_planned(data, attribution, r).empty()) continue;
-    return "sensor delays are significant on " + std::to_string(groups.size()) + " groups (" + join(groups) +
-           "), and an input delay of " + steps(r.hypothesis.delay) +
-           " is significant too: commands acting late delay every channel they drive";
-  }
-  return "";
-}
-
 // The gain of D_c(t-d) - D_c(t) is 1 when the whole residual is the delay,
 // less where the predicted change D is partly wrong (errors in the
 // regressor attenuate it). Below kMinGain most of the regressor is
@@ -172,11 +149,99 @@ std::string not_planned(const ResidualData& data, const Attribution& attribution
 constexpr double kMinGain = 0.5;
 bool plausible(double gain, const Eigen::VectorXd&) { return gain >= kMinGain; }
 
+// The other groups where the lead's delay shows too: a group whose channels'
+// sensor delays of the lead's steps have a median gain of at least kMinGain,
+// a channel counting as gain 0 where that delay is not testable or fails
+// Holm's test. No practical floor: a dead time delays every channel the
+// commands drive, but on the tendons and joint angles the model predicts
+// well it leaves a residual below the floors, with the same gain. On plant
+// logs of development seeds 871-875 (1- and 2-step delays, 5 sets each) the
+// groups a loadcell delay does not touch read median gains of 0.14-0.38,
+// and with commands acting late every group read 0.59-0.84
+// (docs/residual.md, "Detection on fresh logs").
+std::vector<std::pair<std::string, double>> shown_elsewhere(const ResidualData& data, const Attribution& attribution,
+                                                           const HypothesisResult& lead) {
+  const int d = lead.hypothesis.delay;
+  const std::string own = channel_group(y_name(data, lead.hypothesis.target));
+  std::vector<std::string> groups;
+  std::vector<std::vector<double>> gains;
+  for (const auto& r : attribution.ranked) {
+    if (r.hypothesis.kind != EffectKind::kSensorDelay || r.hypothesis.delay != d) continue;
+    const std::string g = channel_group(y_name(data, r.hypothesis.target));
+    if (g == own) continue;
+    const auto it = std::find(groups.begin(), groups.end(), g);
+    const auto k = static_cast<std::size_t>(it - groups.begin());
+    if (it == groups.end()) {
+      groups.push_back(g);
+      gains.emplace_back();
+    }
+    const bool passes = r.testable && r.p_adjusted < attribution.options.alpha && std::isfinite(r.parameter);
+    gains[k].push_back(passes ? r.parameter : 0.0);
+  }
+  std::vector<std::pair<std::string, double>> out;
+  for (std::size_t k = 0; k < groups.size(); ++k) {
+    auto& v = gains[k];
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    const double median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    if (median >= kMinGain) out.emplace_back(groups[k], median);
+  }
+  return out;
+}
+
+// "l (median gain 0.78), th (0.72)" for shown_elsewhere().
+std::string elsewhere_text(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead) {
+  std::string s;
+  for (const auto& [group, gain] : shown_elsewhere(data, attribution, lead))
+    s += (s.empty() ? group + " (median gain" + fmt(" %.2f)", gain) : ", " + group + fmt(" (%.2f)", gain));
+  return s;
+}
+
+// A sensor delay belongs to one acquisition chain. Commands that act late
+// delay every channel they drive and leave the same residual there, so a
+// sensor delay is declined (--fix then takes the input delay) when sensor
+// delays are significant on two groups or more and an input delay is
+// significant too and can be added (input_delay::not_planned: not when the
+// model has its lagged commands already, or its delay is longer than a lag
+// input states). On plant logs of development seeds 871-875 (motions and
+// noise the model never saw) the sensor delays of loadcells reported late
+// were significant on their group only, those of commands acting late on
+// 2-4 groups, while the input delay's own regressors (linear in the
+// commands) were often significant on the tendons alone.
+// input_delay::not_planned is the mirror rule.
+// A lead whose delay shows on other groups too (shown_elsewhere) is not
+// declined here but planned as an input dead time (plan()), unless the dead
+// time cannot be added.
+std::string not_planned(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead) {
+  if (!shown_elsewhere(data, attribution, lead).empty()) {
+    const std::string why = input_delay::not_addable(data, lead.hypothesis.delay);
+    if (why.empty()) return "";
+    return "the same delay shows on other groups too (" + elsewhere_text(data, attribution, lead) +
+           "): commands acting late, and their dead time cannot be added: " + why;
+  }
+  const auto groups = sensor_delay_groups(data, attribution);
+  if (groups.size() < 2) return "";
+  for (const auto& r : attribution.ranked) {
+    if (!r.significant) break;
+    if (r.hypothesis.kind != EffectKind::kInputDelay) continue;
+    if (!input_delay::not_planned(data, attribution, r).empty()) continue;
+    return "sensor delays are significant on " + std::to_string(groups.size()) + " groups (" + join(groups) +
+           "), and an input delay of " + steps(r.hypothesis.delay) +
+           " is significant too: commands acting late delay every channel they drive";
+  }
+  return "";
+}
+
+
 std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
   return "delay = " + steps(h.delay) + " on " + y_name(data, h.target) + " (gain" + fmt(" %.2f)", p);
 }
 
 void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
+  if (!shown_elsewhere(data, attribution, w).empty()) {
+    input_delay::plan_for_sensor_delay(data, attribution, w, elsewhere_text(data, attribution, w), a);
+    return;
+  }
   const auto& h = w.hypothesis;
   auto& change = a.change.emplace<TimeAlignment>();
   change.delay = h.delay;
@@ -278,16 +343,21 @@ std::vector<std::string> new_lag_inputs(const ResidualData& data, int d) {
 // rule); otherwise it is planned. Also declined: a delay longer than a lag
 // input may state, and a delay whose lagged commands the model already has
 // (an earlier round added them).
-std::string not_planned(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead) {
-  const int d = lead.hypothesis.delay;
+std::string not_addable(const ResidualData& data, int d) {
   if (d > kMaxCommandLag)
     return "longer than the " + steps(kMaxCommandLag) + " a lagged command input may state (--max-delay)";
   if (new_lag_inputs(data, d).empty()) return "the model already has every command " + steps(d) + " earlier as an input";
+  return "";
+}
+
+std::string not_planned(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead) {
+  if (std::string why = not_addable(data, lead.hypothesis.delay); !why.empty()) return why;
   const auto groups = family_groups(data, attribution, lead);
   if (groups.size() >= 2 || sensor_delay_groups(data, attribution).size() >= 2) return "";
   for (const auto& r : attribution.ranked) {
     if (!r.significant) break;
     if (r.hypothesis.kind != EffectKind::kSensorDelay) continue;
+    if (!sensor_delay::shown_elsewhere(data, attribution, r).empty()) continue;  // a dead time's (sensor_delay::plan)
     const std::string& channel = y_name(data, r.hypothesis.target);
     if (channel_group(channel) != groups.front()) continue;
     return "seen on one group (" + groups.front() + ") only, where a sensor delay of " + steps(r.hypothesis.delay) +
@@ -307,6 +377,23 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   change.inputs = new_lag_inputs(data, d);
   a.description = "add the commands " + steps(d) + " earlier as inputs (" + join(change.inputs) + "; input delay on " +
                   join(a.channels) + ")";
+  a.found_on = a.channels;
+}
+
+// A sensor delay whose delay shows on other groups too (sensor_delay::plan):
+// commands acting late, so the dead time of its steps, found on the sensor
+// delay's channels (the decision compares the models there).
+void plan_for_sensor_delay(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead,
+                           const std::string& evidence, Augmentation& a) {
+  const int d = lead.hypothesis.delay;
+  a.kind = EffectKind::kInputDelay;
+  a.effect = effect_info(a.kind).name;
+  auto& change = a.change.emplace<DerivedCommandInputs>();
+  for (const auto& r : attribution.family_of(lead)) a.channels.push_back(y_name(data, r.hypothesis.target));
+  change.inputs = new_lag_inputs(data, d);
+  a.description = "add the commands " + steps(d) + " earlier as inputs (" + join(change.inputs) + "; a delay of " +
+                  steps(d) + " on " + join(a.channels) + " that shows on " + evidence +
+                  " too: commands acting late, not one sensor chain)";
   a.found_on = a.channels;
 }
 
@@ -1032,7 +1119,8 @@ const std::vector<EffectInfo>& effect_library() {
        "with the winner's group where the same delay passes the test without the floors; the delay goes into the "
        "sensor model "
        "(not when sensor delays are significant on two groups or more and an input delay that can be added is "
-       "significant too)",
+       "significant too; a delay that shows on another group too, with a median gain of at least 1/2 there below "
+       "the floors, is added as the commands' dead time instead)",
        SourceKind::kNone, sensor_delay::enumerate, sensor_delay::features, first_coefficient, sensor_delay::plausible,
        sensor_delay::describe, sensor_delay::plan, sensor_delay::not_planned, sensor_delay::look_alike},
       {EffectKind::kInputDelay, "input-delay",
