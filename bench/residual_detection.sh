@@ -47,7 +47,11 @@
 # its smaller, measured with this code; 881-890 all and 911-920
 # sensor-delay=1 and input-delay=1 also with the stop-38 binary (the same
 # logs; nothing was chosen on them); 961-970 sensor-delay=3 and 4 with
-# both binaries (the same logs).
+# both binaries (the same logs). Stop 41 (a delay that shows on other groups
+# too is planned as the commands' dead time; chosen on the stop-40 runs of
+# development seeds 871-875): 971-980 every effect at its larger strength
+# and 981-990 at its smaller, measured with this code; their delay cases
+# also with the stop-40 binary (the same logs).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...

@@ -41,7 +41,10 @@
 # unknown-effect and two-effect benches); 851-870 the same without rated
 # ranges (841-850: detection). Stop 40 (the sensor delay's regressor on the
 # predicted change): 891-910 measured with rated ranges, 941-960 without
-# (871-890 and 911-935 belong to the other benches).
+# (871-890 and 911-935 belong to the other benches). Stop 41 (a delay shown
+# on other groups too planned as a dead time): 991-1010 measured with rated
+# ranges, 1011-1030 without (971-990 and 1031-1045 belong to the other
+# benches).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

@@ -25,7 +25,8 @@
 # the curve's plan took the winner's group only), 621-630, 741-750 (after
 # the curve's plausibility bound and the rounds' changes of stop 37),
 # 811-820 (stop 38: --candidates 1 and 5, the same logs), 921-930 (stop 40:
-# the sensor delay's regressor on the predicted change).
+# the sensor delay's regressor on the predicted change), 1031-1040 (stop 41:
+# a delay shown on other groups too planned as a dead time).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve]

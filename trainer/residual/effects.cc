@@ -381,19 +381,30 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
 }
 
 // A sensor delay whose delay shows on other groups too (sensor_delay::plan):
-// commands acting late, so the dead time of its steps, found on the sensor
-// delay's channels (the decision compares the models there).
+// commands acting late, so the dead time of its steps. Where an input delay
+// of those steps is significant and can be planned, its own plan (found on
+// its channels, where the commands' regressors see it); else found on the
+// sensor delay's channels. The decision compares the models there.
 void plan_for_sensor_delay(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead,
                            const std::string& evidence, Augmentation& a) {
   const int d = lead.hypothesis.delay;
+  const std::string why = "a delay of " + steps(d) + " on " + y_name(data, lead.hypothesis.target) + " that shows on " +
+                          evidence + " too: commands acting late, not one sensor chain";
   a.kind = EffectKind::kInputDelay;
   a.effect = effect_info(a.kind).name;
+  for (const auto& r : attribution.ranked) {
+    if (!r.significant) break;
+    if (r.hypothesis.kind != EffectKind::kInputDelay || r.hypothesis.delay != d) continue;
+    if (!not_planned(data, attribution, r).empty()) continue;
+    plan(data, attribution, r, a);
+    a.description += "; " + why;
+    return;
+  }
   auto& change = a.change.emplace<DerivedCommandInputs>();
   for (const auto& r : attribution.family_of(lead)) a.channels.push_back(y_name(data, r.hypothesis.target));
   change.inputs = new_lag_inputs(data, d);
-  a.description = "add the commands " + steps(d) + " earlier as inputs (" + join(change.inputs) + "; a delay of " +
-                  steps(d) + " on " + join(a.channels) + " that shows on " + evidence +
-                  " too: commands acting late, not one sensor chain)";
+  a.description = "add the commands " + steps(d) + " earlier as inputs (" + join(change.inputs) + "; " + why +
+                  "; found on " + join(a.channels) + ")";
   a.found_on = a.channels;
 }
 
