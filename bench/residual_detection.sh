@@ -50,8 +50,11 @@
 # both binaries (the same logs). Stop 41 (a delay that shows on other groups
 # too is planned as the commands' dead time; chosen on the stop-40 runs of
 # development seeds 871-875): 971-980 every effect at its larger strength
-# and 981-990 at its smaller, measured with this code; their delay cases
-# also with the stop-40 binary (the same logs).
+# and 981-990 at its smaller, measured with the rule's first version, their
+# delay cases also with the stop-40 binary (the same logs); they then became
+# development data for the rule's second step (the input delay's own plan:
+# seed 980); 1051-1060 the four delay cases measured with the final code and
+# the stop-40 binary (the same logs).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...

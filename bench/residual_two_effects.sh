@@ -20,8 +20,9 @@
 # 641-645 again with --candidates 5 (stop 38); 931-935 measured with the
 # stop-38 and stop-40 binaries at --candidates 5 (the same logs; stop 40:
 # the sensor delay's regressor on the predicted change); 1041-1045 with the
-# stop-40 and stop-41 binaries (the same logs; stop 41: a delay shown on
-# other groups too planned as a dead time).
+# rule's first version (stop 41: a delay shown on other groups too planned
+# as a dead time); 1061-1065 with the final stop-41 code and the stop-40
+# binary (the same logs).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]...

@@ -334,15 +334,9 @@ std::vector<std::string> new_lag_inputs(const ResidualData& data, int d) {
   return out;
 }
 
-// Dead time in the commands delays every channel they drive; on a channel the
-// commands drive directly, a sensor delay leaves nearly the residual of an
-// input delay (of its own or a nearby number of steps). So an input delay
-// seen on one group only is declined when a sensor delay is significant in
-// that group and sensor delays are significant on no other group (--fix
-// then takes the sensor delay; sensor_delay::not_planned is the mirror
-// rule); otherwise it is planned. Also declined: a delay longer than a lag
-// input may state, and a delay whose lagged commands the model already has
-// (an earlier round added them).
+// Why the commands d steps earlier cannot be added ("" when they can): a
+// delay longer than a lag input may state, or one whose lagged commands the
+// model already has (an earlier round added them).
 std::string not_addable(const ResidualData& data, int d) {
   if (d > kMaxCommandLag)
     return "longer than the " + steps(kMaxCommandLag) + " a lagged command input may state (--max-delay)";
@@ -350,6 +344,15 @@ std::string not_addable(const ResidualData& data, int d) {
   return "";
 }
 
+// Dead time in the commands delays every channel they drive; on a channel the
+// commands drive directly, a sensor delay leaves nearly the residual of an
+// input delay (of its own or a nearby number of steps). So an input delay
+// seen on one group only is declined when a sensor delay is significant in
+// that group, sensor delays are significant on no other group, and that
+// sensor delay does not show on another group below the floors (--fix then
+// takes the sensor delay; sensor_delay::not_planned is the mirror rule, and
+// a sensor delay that shows elsewhere is planned as this dead time);
+// otherwise it is planned, if it can be added (not_addable).
 std::string not_planned(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead) {
   if (std::string why = not_addable(data, lead.hypothesis.delay); !why.empty()) return why;
   const auto groups = family_groups(data, attribution, lead);
@@ -1138,7 +1141,8 @@ const std::vector<EffectInfo>& effect_library() {
        "u(t-1-d) - u(t-1), every command channel: commands that act d steps later than the model assumes",
        "delay d (steps)",
        "dead time as inputs: the commands d steps earlier, lag<d>_<c> for every command c, appended to u "
-       "(not when it is seen on one group only, the only group where sensor delays are significant)",
+       "(not when it is seen on one group only, the only group where sensor delays are significant and none of "
+       "them shows on another group too)",
        SourceKind::kNone, input_delay::enumerate, input_delay::features, input_delay::norm, finite,
        input_delay::describe, input_delay::plan, input_delay::not_planned, input_delay::look_alike},
       {EffectKind::kFriction, "friction",
