@@ -43,7 +43,7 @@
 # predicted change): 891-910 measured with rated ranges, 941-960 without
 # (871-890 and 911-935 belong to the other benches). Stop 41 (a delay shown
 # on other groups too planned as a dead time): 991-1010 measured with rated
-# ranges, 1011-1030 without (971-990 and 1031-1045 belong to the other
+# ranges, 1011-1030 without (971-990 and 1031-1065 belong to the other
 # benches).
 # Give others as arguments.
 #

@@ -116,7 +116,8 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   // (docs/residual.md): an input-delay winner seen on one group only, the
   // only group where sensor delays are significant, or a sensor-delay winner
   // where sensor delays are significant on several groups beside an input
-  // delay, is skipped and said (why_not_fixable).
+  // delay, is skipped and said (why_not_fixable); a sensor delay that shows
+  // on other groups too is planned as the commands' dead time.
   std::string winner_not_fixable;
   std::vector<EffectKind> leads;
   for (const auto& r : attribution.ranked) {
@@ -124,17 +125,24 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
     const std::string why = why_not_fixable(data, attribution, r);
     if (r.label == winner->label) winner_not_fixable = why;
     if (!why.empty()) continue;
-    // One candidate per effect, by the effect of the hypothesis that led to
-    // it as well as by the effect planned (a sensor delay can plan a dead time).
-    const bool seen = std::any_of(out.begin(), out.end(), [&](const Augmentation& b) { return b.kind == r.hypothesis.kind; }) ||
-                      std::find(leads.begin(), leads.end(), r.hypothesis.kind) != leads.end();
-    if (seen) continue;
+    // One candidate per effect: by the effect of the hypothesis that led to
+    // a candidate, and by the effect planned (a sensor delay that shows on
+    // other groups plans a dead time: effects.cc). A lead whose plan repeats
+    // an effect already planned counts as having led.
+    const auto planned = [&](EffectKind kind) {
+      return std::any_of(out.begin(), out.end(), [&](const Augmentation& b) { return b.kind == kind; });
+    };
+    if (planned(r.hypothesis.kind) || std::find(leads.begin(), leads.end(), r.hypothesis.kind) != leads.end()) continue;
     Augmentation a;
     a.kind = r.hypothesis.kind;
     a.effect = r.effect;
     effect_info(a.kind).plan(data, attribution, r, a);
     if (!a.not_fixable.empty()) {  // the plan found nothing to add (a curve without two distinct levels)
       if (r.label == winner->label) winner_not_fixable = a.not_fixable;
+      continue;
+    }
+    if (planned(a.kind)) {
+      leads.push_back(r.hypothesis.kind);
       continue;
     }
     if (out.empty() && r.label != winner->label)
