@@ -54,7 +54,9 @@
 # delay cases also with the stop-40 binary (the same logs); they then became
 # development data for the rule's second step (the input delay's own plan:
 # seed 980); 1051-1060 the four delay cases measured with the final code and
-# the stop-40 binary (the same logs).
+# the stop-40 binary (the same logs); 871-875 again as development for
+# friction, crosstalk, sensor-curve and tension-leak at --fix-epochs 20 and
+# 40 (40 not kept).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...
