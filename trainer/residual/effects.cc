@@ -164,40 +164,34 @@ bool plausible(double gain, const Eigen::VectorXd&) { return gain >= kMinGain; }
 // another group that ranks above it would be taken for a dead time (not
 // seen on the plant: there the loadcells' own delay ranks first).
 constexpr double kShownGain = 0.5;
-std::vector<std::pair<std::string, double>> shown_elsewhere(const ResidualData& data, const Attribution& attribution,
-                                                           const HypothesisResult& lead) {
+using GroupGains = std::vector<std::pair<std::string, double>>;  // (group, median gain), in ranking order
+GroupGains shown_elsewhere(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead) {
   const int d = lead.hypothesis.delay;
   const std::string own = channel_group(y_name(data, lead.hypothesis.target));
-  std::vector<std::string> groups;
-  std::vector<std::vector<double>> gains;
+  std::vector<std::pair<std::string, std::vector<double>>> gains;  // per other group, its channels' gains
   for (const auto& r : attribution.ranked) {
     if (r.hypothesis.kind != EffectKind::kSensorDelay || r.hypothesis.delay != d) continue;
     const std::string g = channel_group(y_name(data, r.hypothesis.target));
     if (g == own) continue;
-    const auto it = std::find(groups.begin(), groups.end(), g);
-    const auto k = static_cast<std::size_t>(it - groups.begin());
-    if (it == groups.end()) {
-      groups.push_back(g);
-      gains.emplace_back();
-    }
+    auto it = std::find_if(gains.begin(), gains.end(), [&](const auto& x) { return x.first == g; });
+    if (it == gains.end()) it = gains.insert(gains.end(), {g, {}});
     const bool passes = r.testable && r.p_adjusted < attribution.options.alpha && std::isfinite(r.parameter);
-    gains[k].push_back(passes ? r.parameter : 0.0);
+    it->second.push_back(passes ? r.parameter : 0.0);
   }
-  std::vector<std::pair<std::string, double>> out;
-  for (std::size_t k = 0; k < groups.size(); ++k) {
-    auto& v = gains[k];
+  GroupGains out;
+  for (auto& [group, v] : gains) {
     std::sort(v.begin(), v.end());
     const std::size_t n = v.size();
     const double median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-    if (median >= kShownGain) out.emplace_back(groups[k], median);
+    if (median >= kShownGain) out.emplace_back(group, median);
   }
   return out;
 }
 
-// "l (median gain 0.78), th (0.72)" for shown_elsewhere().
-std::string elsewhere_text(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead) {
+// "l (median gain 0.78), th (0.72)".
+std::string groups_text(const GroupGains& shown) {
   std::string s;
-  for (const auto& [group, gain] : shown_elsewhere(data, attribution, lead))
+  for (const auto& [group, gain] : shown)
     s += (s.empty() ? group + " (median gain" + fmt(" %.2f)", gain) : ", " + group + fmt(" (%.2f)", gain));
   return s;
 }
@@ -218,10 +212,10 @@ std::string elsewhere_text(const ResidualData& data, const Attribution& attribut
 // declined here but planned as an input dead time (plan()), unless the dead
 // time cannot be added.
 std::string not_planned(const ResidualData& data, const Attribution& attribution, const HypothesisResult& lead) {
-  if (!shown_elsewhere(data, attribution, lead).empty()) {
+  if (const GroupGains shown = shown_elsewhere(data, attribution, lead); !shown.empty()) {
     const std::string why = input_delay::not_addable(data, lead.hypothesis.delay);
     if (why.empty()) return "";
-    return "the same delay shows on other groups too (" + elsewhere_text(data, attribution, lead) +
+    return "the same delay shows on other groups too (" + groups_text(shown) +
            "): commands acting late, and their dead time cannot be added: " + why;
   }
   const auto groups = sensor_delay_groups(data, attribution);
@@ -242,8 +236,8 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
 }
 
 void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
-  if (!shown_elsewhere(data, attribution, w).empty()) {
-    input_delay::plan_for_sensor_delay(data, attribution, w, elsewhere_text(data, attribution, w), a);
+  if (const GroupGains shown = shown_elsewhere(data, attribution, w); !shown.empty()) {
+    input_delay::plan_for_sensor_delay(data, attribution, w, groups_text(shown), a);
     return;
   }
   const auto& h = w.hypothesis;
