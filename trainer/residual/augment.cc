@@ -351,7 +351,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // found on (the plan's found_on, of the model's own channels: the aligned,
   // cleaned, clipped, drifting or friction channels; for an aux channel, the
   // channels its significant hypotheses explain).
-  const Augmentation tested = refined(planned[chosen], split, &result.fitted_rates);
+  const Augmentation tested = refined(planned[chosen], split, &result.fitted_parameters);
   if (!result.candidates[chosen].selected_by_training_rows) result.candidates[chosen].description = tested.description;
   Tuned after = tune(&tested, split, &result.untuned);
   result.augmentation = tested;
