@@ -288,8 +288,9 @@ TEST(ResidualFix, ACrosstalkGainIsReEstimatedBeforeItIsRemoved) {
   // The benches' naming rule: within 0.5x..1.5x the plant's 0.2.
   EXPECT_GT(pair.gain, 0.1);
   EXPECT_LT(pair.gain, 0.3);
+  // Re-estimated, not the attribution's (measured 0.135 from 0.225).
   ASSERT_EQ(r.fix.fitted_parameters.size(), 1u);
-  EXPECT_NE(r.fix.fitted_parameters.front(), pair.gain);  // re-estimated, not the attribution's
+  EXPECT_LT(pair.gain, 0.8 * r.fix.fitted_parameters.front());
 }
 
 TEST(ResidualFix, FrictionGetsDerivedCommandInputsAndCutsTheTendonsError) {
