@@ -56,7 +56,11 @@
 # seed 980); 1051-1060 the four delay cases measured with the final code and
 # the stop-40 binary (the same logs); 871-875 again as development for
 # friction, crosstalk, sensor-curve and tension-leak at --fix-epochs 20 and
-# 40 (40 not kept).
+# 40 (40 not kept). Stop 42 (a cross-talk's gain re-estimated through the
+# unchanged network before its removal; not kept): 971-990 again as
+# development (crosstalk and tension-leak at both strengths, two criteria of
+# the re-estimation), 1071-1080 every effect at both strengths measured with
+# that code and with the stop-41 binary (the same logs).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...

@@ -54,12 +54,7 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
     }
     const auto* derived = std::get_if<rs::DerivedCommandInputs>(&a.change);
     if (derived != nullptr && !derived->inputs.empty()) j["augmentation"]["derived_inputs"] = derived->inputs;
-    if (!f.fitted_parameters.empty()) {
-      if (std::holds_alternative<rs::CrosstalkRemoval>(a.change))
-        j["augmentation"]["fitted_gain"] = f.fitted_parameters.front();
-      else
-        j["augmentation"]["fitted_rates"] = f.fitted_parameters;
-    }
+    if (!f.fitted_rates.empty()) j["augmentation"]["fitted_rates"] = f.fitted_rates;
   }
   if (f.changed) j["sensor_model"] = f.model.sensor.describe();
   if (f.control) j["control"] = held_out_json(*f.control);

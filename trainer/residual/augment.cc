@@ -256,7 +256,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   }
 
   // What an augmentation re-estimates before fine-tuning (drift: the rates;
-  // curve: the slopes; cross-talk: the gain), probing the unchanged network with a sensor model on
+  // curve: the slopes), probing the unchanged network with a sensor model on
   // the rows before cut[i] of each log: the rows its fine-tuning will see.
   HadynetModel probe = model;
   auto refined = [&](Augmentation a, const std::vector<int>& cut, std::vector<double>* fitted) {
@@ -271,9 +271,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       }
       return Eigen::VectorXd(held_out_error(probe, train).rmse);
     };
-    std::vector<double> parameters;  // the attribution's, before refine()
-    std::visit([&](auto& change) { change.refine(a, model.sensor, training_rmse, parameters); }, a.change);
-    if (fitted != nullptr) *fitted = std::move(parameters);
+    std::vector<double> rates;
+    std::visit([&](auto& change) { change.refine(a, model.sensor, training_rmse, rates); }, a.change);
+    if (fitted != nullptr) *fitted = std::move(rates);
     return a;
   };
 
@@ -351,7 +351,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // found on (the plan's found_on, of the model's own channels: the aligned,
   // cleaned, clipped, drifting or friction channels; for an aux channel, the
   // channels its significant hypotheses explain).
-  const Augmentation tested = refined(planned[chosen], split, &result.fitted_parameters);
+  const Augmentation tested = refined(planned[chosen], split, &result.fitted_rates);
   if (!result.candidates[chosen].selected_by_training_rows) result.candidates[chosen].description = tested.description;
   Tuned after = tune(&tested, split, &result.untuned);
   result.augmentation = tested;

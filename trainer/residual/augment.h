@@ -109,15 +109,12 @@ struct TimeAlignment : ModelChange {
 };
 
 // crosstalk: removal of the winner's pair: the target picks up `gain` times
-// the source (the fitted gain, re-estimated before fine-tuning: refine); the
-// model is fine-tuned on y'_c = y_c - k y_s (in y and x); the measured y_c is
-// y'_c + k y'_s.
+// the source (the fitted gain); the model is fine-tuned on y'_c = y_c - k y_s
+// (in y and x); the measured y_c is y'_c + k y'_s.
 struct CrosstalkRemoval : ModelChange {
   SensorCrosstalk pair;  // target, source, gain (target units per source unit)
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;
-  void refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
-              std::vector<double>& fitted);
-  bool carried_before_tuning() const { return true; }  // refine() fitted it
+  bool carried_before_tuning() const { return true; }
 };
 
 // drift-load, drift-time: a bias state b_c(t) = rate * D_c(t) per family
@@ -306,9 +303,7 @@ struct FixResult {
   std::vector<CandidateTrial> candidates;          // the screen's candidates, in its order
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
-  // The attribution's parameters before refine(): drift, its rate per
-  // channel; crosstalk, the gain; else empty.
-  std::vector<double> fitted_parameters;
+  std::vector<double> fitted_rates;     // drift: the attribution's rate per channel, before refine(); else empty
   // Confirmed: what the data's 1-step residuals do not tell apart from the
   // confirmed change (look_alike()); "" otherwise.
   std::string look_alike;

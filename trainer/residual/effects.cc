@@ -1013,20 +1013,14 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
 // worse: between correlated sources the family holds pairs the plant does
 // not have (fc6 -> fc5 with gain -0.27 on the default plant logs), and fc1
 // got worse than before (docs/residual.md).
-// What --fix removes, e.g. "remove the crosstalk fc4 -> fc3 (train on fc3 -
-// 0.35 fc4; the sensor model adds it back)"; `how` says where the gain is from.
-std::string removal_text(const trainer::SensorCrosstalk& pair, const std::string& how) {
-  char gain[32];
-  std::snprintf(gain, sizeof gain, "%.4g", pair.gain);
-  return "remove the crosstalk " + pair.source + " -> " + pair.target + " (train on " + pair.target + " - " + gain +
-         " " + pair.source + how + "; the sensor model adds it back)";
-}
-
 void plan(const ResidualData& data, const Attribution&, const HypothesisResult& w, Augmentation& a) {
   auto& change = a.change.emplace<CrosstalkRemoval>();
   a.channels = {y_name(data, w.hypothesis.target)};
   change.pair = {a.channels[0], source_name(w.hypothesis, data), w.parameter};
-  a.description = removal_text(change.pair, "");
+  char gain[32];
+  std::snprintf(gain, sizeof gain, "%.4g", change.pair.gain);
+  a.description = "remove the crosstalk " + change.pair.source + " -> " + a.channels[0] + " (train on " +
+                  a.channels[0] + " - " + gain + " " + change.pair.source + "; the sensor model adds it back)";
   a.found_on = a.channels;
 }
 
@@ -1034,39 +1028,6 @@ void plan(const ResidualData& data, const Attribution&, const HypothesisResult& 
 }  // namespace
 
 void CrosstalkRemoval::add_to_sensor(SensorModel& s, const Augmentation&) const { s.crosstalk.push_back(pair); }
-
-// The attribution's gain reads high on fresh logs (fc4 -> fc3 at 0.46-0.64
-// for the plant's 0.35: the model's own misfit between neighbouring
-// loadcells adds to it), and a removal by too much feeds the network a
-// signal it was not trained on. The gain is re-estimated as the one, on a
-// grid of 0.05..2x the fitted gain in steps of 0.05x and inside the physical
-// domain (below 1), that minimises the unchanged network's 1-step error of
-// every channel on the training rows in the measured frame, each relative
-// to its error before: sum_c (rmse_c / rmse_c,before)^2, the calibration
-// curve's criterion. As there, the target's own error alone is no
-// criterion: what the network predicts of the other channels from the
-// cleaned target shows a wrong gain, and a pair that is the model's own
-// misfit re-estimates near the grid's bottom (fc4 -> fc3 on tension-leak
-// logs: 0.02-0.04 from 0.39-0.73, development seeds 971-990,
-// docs/residual.md). The grid starts above 0: a removal of nothing would be
-// the control itself.
-void CrosstalkRemoval::refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
-                              std::vector<double>& fitted) {
-  fitted.push_back(pair.gain);
-  const double fitted_gain = pair.gain;
-  const Eigen::ArrayXd rmse_before = training_rmse.all(before).array().max(1e-12);
-  double best_gain = fitted_gain, best_loss = std::numeric_limits<double>::infinity();
-  for (int step = 1; step <= 40; ++step) {
-    pair.gain = fitted_gain * 0.05 * step;
-    if (pair.gain >= 1) break;
-    const double loss = (training_rmse.all(sensor_after(before, a)).array() / rmse_before).square().sum();
-    if (loss < best_loss) best_loss = loss, best_gain = pair.gain;
-  }
-  pair.gain = best_gain;
-  char how[80];
-  std::snprintf(how, sizeof how, ", the gain re-estimated from the attribution's %.4g", fitted_gain);
-  a.description = crosstalk::removal_text(pair, how);
-}
 
 namespace {
 
@@ -1224,8 +1185,7 @@ const std::vector<EffectInfo>& effect_library() {
        "y_s(t) and y_s(t-1): another channel's measured value (by default of the target's group or unit) "
        "leaking into the target, and what the network carries over of it from x_{t-1}",
        "gain: the fraction of y_s the target picks up (the coefficient of y_s(t))",
-       "removal: train on y_c - k y_s (in y and x), k re-estimated through the unchanged network; the sensor "
-       "model adds k times the predicted y_s back",
+       "removal: train on y_c - k y_s (in y and x); the sensor model adds k times the predicted y_s back",
        SourceKind::kObserved, crosstalk::enumerate, crosstalk::features, first_coefficient, crosstalk::fraction,
        crosstalk::describe, crosstalk::plan, nullptr},
       {EffectKind::kAuxChannel, "aux-channel", "an aux_* column's value at t: a logged channel the model does not use",
