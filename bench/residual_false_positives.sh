@@ -45,7 +45,8 @@
 # on other groups too planned as a dead time): 991-1010 measured with rated
 # ranges, 1011-1030 without (971-990 and 1031-1065 belong to the other
 # benches). Stop 42 (a cross-talk's gain re-estimated before its removal;
-# not kept): 1081-1100 measured with rated ranges (1071-1080 and 1101-1110
+# not kept): 1081-1100 measured with rated ranges (seed 1086 also with the
+# stop-41 binary, on the same logs; 1071-1080, 1101-1110 and 1131-1135
 # belong to the other benches).
 # Give others as arguments.
 #

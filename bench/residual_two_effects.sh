@@ -22,7 +22,8 @@
 # the sensor delay's regressor on the predicted change); 1041-1045 with the
 # rule's first version (stop 41: a delay shown on other groups too planned
 # as a dead time); 1061-1065 with the final stop-41 code and the stop-40
-# binary (the same logs); 1131-1135 with the stop-41 code (stop 42).
+# binary (the same logs); 1131-1135 with the stop-41 code at --candidates 5
+# (stop 42).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]...
