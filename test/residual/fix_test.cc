@@ -96,18 +96,6 @@ FixRun run_fix(const std::vector<LogInput>& logs, const std::string& label,
   return r;
 }
 
-// The model's stored held-out logs (rows of its training logs no training
-// window used), as `hadynet residual` reads them by default.
-const std::vector<LogInput>& stored_null() {
-  static const std::vector<LogInput> logs = [] {
-    std::vector<LogInput> out;
-    for (const auto& stored : build_model().held_out_logs)
-      out.push_back({datalog::parse_log(stored.text, "held-out log " + stored.name), stored.name});
-    return out;
-  }();
-  return logs;
-}
-
 // The fix produced a model with the augmentation of `kind`.
 ::testing::AssertionResult fixed_as(const FixRun& r, EffectKind kind) {
   if (!r.fix.changed) return ::testing::AssertionFailure() << "not fixed: " << r.fix.status;

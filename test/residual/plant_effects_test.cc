@@ -477,12 +477,9 @@ TEST(PlantEffects, ACalibrationCurveIsNamedOnALoadcellAndItsGroupWithANull) {
   const rs::Analysis without = rs::analyse(build_model(), logs, {});
   for (const auto& r : without.attribution.ranked) EXPECT_NE(r.hypothesis.kind, EffectKind::kSensorCurve);
   EXPECT_NE(rs::floors_summary(without).find("calibration curves are not tested"), std::string::npos);
-  std::vector<rs::LogInput> stored_null;
-  for (const auto& stored : build_model().held_out_logs)
-    stored_null.push_back({datalog::parse_log(stored.text, "held-out log " + stored.name), stored.name});
   rs::AnalysisOptions options;
   options.reference_pb_choice = "state";
-  const rs::Analysis o = rs::analyse(build_model(), logs, options, stored_null);
+  const rs::Analysis o = rs::analyse(build_model(), logs, options, stored_null());
   std::printf("sensor-curve with the null: %s\n", o.verdict.c_str());
   ASSERT_TRUE(o.attribution.winner().has_value());
   const auto w = *o.attribution.winner();
@@ -507,15 +504,12 @@ Outcome analyse_with_the_stored_null(const std::string& effect, std::uint64_t se
   namespace rs = trainer::residual;
   static const auto model = rs::with_rated_ranges(
       build_model(), {rs::parse_rated_range("fc=0..50"), rs::parse_rated_range("f=0..200")});
-  std::vector<rs::LogInput> stored_null;
-  for (const auto& stored : model.held_out_logs)
-    stored_null.push_back({datalog::parse_log(stored.text, "held-out log " + stored.name), stored.name});
   trainer::SensorModel reference_sensor;  // the stored logs: the training logs, rated ranges only
   reference_sensor.clips = model.sensor.clips;
   rs::AnalysisOptions options;
   options.reference_pb_choice = "state";
   options.reference_sensor = &reference_sensor;
-  rs::Analysis a = rs::analyse(model, plant_logs(effect, 300, seed), options, stored_null);
+  rs::Analysis a = rs::analyse(model, plant_logs(effect, 300, seed), options, stored_null());
   std::printf("%s, seed %llu, with the stored null: %s\n", effect.c_str(), static_cast<unsigned long long>(seed),
               a.verdict.c_str());
   return {std::move(a.data), std::move(a.attribution)};

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "datalog/log_reader.h"
 #include "host-sim/plant/experiment.h"
 #include "trainer/model_file.h"
 #include "trainer/residual/residuals.h"
@@ -18,6 +19,19 @@ namespace hadynet::test {
 inline const trainer::HadynetModel& build_model() {
   static const trainer::HadynetModel model = trainer::load_model(HADYNET_MODEL_PATH);
   return model;
+}
+
+// The build model's stored held-out logs (rows of its training logs no
+// training window used), as `hadynet residual` reads them for its default
+// null. Rated ranges (with_rated_ranges) leave them as they are.
+inline const std::vector<trainer::residual::LogInput>& stored_null() {
+  static const std::vector<trainer::residual::LogInput> logs = [] {
+    std::vector<trainer::residual::LogInput> out;
+    for (const auto& stored : build_model().held_out_logs)
+      out.push_back({datalog::parse_log(stored.text, "held-out log " + stored.name), stored.name});
+    return out;
+  }();
+  return logs;
 }
 
 struct PlantLog {
