@@ -45,9 +45,9 @@
 # on other groups too planned as a dead time): 991-1010 measured with rated
 # ranges, 1011-1030 without (971-990 and 1031-1065 belong to the other
 # benches). Stop 42 (a cross-talk's gain re-estimated before its removal;
-# not kept): 1081-1100 measured with rated ranges (seed 1086 also with the
-# stop-41 binary, on the same logs; 1071-1080, 1101-1110 and 1131-1135
-# belong to the other benches).
+# not kept): 1081-1100 measured with rated ranges, with that code and with
+# the stop-41 binary on the same logs (they chose nothing in the kept code;
+# 1071-1080, 1101-1110 and 1131-1135 belong to the other benches).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

@@ -27,8 +27,8 @@
 # 811-820 (stop 38: --candidates 1 and 5, the same logs), 921-930 (stop 40:
 # the sensor delay's regressor on the predicted change), 1031-1040 (stop 41:
 # a delay shown on other groups too planned as a dead time), 1101-1110 (stop
-# 42: a cross-talk's gain re-estimated before its removal; not kept; seed
-# 1108 also with the stop-41 binary, on the same logs).
+# 42: a cross-talk's gain re-estimated before its removal, not kept; also
+# with the stop-41 binary on the same logs).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve]
