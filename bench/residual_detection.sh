@@ -10,7 +10,8 @@
 #             after/before) is at most 0.7;
 #   <control  the augmented model's RMSE there is below fine-tuning alone's.
 # Disjoint roles: the model is trained on seed 1 (collect --preset paper;
-# its stored null is held-out rows of those logs); the null's floor was
+# its stored null is held-out rows of those logs; the 4-seed model of stop
+# 43 on seeds 1 and 2001-2003); the null's floor was
 # chosen on seeds 11, 13-16 and 181-184; no seed below is any of those.
 # Seeds: 231-240 (never used for training, calibration, development or any
 # other benchmark; 181-184 and 191-192 were development runs of the decision
@@ -60,7 +61,12 @@
 # unchanged network before its removal; not kept): 971-990 again as
 # development (crosstalk and tension-leak at both strengths, two criteria of
 # the re-estimation), 1071-1080 every effect at both strengths measured with
-# that code and with the stop-41 binary (the same logs).
+# that code and with the stop-41 binary (the same logs). Stop 43 (the
+# 4-seed model, --model models/hand-4seeds.safetensors, trained on seeds 1
+# and 2001-2003 by scripts/train_hand_model.sh; no rule or threshold
+# changed): 971-980 every effect at its larger strength as the development
+# check, 1141-1150 every effect at both strengths measured with it and with
+# the build's model (the same logs and binary).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...

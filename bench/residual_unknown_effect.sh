@@ -14,7 +14,8 @@
 #                was added; since, a library effect on one loadcell.
 # Run with the plant's rated ranges.
 # Disjoint roles: the model is trained on seed 1 (collect --preset paper;
-# its stored null is held-out rows of those logs); the null's floor was
+# its stored null is held-out rows of those logs; the 4-seed model of stop
+# 43 on seeds 1 and 2001-2003); the null's floor was
 # chosen on seeds 11, 13-16 and 181-184; no seed below is any of those.
 # Seeds (curve): 221-230 (never used elsewhere; see
 # bench/residual_false_positives.sh); with the calibrated null of seed 270
@@ -28,7 +29,9 @@
 # the sensor delay's regressor on the predicted change), 1031-1040 (stop 41:
 # a delay shown on other groups too planned as a dead time), 1101-1110 (stop
 # 42: a cross-talk's gain re-estimated before its removal, not kept; also
-# with the stop-41 binary on the same logs).
+# with the stop-41 binary on the same logs), 1171-1180 (stop 43: the 4-seed
+# model, --model models/hand-4seeds.safetensors, trained on seeds 1 and
+# 2001-2003).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve]
