@@ -9,7 +9,8 @@
 # with the right parameter (bench/residual_named.py: the same rules as
 # bench/residual_detection.sh).
 # Disjoint roles: the model is trained on seed 1 (collect --preset paper;
-# its stored null is held-out rows of those logs); the null's floor was
+# its stored null is held-out rows of those logs; the 4-seed model of stop
+# 43 on seeds 1 and 2001-2003); the null's floor was
 # chosen on seeds 11, 13-16 and 181-184; no seed below is any of those.
 # Seeds: 511-515 were run by hand before this script (docs/residual.md,
 # "Rounds"); 631 development of the rounds' analysis model (the change
@@ -23,7 +24,9 @@
 # rule's first version (stop 41: a delay shown on other groups too planned
 # as a dead time); 1061-1065 with the final stop-41 code and the stop-40
 # binary (the same logs); 1131-1135 with the stop-41 code at --candidates 5
-# (stop 42).
+# (stop 42); 1181-1185 with the 4-seed model of stop 43 (--model
+# models/hand-4seeds.safetensors, trained on seeds 1 and 2001-2003) and
+# with the build's model (the same logs and binary).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]...
