@@ -15,24 +15,28 @@
 # project's 2-core VM).
 #
 # Usage: scripts/train_hand_model.sh [--seeds "S..."] [--data DIR] --out MODEL
-#   defaults: --seeds "1 2001 2002 2003", --data build/hand-model-data
-#   (DIR/seed<S>: each seed's recording, kept and reused when complete)
+#   defaults: --seeds "1 2001 2002 2003", --data build/hand-model-data (in
+#   the repository; DIR/seed<S>: each seed's recording, kept and reused when
+#   it validates). Relative MODEL and DIR are the caller's.
 # Environment: HADYNET (default build/release/cli/hadynet).
 set -euo pipefail
 usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
 seeds="1 2001 2002 2003"
-data=build/hand-model-data
+data=build/hand-model-data   # relative to the repository
+data_given=
 out=
 while (($#)); do
   case "$1" in
     -h | --help) usage; exit 0 ;;
     --seeds) seeds=$2; shift 2 ;;
-    --data) data=$2; shift 2 ;;
+    --data) data=$2; data_given=1; shift 2 ;;
     --out) out=$2; shift 2 ;;
     *) echo "train_hand_model: unknown argument $1 (--help)" >&2; exit 2 ;;
   esac
 done
 [[ -n "$out" ]] || { echo "train_hand_model: --out MODEL is required (--help)" >&2; exit 2; }
+out=$(realpath -m -- "$out")   # relative to the caller's directory, not the repository's
+[[ -z "$data_given" ]] || data=$(realpath -m -- "$data")
 cd "$(dirname "$0")/.."
 hadynet="${HADYNET:-build/release/cli/hadynet}"
 [[ -x "$hadynet" ]] || { echo "train_hand_model: $hadynet not found (scripts/build.sh release)" >&2; exit 2; }
