@@ -11,8 +11,8 @@
 #   <control  the augmented model's RMSE there is below fine-tuning alone's.
 # Disjoint roles: the model is trained on seed 1 (collect --preset paper;
 # its stored null is held-out rows of those logs; the 4-seed model of stop
-# 43 on seeds 1 and 2001-2003); the null's floor was
-# chosen on seeds 11, 13-16 and 181-184; no seed below is any of those.
+# 43 on seeds 1 and 2001-2003); the null's floor was chosen on seeds 11,
+# 13-16 and 181-184; no seed below is any of those.
 # Seeds: 231-240 (never used for training, calibration, development or any
 # other benchmark; 181-184 and 191-192 were development runs of the decision
 # with several candidates; see bench/residual_false_positives.sh for the

@@ -49,9 +49,9 @@
 # the stop-41 binary on the same logs (they chose nothing in the kept code;
 # 1071-1080, 1101-1110 and 1131-1135 belong to the other benches). Stop 43
 # (the 4-seed model, --model models/hand-4seeds.safetensors, trained on
-# seeds 1 and 2001-2003, which no bench uses): 1151-1170 measured with rated
-# ranges (1141-1150 and 1171-1191 belong to the other benches and the test
-# cli.four_seed_model).
+# seed 1 and seeds 2001-2003, which no bench uses): 1151-1170 measured with
+# rated ranges (1141-1150 and 1171-1185 belong to the other benches, 1191 to
+# the test cli.four_seed_model).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

@@ -10,8 +10,8 @@
 # bench/residual_detection.sh).
 # Disjoint roles: the model is trained on seed 1 (collect --preset paper;
 # its stored null is held-out rows of those logs; the 4-seed model of stop
-# 43 on seeds 1 and 2001-2003); the null's floor was
-# chosen on seeds 11, 13-16 and 181-184; no seed below is any of those.
+# 43 on seeds 1 and 2001-2003); the null's floor was chosen on seeds 11,
+# 13-16 and 181-184; no seed below is any of those.
 # Seeds: 511-515 were run by hand before this script (docs/residual.md,
 # "Rounds"); 631 development of the rounds' analysis model (the change
 # before fine-tuning); 641-645 measured, with the binary before and after

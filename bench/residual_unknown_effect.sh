@@ -15,8 +15,8 @@
 # Run with the plant's rated ranges.
 # Disjoint roles: the model is trained on seed 1 (collect --preset paper;
 # its stored null is held-out rows of those logs; the 4-seed model of stop
-# 43 on seeds 1 and 2001-2003); the null's floor was
-# chosen on seeds 11, 13-16 and 181-184; no seed below is any of those.
+# 43 on seeds 1 and 2001-2003); the null's floor was chosen on seeds 11,
+# 13-16 and 181-184; no seed below is any of those.
 # Seeds (curve): 221-230 (never used elsewhere; see
 # bench/residual_false_positives.sh); with the calibrated null of seed 270
 # (--reference-seed 270): 301-310; with the stored null and cross-talk

@@ -5,8 +5,10 @@
 # trained on seed 1 alone (docs/residual.md, "A model that generalises").
 # Checked here on one clean set of the four grasps of docs/residual.md,
 # recorded with seed 1191 (used for nothing else): `hadynet residual` with
-# each model, the channel-mean 1-step fit (the report's "fit h=1", %) of the
-# 4-seed model must beat the build model's by at least 4 points.
+# each model and the plant's rated ranges (as the benchmarks), the
+# channel-mean 1-step fit (the report's "fit h=1", %) of the 4-seed model
+# must beat the build model's by at least 4 points. Measured now: 57.6 %
+# against 73.2 %.
 # Tolerance: on the clean sets 1151-1170 (bench/residual_false_positives.sh)
 # the gap is 8.7-31.5 points (mean 16.8); 4 is about half the smallest, so a
 # 4-seed model that lost most of its advantage (trained on one seed, or a
@@ -31,10 +33,11 @@ print(sum(v[0] for v in fit.values()) / len(fit))' "$1"
 }
 for m in build four_seed; do
   model_var=${m}_model
-  "$hadynet" residual "${!model_var}" logs --json "$m.json" >"$m.txt" 2>&1 ||
+  "$hadynet" residual "${!model_var}" logs --rated-range fc=0..50 --rated-range f=0..200 --json "$m.json" >"$m.txt" 2>&1 ||
     fail "residual with the $m model exited $?: $(tail -3 "$m.txt")"
 done
-build_fit=$(mean_fit build.json) four_seed_fit=$(mean_fit four_seed.json) || fail "reading the fits"
+build_fit=$(mean_fit build.json) || fail "reading the build model's fit"
+four_seed_fit=$(mean_fit four_seed.json) || fail "reading the 4-seed model's fit"
 printf "channel-mean 1-step fit: build model %.1f %%, 4-seed model %.1f %% (at least %s points better required)\n" \
   "$build_fit" "$four_seed_fit" "$min_gap"
 python3 -c 'import sys; sys.exit(0 if float(sys.argv[2]) - float(sys.argv[1]) >= float(sys.argv[3]) else 1)' \
