@@ -65,8 +65,9 @@
 # 4-seed model, --model models/hand-4seeds.safetensors, trained on seeds 1
 # and 2001-2003 by scripts/train_hand_model.sh; no rule or threshold
 # changed): 971-980 every effect at its larger strength as the development
-# check, 1141-1150 every effect at both strengths measured with it and with
-# the build's model (the same logs and binary).
+# check (tension-leak=0.2 there also with --pb state), 1141-1150 every
+# effect at both strengths measured with it, with it and --pb state, and
+# with the build's model (the same logs and binary).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...
