@@ -65,7 +65,8 @@
 # 4-seed model, --model models/hand-4seeds.safetensors, trained on seeds 1
 # and 2001-2003 by scripts/train_hand_model.sh; no rule or threshold
 # changed): 971-980 every effect at its larger strength as the development
-# check (tension-leak=0.2 there also with --pb state), 1141-1150 every
+# check (tension-leak=0.2 there also with --pb state; every effect also
+# with an 8-seed model, seeds 1 and 2001-2007, not kept), 1141-1150 every
 # effect at both strengths measured with it, with it and --pb state, and
 # with the build's model (the same logs and binary).
 #
