@@ -9,7 +9,7 @@
 # Cylinder/random1/i0):
 #   clean      the trained states (their own zeroings), fresh motions and noise;
 #   effect     the same with one plant effect at its default strength
-#              (sensor-delay, friction, crosstalk, drift, saturation);
+#              (each of the library's effects);
 #   rezeroed   the same grasps under zeroings the model never saw (init ids
 #              below), relabelled with the trained state names: a hand
 #              re-zeroed at start-up that keeps its names.
@@ -20,8 +20,9 @@
 # use inits 100-149. Measured here: seeds 141-150 (clean, effect) and inits
 # 200-209 (rezeroed, seed 141), used for nothing else.
 #
-# Usage: bench/pb_auto_check.sh [--model M] [--out DIR] [--seeds N]
+# Usage: bench/pb_auto_check.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--first-init I]
 #   defaults: models/hand.safetensors, build/pb-auto-check, 10 seeds/zeroings
+#   from seed 141 and init 200 (the rezeroed sets are recorded with seed S)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per log set with an ETA, then the counts (OUT/summary.txt).
 set -euo pipefail
@@ -29,12 +30,16 @@ usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
 model=models/hand.safetensors
 out=build/pb-auto-check
 n=10
+first_seed=141
+first_init=200
 while (($#)); do
   case "$1" in
     -h | --help) usage; exit 0 ;;
     --model) model=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --seeds) n=$2; shift 2 ;;
+    --first-seed) first_seed=$2; shift 2 ;;
+    --first-init) first_init=$2; shift 2 ;;
     *) echo "pb_auto_check: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -45,7 +50,7 @@ hadynet="${HADYNET:-build/release/cli/hadynet}"
 mkdir -p "$out"
 summary="$out/summary.txt"
 : >"$summary"
-effects=(sensor-delay friction crosstalk drift saturation)
+effects=(sensor-delay friction crosstalk tension-leak drift saturation input-delay sensor-curve)
 
 # collect_set DIR SEED INIT_OVERRIDE [--effect E]: the four grasps; with an
 # init override, recorded under that zeroing and relabelled with the trained name.
@@ -88,15 +93,15 @@ PY
 }
 
 for ((k = 0; k < n; ++k)); do
-  seed=$((141 + k))
+  seed=$((first_seed + k))
   collect_set "$out/clean$seed" "$seed" ""
   check_set "clean seed $seed" "$out/clean$seed"
   for e in "${effects[@]}"; do
     collect_set "$out/$e$seed" "$seed" "" --effect "$e"
     check_set "$e seed $seed" "$out/$e$seed"
   done
-  init=$((200 + k))
-  collect_set "$out/rezeroed$init" 141 "$init"
+  init=$((first_init + k))
+  collect_set "$out/rezeroed$init" "$first_seed" "$init"
   check_set "rezeroed init $init" "$out/rezeroed$init"
 done
 

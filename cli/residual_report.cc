@@ -75,6 +75,9 @@ nlohmann::json analysis_json(const rs::Analysis& a, const std::string& model_pat
                     {"pb_check", log.pb_check.checked
                                      ? json{{"stored_loss", log.pb_check.stored_loss},
                                             {"adapted_loss", log.pb_check.adapted_loss},
+                                            {"stored_channel_loss", to_vector(log.pb_check.stored_channel_loss)},
+                                            {"adapted_channel_loss", to_vector(log.pb_check.adapted_channel_loss)},
+                                            {"channel_ratio", log.pb_check.channel_ratio},
                                             {"margin", rs::kStoredPbMargin},
                                             {"replaced", log.pb_check.replace}}
                                      : json(nullptr)},

@@ -51,6 +51,24 @@ std::vector<int> epoch_order(std::span<const int> ids, std::uint64_t seed, int e
   return order;
 }
 
+Eigen::VectorXd evaluate_channel_loss(const HadynetModel& model, const WindowDataset& data,
+                                      std::span<const int> ids, const Eigen::VectorXf& pb, int chunk) {
+  if (ids.empty()) return Eigen::VectorXd::Constant(data.y_dim(), std::numeric_limits<double>::quiet_NaN());
+  if (chunk < 1) throw std::invalid_argument("evaluate_loss: chunk must be >= 1");
+  HadynetNetwork<float> net;
+  WindowBatch<float> batch;
+  Matrix<float> y;
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(data.y_dim());
+  for (std::size_t begin = 0; begin < ids.size(); begin += static_cast<std::size_t>(chunk)) {
+    const std::size_t n = std::min(ids.size() - begin, static_cast<std::size_t>(chunk));
+    data.gather(ids.subspan(begin, n), batch, y);
+    if (pb.size() != 0) batch.pb = pb.replicate(1, static_cast<Eigen::Index>(n));
+    const Matrix<float>& y_hat = net.forward(model.params, batch, BnMode::kEval);
+    sum += (y_hat - y).rowwise().squaredNorm().cast<double>();  // y_hat, y: y_dim x (steps * windows)
+  }
+  return sum / (static_cast<double>(ids.size()) * data.steps());
+}
+
 double evaluate_loss(const HadynetModel& model, const WindowDataset& data, std::span<const int> ids,
                      const Eigen::VectorXf& pb, int chunk) {
   if (ids.empty()) return std::numeric_limits<double>::quiet_NaN();

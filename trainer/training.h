@@ -54,6 +54,13 @@ HadynetModel new_model(const FeatureLayout& layout, const Normalization& norm,
 double evaluate_loss(const HadynetModel& model, const WindowDataset& data, std::span<const int> ids,
                      const Eigen::VectorXf& pb = {}, int chunk = 1000);
 
+// The same per y channel: element c is channel c's mean squared error
+// (standardised units) over the windows' steps; their mean is evaluate_loss's
+// value up to rounding (kept apart: training's reported losses keep their bits).
+// Empty `ids`: a vector of NaN.
+Eigen::VectorXd evaluate_channel_loss(const HadynetModel& model, const WindowDataset& data,
+                                      std::span<const int> ids, const Eigen::VectorXf& pb = {}, int chunk = 1000);
+
 // Runs epochs state.epochs_done+1 .. options.epochs on the `train` windows,
 // reporting each epoch (held-out loss on `held_out` if non-empty) to
 // `on_epoch`, which may save a checkpoint. Throws std::invalid_argument on

@@ -300,7 +300,7 @@ TEST(PbAuto, TrainedPbOfAnotherZeroingIsReplaced) {
     if (log.pb_origin == ResidualLog::PbOrigin::kAdaptedOverTrained) ++replaced;
     // The rule the origin follows, whatever the losses.
     EXPECT_EQ(log.pb_origin == ResidualLog::PbOrigin::kAdaptedOverTrained,
-              log.pb_check.stored_loss > trainer::residual::kStoredPbMargin * log.pb_check.adapted_loss);
+              log.pb_check.channel_ratio > trainer::residual::kStoredPbMargin);
   }
   std::printf("trained PB replaced for %d of %zu re-zeroed logs\n", replaced, data.logs.size());
   EXPECT_GE(replaced, kRezeroedReplacedAtLeast);
@@ -321,6 +321,27 @@ TEST(PbAuto, TrainingZeroingsKeepTheirTrainedPb) {
   std::printf("trained PB kept for %d of %zu logs of the training zeroings\n", kept, data.logs.size());
   EXPECT_EQ(kept, static_cast<int>(data.logs.size()));
   EXPECT_EQ(trainer::residual::pb_summary(data, "auto").find("worse"), std::string::npos);
+}
+
+// A strong effect on one channel is not a new state. A tendon's tension
+// leaking into a palm loadcell (tension-leak=0.2, seed 1202: development
+// data of the check) makes the trained PB predict fc6 much worse, and the
+// mean held-out loss with it (trained/adapted 1.21, 1.12, 2.99, 1.26 for the
+// four grasps: the mean-loss rule replaced three PBs and the adapted PBs
+// absorbed part of the leak). Per channel the trained PB still predicts a
+// typical channel better (geometric mean 0.15-0.40), so every one is kept;
+// bound: all four, since the largest ratio is a third of the margin.
+TEST(PbAuto, AStrongEffectOnOneChannelKeepsTheTrainedPb) {
+  const trainer::residual::ResidualData data =
+      trainer::residual::compute_residuals(build_model(), plant_logs("tension-leak=0.2", 300, 1202), "auto");
+  int kept = 0;
+  for (const auto& log : data.logs) {
+    std::printf("%s: %s\n", log.seq.file.c_str(), log.pb_source.c_str());
+    ASSERT_TRUE(log.pb_check.checked) << log.seq.file;
+    if (log.pb_origin == ResidualLog::PbOrigin::kTrained) ++kept;
+  }
+  std::printf("trained PB kept for %d of %zu tension-leak logs\n", kept, data.logs.size());
+  EXPECT_EQ(kept, static_cast<int>(data.logs.size()));
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <limits>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -43,8 +44,9 @@ Eigen::VectorXf adapt_to(const HadynetModel& model, const std::vector<LogSequenc
 // name and changes its dynamics. So the trained PB is checked: a PB is adapted
 // to the first 70 % of the state's windows and both are scored on the last
 // 30 % (WindowDataset::split_tail: no observation in both). The trained PB is
-// replaced (by a PB adapted to all the windows) only when its held-out loss
-// exceeds the adapted one's by more than kStoredPbMargin.
+// replaced (by a PB adapted to all the windows) only when it predicts a
+// typical channel's held-out rows worse by more than kStoredPbMargin
+// (StoredPbCheck::channel_ratio).
 constexpr double kCheckHeldOutFraction = 0.3;
 
 StoredPbCheck check_stored_pb(const HadynetModel& model, const std::vector<LogSequence>& seqs,
@@ -56,9 +58,17 @@ StoredPbCheck check_stored_pb(const HadynetModel& model, const std::vector<LogSe
   const Eigen::VectorXf adapted =
       adapt_pb(model, data, split.train, Eigen::VectorXf::Zero(model.params.dims.pb), AdaptOptions{}).pb;
   c.checked = true;
-  c.stored_loss = evaluate_loss(model, data, split.held_out, stored);
-  c.adapted_loss = evaluate_loss(model, data, split.held_out, adapted);
-  c.replace = c.stored_loss > kStoredPbMargin * c.adapted_loss;
+  c.stored_channel_loss = evaluate_channel_loss(model, data, split.held_out, stored);
+  c.adapted_channel_loss = evaluate_channel_loss(model, data, split.held_out, adapted);
+  c.stored_loss = c.stored_channel_loss.mean();
+  c.adapted_loss = c.adapted_channel_loss.mean();
+  // A channel both PBs predict exactly (a constant one) has ratio 1: tiny is
+  // relative to the whole loss, so no channel's units matter.
+  const double tiny = 1e-12 * (c.stored_loss + c.adapted_loss) + std::numeric_limits<double>::min();
+  c.channel_ratio = std::exp(((c.stored_channel_loss.array() + tiny) / (c.adapted_channel_loss.array() + tiny))
+                                 .log()
+                                 .mean());
+  c.replace = c.channel_ratio > kStoredPbMargin;
   return c;
 }
 
@@ -221,7 +231,8 @@ ResidualData compute_residuals(const HadynetModel& model, const std::vector<LogI
         const StoredPbCheck check = check_stored_pb(model, seqs, pb);
         for (std::size_t i : members) data.logs[i].pb_check = check;
         const std::string losses = "held-out loss " + loss_text(check.stored_loss) + " trained, " +
-                                   loss_text(check.adapted_loss) + " adapted";
+                                   loss_text(check.adapted_loss) + " adapted; per channel trained/adapted " +
+                                   loss_text(check.channel_ratio) + " (geometric mean)";
         if (check.replace) {
           pb = adapt_to(model, seqs);
           source = "adapted to the state's logs: the trained PB of " + state + " fits them worse (" + losses +
