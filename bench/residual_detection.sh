@@ -68,7 +68,12 @@
 # check (tension-leak=0.2 there also with --pb state; every effect also
 # with an 8-seed model, seeds 1 and 2001-2007, not kept), 1141-1150 every
 # effect at both strengths measured with it, with it and --pb state, and
-# with the build's model (the same logs and binary).
+# with the build's model (the same logs and binary). Stop 44 (--pb auto's
+# check of a trained PB per channel, not by the mean loss; the rule chosen
+# on bench/pb_auto_check.sh's development sets 1201-1210 and on 971-979
+# checked without --fix): 1211-1220 every effect at both strengths measured
+# with the 4-seed model, and with the mean-loss check's binary on the 52
+# sets where the two checks decide a PB differently (the same logs).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--case EFFECT=STRENGTH]...

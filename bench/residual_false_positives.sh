@@ -51,7 +51,9 @@
 # (the 4-seed model, --model models/hand-4seeds.safetensors, trained on
 # seed 1 and seeds 2001-2003, which no bench uses): 1151-1170 measured with
 # rated ranges (1141-1150 and 1171-1185 belong to the other benches, 1191 to
-# the test cli.four_seed_model).
+# the test cli.four_seed_model). Stop 44 (--pb auto's check per channel,
+# the 4-seed model): 1221-1240 measured (1201-1220 and 1241-1265 belong to
+# the other benches).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

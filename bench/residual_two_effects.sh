@@ -26,7 +26,9 @@
 # binary (the same logs); 1131-1135 with the stop-41 code at --candidates 5
 # (stop 42); 1181-1185 with the 4-seed model of stop 43 (--model
 # models/hand-4seeds.safetensors, trained on seeds 1 and 2001-2003) and
-# with the build's model (the same logs and binary).
+# with the build's model (the same logs and binary); 1261-1265 (stop 44:
+# --pb auto's check per channel, the 4-seed model; also with the mean-loss
+# check's binary on the same logs).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]...

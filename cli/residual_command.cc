@@ -174,9 +174,9 @@ int run_residual(int argc, char** argv) {
               "parameters, or 'no significant effect'. Works on any (u, y) logs the model's channels fit.",
               "MODEL LOG|DIR... [options]");
   opt.value("pb", "PB",
-            "auto (the state's trained PB if the model knows it and it predicts the state's held-out rows\n"
-            "at most " + num("%g", rs::kStoredPbMargin) +
-                " times worse than one adapted to its other rows, else adapted), state, adapt, zero,\n"
+            "auto (the state's trained PB if the model knows it and it predicts a typical channel of the\n"
+            "state's held-out rows (geometric mean over the channels) at most " + num("%g", rs::kStoredPbMargin) +
+                " times worse than one\nadapted to its other rows, else adapted), state, adapt, zero,\n"
                 "a state, or values",
             "auto");
   opt.value("horizon", "N", "multi-step horizon (default: the model's N_train)");
