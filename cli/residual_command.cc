@@ -176,8 +176,8 @@ int run_residual(int argc, char** argv) {
   opt.value("pb", "PB",
             "auto (the state's trained PB if the model knows it and it predicts a typical channel of the\n"
             "state's held-out rows (geometric mean over the channels) at most " + num("%g", rs::kStoredPbMargin) +
-                " times worse than one\nadapted to its other rows, else adapted), state, adapt, zero,\n"
-                "a state, or values",
+                " times worse than one\nadapted to its other rows, else adapted), state, adapt, zero, a state,\n"
+                "or values",
             "auto");
   opt.value("horizon", "N", "multi-step horizon (default: the model's N_train)");
   opt.value("max-lag", "L", "correlation lags 1..L (whiteness) and -L..L (independence)",
