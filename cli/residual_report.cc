@@ -20,6 +20,14 @@ namespace {
 
 std::vector<double> to_vector(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
 
+// {name: value} for per-channel values in `names`' order.
+json by_channel(const std::vector<std::string>& names, const Eigen::VectorXd& v) {
+  json out = json::object();
+  for (std::size_t c = 0; c < names.size() && static_cast<Eigen::Index>(c) < v.size(); ++c)
+    out[names[c]] = v(static_cast<Eigen::Index>(c));
+  return out;
+}
+
 json hypothesis_json(const rs::ResidualData& data, const rs::HypothesisResult& r) {
   const auto& h = r.hypothesis;
   json j = {{"effect", r.effect},
@@ -75,8 +83,8 @@ nlohmann::json analysis_json(const rs::Analysis& a, const std::string& model_pat
                     {"pb_check", log.pb_check.checked
                                      ? json{{"stored_loss", log.pb_check.stored_loss},
                                             {"adapted_loss", log.pb_check.adapted_loss},
-                                            {"stored_channel_loss", to_vector(log.pb_check.stored_channel_loss)},
-                                            {"adapted_channel_loss", to_vector(log.pb_check.adapted_channel_loss)},
+                                            {"stored_channel_loss", by_channel(d.y_names, log.pb_check.stored_channel_loss)},
+                                            {"adapted_channel_loss", by_channel(d.y_names, log.pb_check.adapted_channel_loss)},
                                             {"channel_ratio", log.pb_check.channel_ratio},
                                             {"margin", rs::kStoredPbMargin},
                                             {"replaced", log.pb_check.replace}}

@@ -54,7 +54,7 @@ std::vector<int> epoch_order(std::span<const int> ids, std::uint64_t seed, int e
 Eigen::VectorXd evaluate_channel_loss(const HadynetModel& model, const WindowDataset& data,
                                       std::span<const int> ids, const Eigen::VectorXf& pb, int chunk) {
   if (ids.empty()) return Eigen::VectorXd::Constant(data.y_dim(), std::numeric_limits<double>::quiet_NaN());
-  if (chunk < 1) throw std::invalid_argument("evaluate_loss: chunk must be >= 1");
+  if (chunk < 1) throw std::invalid_argument("evaluate_channel_loss: chunk must be >= 1");
   HadynetNetwork<float> net;
   WindowBatch<float> batch;
   Matrix<float> y;

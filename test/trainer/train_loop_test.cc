@@ -85,18 +85,28 @@ TEST(EpochOrder, IsAPermutationThatDependsOnSeedAndEpochOnly) {
   EXPECT_EQ(epoch_order(std::vector<int>{4}, 9, 1), std::vector<int>{4});
 }
 
+// The fresh model with distinct PBs, and its predictions and targets over
+// every window of `s` in one batch, BN eval (y_dim x (steps * windows)): the
+// reference for evaluate_loss and evaluate_channel_loss, which chunk.
+struct EvalReference {
+  HadynetModel model;
+  std::vector<int> ids;
+  Matrix<float> y_hat, y;
+  explicit EvalReference(const LoopData& s) : model(s.fresh), ids(all_ids(s.data)) {
+    model.params.pb << 0.5f, -0.25f, -0.75f, 1.0f;
+    WindowBatch<float> batch;
+    s.data.gather(ids, batch, y);
+    HadynetNetwork<float> net;
+    y_hat = net.forward(model.params, batch, BnMode::kEval);
+  }
+};
+
 TEST(EvaluateLoss, IsTheEvalModeMseOfTheWindowsWithTheirOwnOrAGivenPb) {
   const LoopData s;
-  HadynetModel m = s.fresh;
-  m.params.pb << 0.5f, -0.25f, -0.75f, 1.0f;
-  const std::vector<int> ids = all_ids(s.data);
-
-  // Reference: one batch, BN eval.
-  WindowBatch<float> batch;
-  Matrix<float> y;
-  s.data.gather(ids, batch, y);
-  HadynetNetwork<float> net;
-  const double ref = static_cast<double>(mse_loss(net.forward(m.params, batch, BnMode::kEval), y));
+  const EvalReference r(s);
+  const HadynetModel& m = r.model;
+  const std::vector<int>& ids = r.ids;
+  const double ref = static_cast<double>(mse_loss(r.y_hat, r.y));
   // Float sums over ~1000 squared errors, chunked or not: 1e-5 relative
   // covers the rounding; a wrong PB or mode changes the loss by far more.
   EXPECT_NEAR(evaluate_loss(m, s.data, ids), ref, 1e-5 * ref);
@@ -114,6 +124,24 @@ TEST(EvaluateLoss, IsTheEvalModeMseOfTheWindowsWithTheirOwnOrAGivenPb) {
   EXPECT_GT(std::abs(evaluate_loss(m, s.data, stiff, p0) - with_table), 1e-3 * with_table);
 
   EXPECT_TRUE(std::isnan(evaluate_loss(m, s.data, std::vector<int>{})));
+}
+
+TEST(EvaluateLoss, PerChannelLossesAreTheColumnsOfTheMseAndAverageToIt) {
+  const LoopData s;
+  const EvalReference r(s);
+  const HadynetModel& m = r.model;
+  const std::vector<int>& ids = r.ids;
+  const Matrix<float> err = r.y_hat - r.y;
+  const Eigen::VectorXd per_channel = evaluate_channel_loss(m, s.data, ids, {}, 7);
+  ASSERT_EQ(per_channel.size(), s.data.y_dim());
+  // The same float rounding bound as above (sums over ~1000 squared errors).
+  for (int c = 0; c < s.data.y_dim(); ++c) {
+    const double ref = static_cast<double>(err.row(c).squaredNorm()) / static_cast<double>(err.cols());
+    EXPECT_NEAR(per_channel(c), ref, 1e-5 * ref) << "channel " << c;
+  }
+  const double mean = evaluate_loss(m, s.data, ids);
+  EXPECT_NEAR(per_channel.mean(), mean, 1e-5 * mean);
+  EXPECT_TRUE(evaluate_channel_loss(m, s.data, std::vector<int>{}).array().isNaN().all());
 }
 
 TEST(TrainLoop, LossFallsOnTheSyntheticStates) {
