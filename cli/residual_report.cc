@@ -131,10 +131,9 @@ nlohmann::json analysis_json(const rs::Analysis& a, const std::string& model_pat
   const auto w = att.winner();
   json null_json = nullptr;
   if (att.null) {
-    json level = json::object();
-    for (std::size_t c = 0; c < d.y_names.size(); ++c)
-      level[d.y_names[c]] = att.null->residual_level(static_cast<Eigen::Index>(c));
-    null_json = {{"logs", att.null->logs}, {"pb_summary", a.reference_pb}, {"residual_level", level}};
+    null_json = {{"logs", att.null->logs},
+                 {"pb_summary", a.reference_pb},
+                 {"residual_level", by_channel(d.y_names, att.null->residual_level)}};
   }
   return {{"model", model_path},
           {"pb", pb_choice},

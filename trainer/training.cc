@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
+#include <string>
 
 namespace hadynet::trainer {
 
@@ -51,39 +53,47 @@ std::vector<int> epoch_order(std::span<const int> ids, std::uint64_t seed, int e
   return order;
 }
 
-Eigen::VectorXd evaluate_channel_loss(const HadynetModel& model, const WindowDataset& data,
-                                      std::span<const int> ids, const Eigen::VectorXf& pb, int chunk) {
-  if (ids.empty()) return Eigen::VectorXd::Constant(data.y_dim(), std::numeric_limits<double>::quiet_NaN());
-  if (chunk < 1) throw std::invalid_argument("evaluate_channel_loss: chunk must be >= 1");
+namespace {
+
+// Runs `model` (BN eval) on the windows `ids` in chunks of `chunk` windows,
+// each with its own state's PB or with `pb` if it is non-empty, and calls
+// on_chunk(y_hat, y) per chunk (both y_dim x (steps * windows)). `caller`
+// names the function in the chunk error.
+template <class OnChunk>
+void for_each_chunk(const HadynetModel& model, const WindowDataset& data, std::span<const int> ids,
+                    const Eigen::VectorXf& pb, int chunk, const char* caller, OnChunk on_chunk) {
+  if (chunk < 1) throw std::invalid_argument(std::string(caller) + ": chunk must be >= 1");
   HadynetNetwork<float> net;
   WindowBatch<float> batch;
   Matrix<float> y;
-  Eigen::VectorXd sum = Eigen::VectorXd::Zero(data.y_dim());
   for (std::size_t begin = 0; begin < ids.size(); begin += static_cast<std::size_t>(chunk)) {
     const std::size_t n = std::min(ids.size() - begin, static_cast<std::size_t>(chunk));
     data.gather(ids.subspan(begin, n), batch, y);
     if (pb.size() != 0) batch.pb = pb.replicate(1, static_cast<Eigen::Index>(n));
-    const Matrix<float>& y_hat = net.forward(model.params, batch, BnMode::kEval);
-    sum += (y_hat - y).rowwise().squaredNorm().cast<double>();  // y_hat, y: y_dim x (steps * windows)
+    on_chunk(net.forward(model.params, batch, BnMode::kEval), y);
   }
+}
+
+}  // namespace
+
+Eigen::VectorXd evaluate_channel_loss(const HadynetModel& model, const WindowDataset& data,
+                                      std::span<const int> ids, const Eigen::VectorXf& pb, int chunk) {
+  if (ids.empty()) return Eigen::VectorXd::Constant(data.y_dim(), std::numeric_limits<double>::quiet_NaN());
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(data.y_dim());
+  for_each_chunk(model, data, ids, pb, chunk, "evaluate_channel_loss",
+                 [&](const Matrix<float>& y_hat, const Matrix<float>& y) {
+                   sum += (y_hat - y).rowwise().squaredNorm().cast<double>();
+                 });
   return sum / (static_cast<double>(ids.size()) * data.steps());
 }
 
 double evaluate_loss(const HadynetModel& model, const WindowDataset& data, std::span<const int> ids,
                      const Eigen::VectorXf& pb, int chunk) {
   if (ids.empty()) return std::numeric_limits<double>::quiet_NaN();
-  if (chunk < 1) throw std::invalid_argument("evaluate_loss: chunk must be >= 1");
-  HadynetNetwork<float> net;
-  WindowBatch<float> batch;
-  Matrix<float> y;
   double sum = 0.0;
-  for (std::size_t begin = 0; begin < ids.size(); begin += static_cast<std::size_t>(chunk)) {
-    const std::size_t n = std::min(ids.size() - begin, static_cast<std::size_t>(chunk));
-    data.gather(ids.subspan(begin, n), batch, y);
-    if (pb.size() != 0) batch.pb = pb.replicate(1, static_cast<Eigen::Index>(n));
-    const Matrix<float>& y_hat = net.forward(model.params, batch, BnMode::kEval);
+  for_each_chunk(model, data, ids, pb, chunk, "evaluate_loss", [&](const Matrix<float>& y_hat, const Matrix<float>& y) {
     sum += static_cast<double>((y_hat - y).squaredNorm());
-  }
+  });
   return sum / (static_cast<double>(ids.size()) * data.steps() * data.y_dim());
 }
 

@@ -56,7 +56,8 @@ double evaluate_loss(const HadynetModel& model, const WindowDataset& data, std::
 
 // The same per y channel: element c is channel c's mean squared error
 // (standardised units) over the windows' steps; their mean is evaluate_loss's
-// value up to rounding (kept apart: training's reported losses keep their bits).
+// value up to rounding (evaluate_loss sums in its own order: training's
+// reported losses keep their bits).
 // Empty `ids`: a vector of NaN.
 Eigen::VectorXd evaluate_channel_loss(const HadynetModel& model, const WindowDataset& data,
                                       std::span<const int> ids, const Eigen::VectorXf& pb = {}, int chunk = 1000);
