@@ -60,23 +60,18 @@ summary="$out/summary.txt"
 : >"$summary"
 effects=(sensor-delay friction crosstalk tension-leak drift saturation input-delay sensor-curve)
 
-# collect_set DIR SEED INIT_OVERRIDE [--effect E]: the four grasps; with an
-# init override, recorded under that zeroing and relabelled with the trained name.
+# collect_set DIR SEED INIT_OVERRIDE [--effect E]: the four grasps in DIR/logs;
+# with an init override, recorded under that zeroing and relabelled with the
+# trained name (collect_rezeroed_grasps).
 collect_set() {
   local dir=$1 seed=$2 init_override=$3
   shift 3
   rm -rf "$dir" && mkdir -p "$dir/logs"
-  for g in "${residual_grasps[@]}"; do
-    set -- $g "$@"
-    local object=$1 motion=$2 init=$3
-    shift 3
-    local rec_init=${init_override:-$init}
-    "$hadynet" collect --object "$object" --motion "$motion" --init "$rec_init" --rows 300 --seed "$seed" \
-      --out "$dir/raw" --quiet "$@" >/dev/null
-    local f
-    f=$(ls "$dir"/raw/*/"${object}_${motion}_i${rec_init}_w0.csv")
-    sed "s|^# state: .*|# state: $object/i$init/w0|" "$f" >"$dir/logs/${object}_${motion}_i${init}.csv"
-  done
+  if [[ -n "$init_override" ]]; then
+    collect_rezeroed_grasps "$hadynet" "$dir/logs" "$seed" "$init_override" "$@"
+  else
+    collect_residual_grasps "$hadynet" "$dir/logs" "$seed" "$@"
+  fi
 }
 
 # check_set NAME DIR: residual --pb auto, one line with each state's losses and verdict.

@@ -76,10 +76,12 @@
 # sets where the two checks decide a PB differently (the same logs).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
-#          [--reference-seed S] [--case EFFECT=STRENGTH]...
+#          [--reference-seed S] [--rezeroed-first-init I] [--case EFFECT=STRENGTH]...
 #   defaults: models/hand.safetensors, build/residual-detection, 10, 231, the tool's --candidates (5), every case
 #   (--case: only those; repeatable), the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
+#   --rezeroed-first-init I: the k-th seed's sets are recorded under the zeroing I + k, one the model
+#   never saw, and keep the trained state names (a re-zeroed hand; bench/residual_grasps.sh)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
 set -euo pipefail
@@ -91,6 +93,7 @@ n=10
 first_seed=231
 candidates=()
 only_cases=()
+rezeroed_first_init=
 while (($#)); do
   case "$1" in
     -h | --help) usage; exit 0 ;;
@@ -101,6 +104,7 @@ while (($#)); do
     --first-seed) first_seed=$2; shift 2 ;;
     --candidates) candidates=(--candidates "$2"); shift 2 ;;
     --case) only_cases+=("$2"); shift 2 ;;
+    --rezeroed-first-init) rezeroed_first_init=$2; shift 2 ;;
     *) echo "residual_detection: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -123,7 +127,11 @@ for ((k = 0; k < n; ++k)); do
   for c in "${cases[@]}"; do
     d="$out/$c/seed$seed"
     rm -rf "$d" && mkdir -p "$d"
-    collect_residual_grasps "$hadynet" "$d/logs" "$seed" --effect "$c"
+    if [[ -n "$rezeroed_first_init" ]]; then
+      collect_rezeroed_grasps "$hadynet" "$d/logs" "$seed" $((rezeroed_first_init + k)) --effect "$c"
+    else
+      collect_residual_grasps "$hadynet" "$d/logs" "$seed" --effect "$c"
+    fi
     "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 "${reference_args[@]}" --fix \
       "${candidates[@]}" \
       --json "$d/residual.json" >"$d/out.txt" 2>&1 || { echo "$c seed $seed: residual failed" >>"$runs"; continue; }

@@ -57,12 +57,14 @@
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
-#          [--reference-seed S] [SEED...]
+#          [--reference-seed S] [--rezeroed-first-init I] [SEED...]
 #   defaults: models/hand.safetensors, build/residual-false-positives, 161..180,
 #   no rated range (the plant's datasheet: --rated-range fc=0..50 --rated-range f=0..200),
 #   the null of `hadynet residual`'s default: the held-out logs stored in the model
 #   (--reference-seed S: clean sets of the four grasps recorded with seed S are the null,
 #   `hadynet residual --reference`; --reference-seed none: no null, absolute floors)
+#   --rezeroed-first-init I: the n-th seed's set is recorded under the zeroing I + n - 1, one the
+#   model never saw, and keeps the trained state names (a re-zeroed hand; bench/residual_grasps.sh)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per seed with an ETA, then the counts; OUT/summary.txt.
 set -euo pipefail
@@ -72,6 +74,7 @@ reference_seed=
 out=build/residual-false-positives
 seeds=()
 ranges=()
+rezeroed_first_init=
 while (($#)); do
   case "$1" in
     -h | --help) usage; exit 0 ;;
@@ -80,6 +83,7 @@ while (($#)); do
     --out) out=$2; shift 2 ;;
     --rated-range) ranges+=(--rated-range "$2"); shift 2 ;;
     --candidates) ranges+=(--candidates "$2"); shift 2 ;;
+    --rezeroed-first-init) rezeroed_first_init=$2; shift 2 ;;
     -*) echo "residual_false_positives: unknown option $1" >&2; exit 2 ;;
     *) seeds+=("$1"); shift ;;
   esac
@@ -98,7 +102,11 @@ for seed in "${seeds[@]}"; do
   i=$((i + 1))
   d="$out/seed$seed"
   rm -rf "$d" && mkdir -p "$d/logs"
-  collect_residual_grasps "$hadynet" "$d/logs" "$seed"
+  if [[ -n "$rezeroed_first_init" ]]; then
+    collect_rezeroed_grasps "$hadynet" "$d/logs" "$seed" $((rezeroed_first_init + i - 1))
+  else
+    collect_residual_grasps "$hadynet" "$d/logs" "$seed"
+  fi
   # stdout and stderr apart (a file's stdout is block-buffered: interleaved, a
   # line could be cut); the counts come from the JSON, not from the text.
   if ! "$hadynet" residual "$model" "$d/logs" "${ranges[@]}" "${reference_args[@]}" --fix --json "$d/residual.json" >"$d/out.txt" \

@@ -18,6 +18,26 @@ collect_residual_grasps() {
   done
 }
 
+# collect_rezeroed_grasps HADYNET OUT SEED INIT [collect options...]: the same
+# four grasps recorded under the zeroing INIT (an init id the model never
+# saw) and relabelled with their trained state names (OUT/*.csv): a hand
+# re-zeroed at start-up that keeps its names (docs/residual.md, "Which PB").
+# The plant's raw recordings stay in OUT.raw (beside OUT: a log directory is
+# read recursively).
+collect_rezeroed_grasps() {
+  local hadynet=$1 out=$2 seed=$3 rezero=$4 g f
+  shift 4
+  mkdir -p "$out"
+  for g in "${residual_grasps[@]}"; do
+    set -- $g "$@"
+    "$hadynet" collect --object "$1" --motion "$2" --init "$rezero" --rows "${RESIDUAL_ROWS:-300}" --seed "$seed" \
+      --out "$out.raw" "${@:4}" --quiet >/dev/null
+    f=$(ls "$out".raw/*/"$1_$2_i${rezero}_w0.csv")
+    sed "s|^# state: .*|# state: $1/i$3/w0|" "$f" >"$out/$1_$2_i$3.csv"
+    shift 3
+  done
+}
+
 # record_reference HADYNET OUT SEED: clean log sets of the four grasps with
 # SEED in OUT/reference, the calibrated null of `hadynet residual --reference`
 # (docs/residual.md, "A calibrated null"), and sets reference_args to the
