@@ -153,6 +153,7 @@ void print_fix(const rs::FixResult& fixed) {
                   "on the training rows' last 25 %% is significant, else the clearest gain, else the screen's first):\n");
       for (const auto& c : fixed.candidates) {
         std::printf("  %c %-74.74s", c.chosen ? '*' : ' ', (c.effect + ": " + c.description).c_str());
+        if (c.below_screen_floor) std::printf(" below the screen's floor (%.2g);", c.screen_statistic);
         if (c.selected_by_training_rows)
           std::printf(" training rows: DM %.2f, p %.2g\n", c.selection.stat, c.selection.p_value);
         else std::printf(" not judged\n");
@@ -235,6 +236,12 @@ int run_residual(int argc, char** argv) {
                               "fine-tuning alone on the rest; the first significant there, else the clearest gain,\n"
                               "else the screen's first, is the one the decision tests on the held-out rows (1: the\n"
                               "screen's winner)", "5");
+  opt.value("fix-min-excess-null", "S",
+            "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"
+            "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"
+            "decision on held-out rows against fine-tuning alone guards what is applied (1 names more effects\n"
+            "and makes more wrong fixes on fresh plant logs: docs/residual.md)",
+            "the screen's");
   opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
                         "unchanged model, a weaker guard)");
   if (!opt.parse(argc, argv)) return 2;
@@ -282,7 +289,20 @@ int run_residual(int argc, char** argv) {
   const auto fix_seed = opt.get_int("fix-seed", 0, (1ll << 62));
   const auto rounds = opt.get_int("rounds", 1, 20);
   const auto candidates = opt.get_int("candidates", 1, 20);
+  std::optional<double> min_excess_candidates;
+  if (opt.has("fix-min-excess-null")) {
+    min_excess_candidates = opt.get_double("fix-min-excess-null", 0.0, 1e6);
+    if (!min_excess_candidates) return 2;
+  }
   if (!fix_epochs || !fix_lr || !fix_seed || !rounds || !candidates) return 2;
+  if (opt.has("fix-min-excess-null") && !opt.has("fix")) {
+    std::fprintf(stderr, "hadynet residual: --fix-min-excess-null needs --fix\n");
+    return 2;
+  }
+  if (opt.has("fix-min-excess-null") && no_reference) {
+    std::fprintf(stderr, "hadynet residual: --fix-min-excess-null needs a null (not --reference none)\n");
+    return 2;
+  }
   if (opt.has("rounds") && !opt.has("fix")) {
     std::fprintf(stderr, "hadynet residual: --rounds needs --fix\n");
     return 2;
@@ -317,9 +337,11 @@ int run_residual(int argc, char** argv) {
         no_reference ? std::vector<rs::LogInput>{}
                      : reference_logs(model, model_path, reference_args, inputs, &null_source);
     if (no_reference) null_source = "--reference none";
-    if (opt.has("min-excess-null") && reference.empty()) {
-      std::fprintf(stderr, "hadynet residual: --min-excess-null needs a null: %s\n", null_source.c_str());
-      return 2;
+    for (const char* name : {"min-excess-null", "fix-min-excess-null"}) {
+      if (opt.has(name) && reference.empty()) {
+        std::fprintf(stderr, "hadynet residual: --%s needs a null: %s\n", name, null_source.c_str());
+        return 2;
+      }
     }
 
     rs::AnalysisOptions ao;
@@ -348,6 +370,7 @@ int run_residual(int argc, char** argv) {
     fo.seed = static_cast<std::uint64_t>(*fix_seed);
     fo.control = !opt.has("no-control");
     fo.candidates = static_cast<int>(*candidates);
+    fo.min_excess_candidates = min_excess_candidates;
     fo.reference = &reference;
     fo.reference_pb_choice = stored_null ? "state" : "auto";
     fo.library = ao.library;

@@ -37,6 +37,7 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
             {"epochs", o.epochs},
             {"lr", o.lr},
             {"seed", o.seed},
+            {"min_excess_candidates", o.min_excess_candidates ? json(*o.min_excess_candidates) : json(nullptr)},
             {"before", held_out_json(f.before)}};
   if (f.augmentation) {
     const rs::Augmentation& a = *f.augmentation;
@@ -76,6 +77,8 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
       candidates.push_back({{"effect", c.effect},
                             {"description", c.description},
                             {"channels", c.channels},
+                            {"screen_statistic", c.screen_statistic},
+                            {"below_screen_floor", c.below_screen_floor},
                             {"selected_by_training_rows", c.selected_by_training_rows},
                             {"selection_statistic", c.selection.stat},
                             {"selection_p_value", c.selection.p_value},

@@ -80,6 +80,11 @@ expect 2 "expected NAME=LOW..HIGH" "$model" good.csv --rated-range fc --json out
 expect 1 "rated range 'u': no output channel or group of that name" "$model" good.csv --rated-range u=0..1 --json out.json
 expect 2 "--min-excess-null needs a null (not --reference none)" "$model" good.csv --reference none --min-excess-null 2 --json out.json
 expect 2 "--min-excess-null: expected a number" "$model" good.csv --reference good.csv --min-excess-null x --json out.json
+expect 2 "--fix-min-excess-null needs --fix" "$model" good.csv --fix-min-excess-null 1 --json out.json
+expect 2 "--fix-min-excess-null needs a null (not --reference none)" "$model" good.csv --reference none --fix \
+  --fix-min-excess-null 1 --json out.json
+expect 2 "--fix-min-excess-null: expected a number in 0..1e+06, got '1e9'" "$model" good.csv --fix \
+  --fix-min-excess-null 1e9 --json out.json
 expect 1 "--reference good.csv is also a log under test" "$model" good.csv --reference good.csv --json out.json
 expect 1 "no_fc8.csv: no column 'fc8'" "$model" good.csv --reference no_fc8.csv --json out.json
 expect 1 "malformed.csv:15:12: column 'f2'" "$model" good.csv --reference malformed.csv --json out.json

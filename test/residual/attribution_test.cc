@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -353,6 +354,55 @@ TEST(CalibratedNull, StructureTheNullAlsoShowsIsNoEffect) {
     if (r.hypothesis.kind != EffectKind::kFriction || r.hypothesis.target != 0 || r.hypothesis.source != 1) continue;
     EXPECT_GT(r.null_explained_std, 0.5 * r.explained_std);
   }
+}
+
+// with_null_floor (--fix's candidates below the screen's floor) is attribute()
+// at that floor: the same significant hypotheses in the same order, the
+// fits and p-values untouched, at floors below, at and above the default; a
+// lower floor lets more in. Without a null the absolute floors stay.
+TEST(CalibratedNull, AnotherFloorRanksAsAttributeAtThatFloor) {
+  const ResidualData test = scaled(21, 1.0, true);
+  const ResidualData reference = scaled(22, 1.0, false);
+  const auto hypotheses = enumerate_hypotheses(test, {});
+  const NullCalibration null = calibrate_null(test, reference, hypotheses, {});
+  const Attribution screen = attribute(test, hypotheses, {}, &null);
+  const auto significant = [](const Attribution& a) {
+    std::vector<std::string> labels;
+    for (const auto& r : a.ranked)
+      if (r.significant) labels.push_back(r.label);
+    return labels;
+  };
+  // The second largest share of the hypotheses that pass every other test:
+  // a floor there lets fewer in than a floor of 0.
+  std::vector<double> shares;
+  for (const auto& r : with_null_floor(screen, 0.0).ranked)
+    if (r.significant) shares.push_back(r.excess_share);
+  ASSERT_GE(shares.size(), 2u);
+  const double between = shares[1];
+  std::size_t at_zero = 0, at_between = 0;
+  for (const double floor : {0.0, 0.5, 1.0, kDefaultMinExcessNull, between, 10.0, 1e6}) {
+    AttributionOptions o;
+    o.min_excess_null = floor;
+    const Attribution direct = attribute(test, hypotheses, o, &null);
+    const Attribution refloored = with_null_floor(screen, floor);
+    EXPECT_EQ(significant(refloored), significant(direct)) << "floor " << floor;
+    EXPECT_EQ(refloored.options.min_excess_null, floor);
+    EXPECT_EQ(refloored.tested, screen.tested);
+    if (floor == 0.0) at_zero = significant(direct).size();
+    if (floor == between) at_between = significant(direct).size();
+  }
+  EXPECT_GT(at_zero, at_between);  // the floor decides something here
+  EXPECT_GE(at_between, 1u);
+  EXPECT_TRUE(significant(with_null_floor(screen, 1e6)).empty());
+  for (const auto& r : with_null_floor(screen, 0.0).ranked) {  // fits and tests as they were
+    const auto same = std::find_if(screen.ranked.begin(), screen.ranked.end(),
+                                   [&](const HypothesisResult& s) { return s.label == r.label; });
+    ASSERT_NE(same, screen.ranked.end());
+    EXPECT_EQ(same->p_adjusted, r.p_adjusted);
+    EXPECT_EQ(same->excess_share, r.excess_share);
+  }
+  const Attribution absolute = run(test);
+  EXPECT_EQ(significant(with_null_floor(absolute, 0.0)), significant(absolute));
 }
 
 TEST(CalibratedNull, AReferenceWithOtherChannelsIsRefused) {

@@ -239,6 +239,25 @@ double floor_of(const AttributionOptions& options, bool with_null) {
   return with_null ? options.min_excess_null : options.min_explained_std;
 }
 
+namespace {
+
+// Steps 4 and 5 on att.ranked's tested results (p_adjusted set): which are
+// significant under att.options' floors, and their order.
+void mark_and_rank(Attribution& att) {
+  const AttributionOptions& options = att.options;
+  for (auto& r : att.ranked) {
+    r.significant = r.testable && r.p_adjusted < options.alpha && r.explained >= options.min_explained &&
+                    floor_statistic(att, r) >= floor_of(options, att.null.has_value()) && r.plausible;
+  }
+  std::stable_sort(att.ranked.begin(), att.ranked.end(), [&att](const HypothesisResult& a, const HypothesisResult& b) {
+    if (a.significant != b.significant) return a.significant;
+    if (a.significant) return floor_statistic(att, a) > floor_statistic(att, b);
+    return a.p_value < b.p_value;
+  });
+}
+
+}  // namespace
+
 Attribution attribute(const ResidualData& data, const std::vector<Hypothesis>& hypotheses,
                       const AttributionOptions& options, const NullCalibration* null) {
   Attribution att;
@@ -270,20 +289,17 @@ Attribution attribute(const ResidualData& data, const std::vector<Hypothesis>& h
   }
   att.tested = static_cast<long>(family.size());
   const std::vector<double> adjusted = holm_adjust(p);
-  for (std::size_t f = 0; f < family.size(); ++f) {
-    const std::size_t i = family[f];
-    results[i].p_adjusted = adjusted[f];
-    results[i].significant = adjusted[f] < options.alpha &&
-                             results[i].explained >= options.min_explained &&
-                             floor_statistic(att, results[i]) >= floor_of(options, null != nullptr) &&
-                             results[i].plausible;
-  }
-  std::stable_sort(results.begin(), results.end(), [&att](const HypothesisResult& a, const HypothesisResult& b) {
-    if (a.significant != b.significant) return a.significant;
-    if (a.significant) return floor_statistic(att, a) > floor_statistic(att, b);
-    return a.p_value < b.p_value;
-  });
+  for (std::size_t f = 0; f < family.size(); ++f) results[family[f]].p_adjusted = adjusted[f];
   att.ranked = std::move(results);
+  mark_and_rank(att);
+  return att;
+}
+
+Attribution with_null_floor(const Attribution& attribution, double min_excess_null) {
+  if (!attribution.null) return attribution;
+  Attribution att = attribution;
+  att.options.min_excess_null = min_excess_null;
+  mark_and_rank(att);
   return att;
 }
 

@@ -142,4 +142,11 @@ double floor_of(const AttributionOptions& options, bool with_null);
 Attribution attribute(const ResidualData& data, const std::vector<Hypothesis>& hypotheses,
                       const AttributionOptions& options, const NullCalibration* null = nullptr);
 
+// `attribution` with the floor of excess_share at `min_excess_null` instead:
+// the same fits, tests and Holm p-values, significance and ranking (steps 4
+// and 5) recomputed. --fix takes its candidates from it with a lower floor
+// than the screen's verdict (FixOptions::min_excess_candidates). Without a
+// null, `attribution` unchanged (the absolute floors stay).
+Attribution with_null_floor(const Attribution& attribution, double min_excess_null);
+
 }  // namespace hadynet::trainer::residual

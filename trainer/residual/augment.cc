@@ -136,6 +136,7 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
     Augmentation a;
     a.kind = r.hypothesis.kind;
     a.effect = r.effect;
+    a.screen_statistic = floor_statistic(attribution, r);
     effect_info(a.kind).plan(data, attribution, r, a);
     if (!a.not_fixable.empty()) {  // the plan found nothing to add (a curve without two distinct levels)
       if (r.label == winner->label) winner_not_fixable = a.not_fixable;
@@ -197,7 +198,12 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   if (logs.size() != data.logs.size()) throw std::invalid_argument("--fix: logs and analysis differ");
   FixResult result;
   result.model = model;
-  std::vector<Augmentation> planned = plan_candidates(data, attribution, options.candidates);
+  // The candidates: the screen's ranking down to the candidates' floor (the
+  // screen's own floor when that is lower or unset).
+  const Attribution candidates_view = with_null_floor(
+      attribution, std::min(attribution.options.min_excess_null,
+                            options.min_excess_candidates.value_or(attribution.options.min_excess_null)));
+  std::vector<Augmentation> planned = plan_candidates(data, candidates_view, options.candidates);
   // Rows a sensor delay costs at the end of each log, before or after: the
   // largest over every candidate, so that all are judged on the same rows.
   int d = model.sensor.max_delay();
@@ -317,6 +323,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     c.effect = planned[k].effect;
     c.description = planned[k].description;
     c.channels = channels_of(planned[k]);
+    c.screen_statistic = planned[k].screen_statistic;
+    c.below_screen_floor = attribution.null && c.screen_statistic < attribution.options.min_excess_null;
     result.candidates.push_back(std::move(c));
   }
   if (planned.size() > 1 && can_select) {

@@ -50,6 +50,15 @@ struct FixOptions {
   // 1: the screen's winner alone. 5 was chosen on development seeds 771-775
   // (docs/residual.md, "Detection on fresh logs").
   int candidates = 5;
+  // With a calibrated null: the floor of excess_share (in units of the
+  // channel's clean residual level) of the candidates fix() may try
+  // (with_null_floor), when below the screen's own floor
+  // (AttributionOptions::min_excess_null, which the verdicts keep); the
+  // decision on held-out rows against fine-tuning alone guards what is
+  // applied. Unset: the screen's floor. Measured at 1 on fresh logs
+  // (docs/residual.md, "Candidates below the screen's floor"): more effects
+  // named, and more wrong fixes, so not the default.
+  std::optional<double> min_excess_candidates;
   // The calibrated null's logs of the analysis (analyse()'s reference), for
   // the augmented model's verdict; nullptr or empty: absolute floors.
   const std::vector<LogInput>* reference = nullptr;
@@ -196,6 +205,9 @@ struct Augmentation {
   std::vector<std::string> found_on;
   // Why --fix cannot add it ("" when it can; change is then meaningless).
   std::string not_fixable;
+  // The screen's floor statistic of the hypothesis that led to it
+  // (floor_statistic: excess_share with a null, else explained_std).
+  double screen_statistic = 0;
   std::variant<TimeAlignment, CrosstalkRemoval, BiasState, OutputClips, CalibrationCurves, DerivedCommandInputs,
                ObservedAuxChannel>
       change;
@@ -260,6 +272,11 @@ struct CandidateTrial {
   DieboldMariano selection;
   bool selected_by_training_rows = false;  // false: not judged (logs too short, one candidate, or an earlier one won)
   bool chosen = false;                     // the candidate the decision tested
+  double screen_statistic = 0;             // Augmentation::screen_statistic
+  // Below the screen's own floor (with a null: excess_share <
+  // AttributionOptions::min_excess_null): the screen's verdict does not name
+  // it; only fix()'s candidates' floor (FixOptions::min_excess_candidates) let it in.
+  bool below_screen_floor = false;
 };
 
 // Which of the judged candidates the decision tests: the first, in the
