@@ -27,6 +27,8 @@
 # on seeds 1 and 2001-2003): seeds 1201-1210 and inits 500-509 development
 # (the rule chosen there, with bench/residual_detection.sh's development sets
 # 971-979), seeds 1241-1250 and inits 510-519 measured (nothing chosen).
+# Stop 45: seed 1301 (init 530 not reached) a smoke run of the script after
+# its recording moved to bench/residual_grasps.sh; nothing measured.
 #
 # Usage: bench/pb_auto_check.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--first-init I]
 #   defaults: models/hand.safetensors, build/pb-auto-check, 10 seeds/zeroings

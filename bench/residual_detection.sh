@@ -73,7 +73,13 @@
 # on bench/pb_auto_check.sh's development sets 1201-1210 and on 971-979
 # checked without --fix): 1211-1220 every effect at both strengths measured
 # with the 4-seed model, and with the mean-loss check's binary on the 52
-# sets where the two checks decide a PB differently (the same logs).
+# sets where the two checks decide a PB differently (the same logs). Stop 45
+# (the 4-seed model): 971-976 development of --fix-min-excess-null (3, 1 and
+# 0.5; saturation, drift, friction, cross-talk and the curve at their larger
+# strengths); 1271-1280 every effect at its larger strength measured with
+# the screen's floor and, on the same logs, --fix-min-excess-null 1, and
+# recorded under the zeroings of init ids 520-529 (--rezeroed-first-init
+# 520; the screen's floor).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--case EFFECT=STRENGTH]...

@@ -53,7 +53,9 @@
 # rated ranges (1141-1150 and 1171-1185 belong to the other benches, 1191 to
 # the test cli.four_seed_model). Stop 44 (--pb auto's check per channel,
 # the 4-seed model): 1221-1240 measured (1201-1220 and 1241-1265 belong to
-# the other benches).
+# the other benches). Stop 45 (--fix-min-excess-null 1, candidates below the
+# screen's floor; the 4-seed model): 1281-1300 measured (1271-1280 and the
+# smoke run 1301 of bench/pb_auto_check.sh belong to the other benches).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
