@@ -82,10 +82,11 @@
 # 520; the screen's floor).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
-#          [--reference-seed S] [--rezeroed-first-init I] [--case EFFECT=STRENGTH]...
+#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...
 #   defaults: models/hand.safetensors, build/residual-detection, 10, 231, the tool's --candidates (5), every case
 #   (--case: only those; repeatable), the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
+#   --fix-min-excess-null S: passed to `hadynet residual --fix` (candidates below the screen's floor)
 #   --rezeroed-first-init I: the k-th seed's sets are recorded under the zeroing I + k, one the model
 #   never saw, and keep the trained state names (a re-zeroed hand; bench/residual_grasps.sh)
 # Environment: HADYNET (default build/release/cli/hadynet).
@@ -109,6 +110,7 @@ while (($#)); do
     --seeds) n=$2; shift 2 ;;
     --first-seed) first_seed=$2; shift 2 ;;
     --candidates) candidates=(--candidates "$2"); shift 2 ;;
+    --fix-min-excess-null) candidates+=(--fix-min-excess-null "$2"); shift 2 ;;
     --case) only_cases+=("$2"); shift 2 ;;
     --rezeroed-first-init) rezeroed_first_init=$2; shift 2 ;;
     *) echo "residual_detection: unknown argument $1" >&2; exit 2 ;;

@@ -59,7 +59,7 @@
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
-#          [--reference-seed S] [--rezeroed-first-init I] [SEED...]
+#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [SEED...]
 #   defaults: models/hand.safetensors, build/residual-false-positives, 161..180,
 #   no rated range (the plant's datasheet: --rated-range fc=0..50 --rated-range f=0..200),
 #   the null of `hadynet residual`'s default: the held-out logs stored in the model
@@ -85,6 +85,7 @@ while (($#)); do
     --out) out=$2; shift 2 ;;
     --rated-range) ranges+=(--rated-range "$2"); shift 2 ;;
     --candidates) ranges+=(--candidates "$2"); shift 2 ;;
+    --fix-min-excess-null) ranges+=(--fix-min-excess-null "$2"); shift 2 ;;
     --rezeroed-first-init) rezeroed_first_init=$2; shift 2 ;;
     -*) echo "residual_false_positives: unknown option $1" >&2; exit 2 ;;
     *) seeds+=("$1"); shift ;;

@@ -31,8 +31,8 @@ collect_rezeroed_grasps() {
   for g in "${residual_grasps[@]}"; do
     set -- $g "$@"
     "$hadynet" collect --object "$1" --motion "$2" --init "$rezero" --rows "${RESIDUAL_ROWS:-300}" --seed "$seed" \
-      --out "$out.raw" "${@:4}" --quiet >/dev/null
-    f=$(ls "$out".raw/*/"$1_$2_i${rezero}_w0.csv")
+      --out "${out%/}.raw" "${@:4}" --quiet >/dev/null
+    f=$(ls "${out%/}".raw/*/"$1_$2_i${rezero}_w0.csv")
     sed "s|^# state: .*|# state: $1/i$3/w0|" "$f" >"$out/$1_$2_i$3.csv"
     shift 3
   done

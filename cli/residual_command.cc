@@ -241,7 +241,7 @@ int run_residual(int argc, char** argv) {
             "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"
             "decision on held-out rows against fine-tuning alone guards what is applied (1 names more effects\n"
             "and makes more wrong fixes on fresh plant logs: docs/residual.md)",
-            "the screen's");
+            "the screen's --min-excess-null");
   opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
                         "unchanged model, a weaker guard)");
   if (!opt.parse(argc, argv)) return 2;
@@ -297,6 +297,11 @@ int run_residual(int argc, char** argv) {
   if (!fix_epochs || !fix_lr || !fix_seed || !rounds || !candidates) return 2;
   if (opt.has("fix-min-excess-null") && !opt.has("fix")) {
     std::fprintf(stderr, "hadynet residual: --fix-min-excess-null needs --fix\n");
+    return 2;
+  }
+  if (min_excess_candidates && *min_excess_candidates > *min_excess) {
+    std::fprintf(stderr, "hadynet residual: --fix-min-excess-null %g is above the screen's --min-excess-null %g: the\n"
+                 "candidates' floor can only be lower\n", *min_excess_candidates, *min_excess);
     return 2;
   }
   if (opt.has("fix-min-excess-null") && no_reference) {
@@ -370,7 +375,7 @@ int run_residual(int argc, char** argv) {
     fo.seed = static_cast<std::uint64_t>(*fix_seed);
     fo.control = !opt.has("no-control");
     fo.candidates = static_cast<int>(*candidates);
-    fo.min_excess_candidates = min_excess_candidates;
+    fo.min_excess_null = min_excess_candidates;
     fo.reference = &reference;
     fo.reference_pb_choice = stored_null ? "state" : "auto";
     fo.library = ao.library;

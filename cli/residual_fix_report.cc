@@ -37,7 +37,7 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
             {"epochs", o.epochs},
             {"lr", o.lr},
             {"seed", o.seed},
-            {"min_excess_candidates", o.min_excess_candidates ? json(*o.min_excess_candidates) : json(nullptr)},
+            {"min_excess_null", o.min_excess_null ? json(*o.min_excess_null) : json(nullptr)},
             {"before", held_out_json(f.before)}};
   if (f.augmentation) {
     const rs::Augmentation& a = *f.augmentation;

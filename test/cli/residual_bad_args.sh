@@ -85,6 +85,8 @@ expect 2 "--fix-min-excess-null needs a null (not --reference none)" "$model" go
   --fix-min-excess-null 1 --json out.json
 expect 2 "--fix-min-excess-null: expected a number in 0..1e+06, got '1e9'" "$model" good.csv --fix \
   --fix-min-excess-null 1e9 --json out.json
+expect 2 "--fix-min-excess-null 4 is above the screen's --min-excess-null 3" "$model" good.csv --fix \
+  --fix-min-excess-null 4 --json out.json
 expect 1 "--reference good.csv is also a log under test" "$model" good.csv --reference good.csv --json out.json
 expect 1 "no_fc8.csv: no column 'fc8'" "$model" good.csv --reference no_fc8.csv --json out.json
 expect 1 "malformed.csv:15:12: column 'f2'" "$model" good.csv --reference malformed.csv --json out.json

@@ -394,7 +394,8 @@ TEST(CalibratedNull, AnotherFloorRanksAsAttributeAtThatFloor) {
   EXPECT_GT(at_zero, at_between);  // the floor decides something here
   EXPECT_GE(at_between, 1u);
   EXPECT_TRUE(significant(with_null_floor(screen, 1e6)).empty());
-  for (const auto& r : with_null_floor(screen, 0.0).ranked) {  // fits and tests as they were
+  // Fits and tests as they were: copied, not recomputed, so equal to the bit.
+  for (const auto& r : with_null_floor(screen, 0.0).ranked) {
     const auto same = std::find_if(screen.ranked.begin(), screen.ranked.end(),
                                    [&](const HypothesisResult& s) { return s.label == r.label; });
     ASSERT_NE(same, screen.ranked.end());

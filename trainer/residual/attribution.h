@@ -145,7 +145,7 @@ Attribution attribute(const ResidualData& data, const std::vector<Hypothesis>& h
 // `attribution` with the floor of excess_share at `min_excess_null` instead:
 // the same fits, tests and Holm p-values, significance and ranking (steps 4
 // and 5) recomputed. --fix takes its candidates from it with a lower floor
-// than the screen's verdict (FixOptions::min_excess_candidates). Without a
+// than the screen's verdict (FixOptions::min_excess_null). Without a
 // null, `attribution` unchanged (the absolute floors stay).
 Attribution with_null_floor(const Attribution& attribution, double min_excess_null);
 

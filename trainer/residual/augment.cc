@@ -202,7 +202,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // screen's own floor when that is lower or unset).
   const Attribution candidates_view = with_null_floor(
       attribution, std::min(attribution.options.min_excess_null,
-                            options.min_excess_candidates.value_or(attribution.options.min_excess_null)));
+                            options.min_excess_null.value_or(attribution.options.min_excess_null)));
   std::vector<Augmentation> planned = plan_candidates(data, candidates_view, options.candidates);
   // Rows a sensor delay costs at the end of each log, before or after: the
   // largest over every candidate, so that all are judged on the same rows.

@@ -55,10 +55,14 @@ struct FixOptions {
   // (with_null_floor), when below the screen's own floor
   // (AttributionOptions::min_excess_null, which the verdicts keep); the
   // decision on held-out rows against fine-tuning alone guards what is
-  // applied. Unset: the screen's floor. Measured at 1 on fresh logs
+  // applied. The plans read the lower floor too: a candidate's family (the
+  // effect's other significant channels) and which leads are skipped
+  // (why_not_fixable) can then differ for candidates above the screen's
+  // floor as well. --fix-min-excess-null. Unset: the screen's floor; above it:
+  // the screen's floor (the CLI refuses it). Measured at 1 on fresh logs
   // (docs/residual.md, "Candidates below the screen's floor"): more effects
   // named, and more wrong fixes, so not the default.
-  std::optional<double> min_excess_candidates;
+  std::optional<double> min_excess_null;
   // The calibrated null's logs of the analysis (analyse()'s reference), for
   // the augmented model's verdict; nullptr or empty: absolute floors.
   const std::vector<LogInput>* reference = nullptr;
@@ -275,7 +279,7 @@ struct CandidateTrial {
   double screen_statistic = 0;             // Augmentation::screen_statistic
   // Below the screen's own floor (with a null: excess_share <
   // AttributionOptions::min_excess_null): the screen's verdict does not name
-  // it; only fix()'s candidates' floor (FixOptions::min_excess_candidates) let it in.
+  // it; only fix()'s candidates' floor (FixOptions::min_excess_null) let it in.
   bool below_screen_floor = false;
 };
 
