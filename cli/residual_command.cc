@@ -289,19 +289,19 @@ int run_residual(int argc, char** argv) {
   const auto fix_seed = opt.get_int("fix-seed", 0, (1ll << 62));
   const auto rounds = opt.get_int("rounds", 1, 20);
   const auto candidates = opt.get_int("candidates", 1, 20);
-  std::optional<double> min_excess_candidates;
+  std::optional<double> fix_min_excess;
   if (opt.has("fix-min-excess-null")) {
-    min_excess_candidates = opt.get_double("fix-min-excess-null", 0.0, 1e6);
-    if (!min_excess_candidates) return 2;
+    fix_min_excess = opt.get_double("fix-min-excess-null", 0.0, 1e6);
+    if (!fix_min_excess) return 2;
   }
   if (!fix_epochs || !fix_lr || !fix_seed || !rounds || !candidates) return 2;
   if (opt.has("fix-min-excess-null") && !opt.has("fix")) {
     std::fprintf(stderr, "hadynet residual: --fix-min-excess-null needs --fix\n");
     return 2;
   }
-  if (min_excess_candidates && *min_excess_candidates > *min_excess) {
+  if (fix_min_excess && *fix_min_excess > *min_excess) {
     std::fprintf(stderr, "hadynet residual: --fix-min-excess-null %g is above the screen's --min-excess-null %g: the\n"
-                 "candidates' floor can only be lower\n", *min_excess_candidates, *min_excess);
+                 "candidates' floor can only be lower\n", *fix_min_excess, *min_excess);
     return 2;
   }
   if (opt.has("fix-min-excess-null") && no_reference) {
@@ -375,7 +375,7 @@ int run_residual(int argc, char** argv) {
     fo.seed = static_cast<std::uint64_t>(*fix_seed);
     fo.control = !opt.has("no-control");
     fo.candidates = static_cast<int>(*candidates);
-    fo.min_excess_null = min_excess_candidates;
+    fo.min_excess_null = fix_min_excess;
     fo.reference = &reference;
     fo.reference_pb_choice = stored_null ? "state" : "auto";
     fo.library = ao.library;

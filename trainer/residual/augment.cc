@@ -198,11 +198,12 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   if (logs.size() != data.logs.size()) throw std::invalid_argument("--fix: logs and analysis differ");
   FixResult result;
   result.model = model;
-  // The candidates: the screen's ranking down to the candidates' floor (the
-  // screen's own floor when that is lower or unset).
-  const Attribution candidates_view = with_null_floor(
-      attribution, std::min(attribution.options.min_excess_null,
-                            options.min_excess_null.value_or(attribution.options.min_excess_null)));
+  // The candidates: the screen's ranking, or with FixOptions::min_excess_null
+  // re-ranked down to that floor (never above the screen's own).
+  const Attribution candidates_view =
+      options.min_excess_null
+          ? with_null_floor(attribution, std::min(attribution.options.min_excess_null, *options.min_excess_null))
+          : attribution;
   std::vector<Augmentation> planned = plan_candidates(data, candidates_view, options.candidates);
   // Rows a sensor delay costs at the end of each log, before or after: the
   // largest over every candidate, so that all are judged on the same rows.
