@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
+#include <optional>
 
 #include "codegen/formats.h"
 #include "codegen/header_text.h"
@@ -59,7 +61,16 @@ SensorArrays sensor_arrays(const trainer::HadynetModel& model, bool q15, int fra
     a.clip_channel.push_back(std::to_string(r));
     a.clip_side.push_back(std::to_string(c.side));
     a.clip_rail.push_back(float_literal(static_cast<float>(c.rail)));
-    const double standardised = (c.rail - model.norm.y.mean(r)) / model.norm.y.std(r);
+    // The rail on the network's channel (trainer/sensor_model.h); none (a cross-talk
+    // target, a drifting channel): the type's extreme on the clip's side,
+    // which never clips.
+    const std::optional<double> rail = trainer::frame_rail(s, c);
+    if (!rail) {
+      const float extreme = c.side > 0 ? std::numeric_limits<float>::max() : std::numeric_limits<float>::lowest();
+      a.clip_rail_model.push_back(q15 ? (c.side > 0 ? "32767" : "-32768") : float_literal(extreme));
+      continue;
+    }
+    const double standardised = (*rail - model.norm.y.mean(r)) / model.norm.y.std(r);
     a.clip_rail_model.push_back(
         q15 ? std::to_string(std::clamp<std::int64_t>(to_fixed(standardised, frac_y), -32768, 32767))
             : float_literal(static_cast<float>(standardised)));

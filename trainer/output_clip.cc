@@ -18,16 +18,20 @@ Eigen::Index row_of(const HadynetModel& model, const OutputClip& c) {
 
 void apply_output_clips(const HadynetModel& model, Eigen::MatrixXd& y) {
   for (const OutputClip& c : model.sensor.clips) {
+    const std::optional<double> rail = frame_rail(model.sensor, c);
+    if (!rail) continue;
     const Eigen::Index r = row_of(model, c);
-    y.row(r) = c.side > 0 ? y.row(r).cwiseMin(c.rail).eval() : y.row(r).cwiseMax(c.rail).eval();
+    y.row(r) = c.side > 0 ? y.row(r).cwiseMin(*rail).eval() : y.row(r).cwiseMax(*rail).eval();
   }
 }
 
 std::vector<StandardisedClip> standardised_clips(const HadynetModel& model) {
   std::vector<StandardisedClip> out;
   for (const OutputClip& c : model.sensor.clips) {
+    const std::optional<double> rail = frame_rail(model.sensor, c);
+    if (!rail) continue;
     const Eigen::Index r = row_of(model, c);
-    out.push_back({r, c.side, static_cast<float>((c.rail - model.norm.y.mean(r)) / model.norm.y.std(r))});
+    out.push_back({r, c.side, static_cast<float>((*rail - model.norm.y.mean(r)) / model.norm.y.std(r))});
   }
   return out;
 }

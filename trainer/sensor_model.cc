@@ -202,4 +202,15 @@ datalog::LogTable to_model_frame(const SensorModel& sensor, const datalog::LogTa
   return time_aligned(curves_inverted(without_bias, file, sensor.curves), file, sensor.delays);
 }
 
+std::optional<double> frame_rail(const SensorModel& sensor, const OutputClip& clip) {
+  const auto offset = [&](const auto& parts, const auto& channel_of) {
+    return std::any_of(parts.begin(), parts.end(), [&](const auto& p) { return channel_of(p) == clip.channel; });
+  };
+  if (offset(sensor.crosstalk, [](const SensorCrosstalk& x) { return x.target; }) ||
+      offset(sensor.drifts, [](const SensorDrift& x) { return x.channel; }))
+    return std::nullopt;
+  if (const SensorCurve* curve = sensor.curve_of(clip.channel)) return curve_level(*curve, clip.rail);
+  return clip.rail;
+}
+
 }  // namespace hadynet::trainer

@@ -24,6 +24,7 @@
 // at its boundary (docs/firmware.md).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -106,6 +107,14 @@ struct SensorModel {
 
   bool operator==(const SensorModel&) const = default;
 };
+
+// The rail of `clip` on the network's channel y'_c (physical, the model's
+// frame): the rail itself for a plain or delayed channel, g_c^-1(rail) for a
+// channel with a curve (g increases, so the side is kept); none for a
+// cross-talk target or a drifting channel, whose measured value is y'_c plus
+// a term that changes every row (the clip then bounds the measured value
+// only). output_clip.h and the firmware's frame clip (kClipRailModel) use it.
+std::optional<double> frame_rail(const SensorModel& sensor, const OutputClip& clip);
 
 // The control period of a log: metadata dt_s (s), 1 if absent. Throws
 // std::runtime_error naming `file` if it is not a positive number.

@@ -217,7 +217,9 @@ concept GeneratedModel = requires {
   M::kClipChannel;        // int[]
   M::kClipSide;           // int[]  +1: min(., rail); -1: max(., rail)
   M::kClipRail;           // float[] physical
-  M::kClipRailModel;      // Value[] the rail standardised, Q(kFracY)
+  M::kClipRailModel;      // Value[] the rail on the network's channel, standardised, Q(kFracY):
+                          // g^-1(rail) with a curve; the type's extreme (never clips) for a
+                          // cross-talk target or a drifting channel (trainer/output_clip.h)
 };
 // clang-format on
 

@@ -656,6 +656,27 @@ TEST(Generate, SensorCurvesWithFewerKnotsArePaddedOnTheirEndSegment) {
   EXPECT_EQ(a.curve_reading, (std::vector<std::string>{"0.0f", "1.5f", "3.0f", "0.0f", "1.20000005f", "2.0999999f"}));
 }
 
+// kClipRailModel is the rail on the network's channel (frame_rail): the
+// type's extreme, which never clips, where cross-talk offsets the channel.
+TEST(Generate, AFrameClipHasNoBoundOnACrosstalkTarget) {
+  HadynetModel m = synthetic_model(true);
+  m.sensor.crosstalk = {{"fc0", "fc1", 0.25}};
+  m.sensor.clips = {{"fc0", -1, 0.0}, {"fc0", 1, 50.0}, {"fc1", -1, 0.0}};
+  const auto& y = m.layout.y_names;
+  const auto r = std::find(y.begin(), y.end(), "fc1") - y.begin();
+  const SensorArrays q15 = sensor_arrays(m, true, 12);
+  ASSERT_EQ(q15.clip_rail_model.size(), 3u);
+  EXPECT_EQ(q15.clip_rail_model[0], "-32768");
+  EXPECT_EQ(q15.clip_rail_model[1], "32767");
+  const double fc1_rail = (0.0 - m.norm.y.mean(r)) / m.norm.y.std(r);
+  EXPECT_EQ(q15.clip_rail_model[2], std::to_string(std::clamp<std::int64_t>(to_fixed(fc1_rail, 12), -32768, 32767)));
+  const SensorArrays f32 = sensor_arrays(m, false, 0);
+  EXPECT_EQ(f32.clip_rail_model[0], float_literal(std::numeric_limits<float>::lowest()));
+  EXPECT_EQ(f32.clip_rail_model[1], float_literal(std::numeric_limits<float>::max()));
+  EXPECT_EQ(f32.clip_rail_model[2], float_literal(static_cast<float>(fc1_rail)));
+  EXPECT_EQ(f32.clip_rail, (std::vector<std::string>{"0.0f", "50.0f", "0.0f"}));  // the measured clip keeps every rail
+}
+
 TEST(Rejects, SensorCurveKnotsThatAreEqualInFloat) {
   HadynetModel m = synthetic_model(true);
   // Strictly increasing in double (the trainer's check passes), one float apart at most.

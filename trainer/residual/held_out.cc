@@ -16,9 +16,9 @@ int index_of(const std::vector<std::string>& names, const std::string& name) {
 
 // How the model's frame maps to the measured channels: its sensor model
 // (sensor_model.h) by y row. The predictions clip the frame's estimate
-// (output_clip.h); the measured value is clipped again at the end, as the
-// firmware reports it (a curve, cross-talk or drift may carry it past the
-// rail).
+// where the frame has a rail (output_clip.h); the measured value is clipped
+// at the end, as the firmware reports it (cross-talk or drift may carry it
+// past the rail).
 struct OutputMap {
   std::vector<int> delay;  // per y channel: reported this many steps late
   int d = 0;               // the largest delay
