@@ -79,7 +79,11 @@
 # strengths); 1271-1280 every effect at its larger strength measured with
 # the screen's floor and, on the same logs, --fix-min-excess-null 1, and
 # recorded under the zeroings of init ids 520-529 (--rezeroed-first-init
-# 520; the screen's floor).
+# 520; the screen's floor). Stop 46 (clips on the network's channel only
+# where the frame has a rail; the 4-seed model): 1271-1280 became its
+# development (re-run on the same logs), 1302-1311 every effect at its
+# larger strength measured with it and, on the same logs, the stop-45
+# binary.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

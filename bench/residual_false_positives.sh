@@ -56,6 +56,8 @@
 # the other benches). Stop 45 (--fix-min-excess-null 1, candidates below the
 # screen's floor; the 4-seed model): 1281-1300 measured (1271-1280 and the
 # smoke run 1301 of bench/pb_auto_check.sh belong to the other benches).
+# Stop 46 (clips on the network's channel only where the frame has a rail;
+# the 4-seed model): 1312-1331 measured (1302-1311 belong to the detection).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
