@@ -213,4 +213,12 @@ std::optional<double> frame_rail(const SensorModel& sensor, const OutputClip& cl
   return clip.rail;
 }
 
+bool frame_transforms(const SensorModel& sensor, const std::string& channel) {
+  if (sensor.curve_of(channel) != nullptr) return true;
+  return std::any_of(sensor.crosstalk.begin(), sensor.crosstalk.end(),
+                     [&](const SensorCrosstalk& x) { return x.target == channel; }) ||
+         std::any_of(sensor.drifts.begin(), sensor.drifts.end(),
+                     [&](const SensorDrift& x) { return x.channel == channel; });
+}
+
 }  // namespace hadynet::trainer

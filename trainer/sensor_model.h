@@ -17,8 +17,8 @@
 //
 // to_model_frame() moves a log into the model's frame (the inverse: the
 // delay undone, which is not causal, cross-talk and drift removed, the
-// curve inverted); the
-// clips are applied to every prediction (output_clip.h). Whoever feeds the
+// curve inverted); every prediction is clipped at each clip's frame rail
+// (frame_rail below, output_clip.h) and, as measured, at its rail. Whoever feeds the
 // network logs or frames must apply it: the trainer's commands do
 // (read_sequences), the firmware applies cross-talk, drift, curves and clips
 // at its boundary (docs/firmware.md).
@@ -113,8 +113,14 @@ struct SensorModel {
 // channel with a curve (g increases, so the side is kept); none for a
 // cross-talk target or a drifting channel, whose measured value is y'_c plus
 // a term that changes every row (the clip then bounds the measured value
-// only). output_clip.h and the firmware's frame clip (kClipRailModel) use it.
+// only). output_clip.h and the firmware's clip before detection
+// (kClipRailModel) use it.
 std::optional<double> frame_rail(const SensorModel& sensor, const OutputClip& clip);
+
+// Whether the model's frame reads `channel` other than as measured (up to a
+// delay): through a calibration curve, or with a cross-talk or a drift
+// removed. A level of such a channel in the frame is not a sensor reading.
+bool frame_transforms(const SensorModel& sensor, const std::string& channel);
 
 // The control period of a log: metadata dt_s (s), 1 if absent. Throws
 // std::runtime_error naming `file` if it is not a positive number.

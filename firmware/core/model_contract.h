@@ -219,7 +219,7 @@ concept GeneratedModel = requires {
   M::kClipRail;           // float[] physical
   M::kClipRailModel;      // Value[] the rail on the network's channel, standardised, Q(kFracY):
                           // g^-1(rail) with a curve; the type's extreme (never clips) for a
-                          // cross-talk target or a drifting channel (trainer/output_clip.h)
+                          // cross-talk target or a drifting channel (frame_rail, trainer/sensor_model.h)
 };
 // clang-format on
 

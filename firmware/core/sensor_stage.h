@@ -127,9 +127,9 @@ class SensorStage {
   }
 
   // The clips on a standardised model-frame estimate (Q(kFracY)), so that
-  // detection compares what a saturating sensor can show; a clip whose
-  // channel the frame offsets (cross-talk, drift) has no bound here
-  // (kClipRailModel), only in to_measured.
+  // detection compares what a saturating sensor can show: at each clip's
+  // frame rail (kClipRailModel; none on a cross-talk target or a drifting
+  // channel, which to_measured clips).
   void clip(Value (&y)[kY]) const noexcept {
     for (int k = 0; k < M::kClipCount; ++k) {
       Value& v = y[M::kClipChannel[k]];

@@ -658,7 +658,7 @@ TEST(Generate, SensorCurvesWithFewerKnotsArePaddedOnTheirEndSegment) {
 
 // kClipRailModel is the rail on the network's channel (frame_rail): the
 // type's extreme, which never clips, where cross-talk offsets the channel.
-TEST(Generate, AFrameClipHasNoBoundOnACrosstalkTarget) {
+TEST(Generate, ACrosstalkTargetHasNoFrameRail) {
   HadynetModel m = synthetic_model(true);
   m.sensor.crosstalk = {{"fc0", "fc1", 0.25}};
   m.sensor.clips = {{"fc0", -1, 0.0}, {"fc0", 1, 50.0}, {"fc1", -1, 0.0}};

@@ -1,6 +1,6 @@
 // A model fixed by `hadynet residual --fix` through codegen and the firmware
 // core (make_fixed_model.cc: derived inputs sign_u0 and hyst_u0, cross-talk,
-// a load drift, a calibration curve and a clip): the runtime's reported
+// a load drift, a calibration curve and clips): the runtime's reported
 // prediction on a held-out plant log must equal the trainer's measured-frame
 // prediction of the same model (to_model_frame, the network, then the sensor
 // model forward) within the forward tolerances of docs/tolerances.md; the
@@ -55,8 +55,11 @@ TEST(FixedModelHeader, CarriesTheDerivedInputsAndTheSensorModel) {
   EXPECT_FALSE(F::kControlActive[F::kU - 1]);  // never set by the stabiliser
   EXPECT_EQ(F::kCrosstalkCount, 1);
   EXPECT_EQ(F::kDriftCount, 1);
-  EXPECT_EQ(F::kClipCount, 1);
-  EXPECT_EQ(Q::kClipCount, 1);
+  EXPECT_EQ(F::kClipCount, 2);
+  EXPECT_EQ(Q::kClipCount, 2);
+  // fc2, a cross-talk target, has no frame rail: the type's extreme.
+  EXPECT_EQ(Q::kClipRailModel[1], -32768);
+  EXPECT_EQ(F::kClipRailModel[1], std::numeric_limits<float>::lowest());
   EXPECT_EQ(F::kSensorPeriod, 0.2f);
   ASSERT_EQ(m.sensor.curves.size(), 1u);
   const trainer::SensorCurve& curve = m.sensor.curves[0];
@@ -165,6 +168,11 @@ TEST(FixedModelRuntime, PredictionEqualsTheTrainersMeasuredFramePrediction) {
   }
   EXPECT_GT(below, 0);
   EXPECT_GT(beyond, 0);
+  // fc2 with fc3's pick-up removed goes below its rated floor in the frame,
+  // where a frame clip at the measured rail (0 N) would differ.
+  int fc2_negative = 0;
+  for (std::size_t t = 0; t < frame.rows(); ++t) fc2_negative += frame.at(t, *frame.column_index("fc2")) < 0.0;
+  EXPECT_GT(fc2_negative, 0);
   const double f32 = max_error<F>(table), q15 = max_error<Q>(table);
   std::printf("fixed model, 1-step prediction vs trainer, max standardised error: f32 %.3g, q15 %.3g\n", f32, q15);
   EXPECT_LE(f32, test::tolerance("forward.f32.max"));

@@ -79,7 +79,10 @@ int main(int argc, char** argv) {
     m.sensor.drifts = {{"fc3", true, 0.02}};
     m.sensor.period_s = 0.2;
     m.sensor.curves = {kFc3Curve};
-    m.sensor.clips = {{"fc6", 1, 2.0}};
+    // fc6 a rail (a plain channel); fc2 (a cross-talk target) its rated
+    // floor at 0 N, which bounds only what it reports (frame_rail: none on
+    // the network's channel).
+    m.sensor.clips = {{"fc6", 1, 2.0}, {"fc2", -1, 0.0}};
     m.provenance["residual_fix"] = "test model of test/firmware/make_fixed_model.cc (no fine-tuning)";
     m.check_consistent();
 

@@ -258,6 +258,15 @@ TEST(Attribution, SaturationAndDriftWin) {
   EXPECT_EQ(sat.winner()->hypothesis.kind, EffectKind::kSaturation);
   EXPECT_EQ(sat.winner()->hypothesis.side, +1);
   EXPECT_NEAR(sat.winner()->hypothesis.rail, 1.5, 1e-9);
+  // The same rows where the model's frame reads a0 through a curve, a
+  // cross-talk or a drift (ResidualData::y_frame_transformed): a level there
+  // is no sensor reading, so no rail is searched on it.
+  ResidualData transformed = synthetic(8, [](ResidualLog& log) {
+    for (Eigen::Index j = 0; j < log.r.cols(); ++j) log.r(0, j) = std::min(log.y_hat(0, j), 1.5) - log.y_hat(0, j);
+  });
+  transformed.y_frame_transformed = {true, false};
+  for (const auto& h : enumerate_hypotheses(transformed, {}))
+    EXPECT_FALSE(h.kind == EffectKind::kSaturation && h.target == 0) << h.rail;
 
   // a1 drifts by 0.01 per second (a bias growing with time since the log's start).
   const Attribution drift = run(synthetic(9, [](ResidualLog& log) {

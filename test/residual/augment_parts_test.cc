@@ -120,7 +120,7 @@ TEST(OutputClip, PhysicalAndStandardisedAgree) {
 // A clip bounds the measured channel; on the network's channel it is the
 // rail only where the measured value follows from that channel alone
 // (frame_rail, sensor_model.h). a0 picks up 0.5 a3, a1 drifts, a2 reads
-// through g(x) = 2x, a3 is plain; each has a rated range [0, 1].
+// through g(x) = 1 + 2x, a3 is plain; each has a rated range [0, 1].
 TEST(OutputClip, TheFrameHasARailOnlyWhereTheMeasuredChannelFollowsFromItAlone) {
   HadynetModel m;
   m.layout = feature_layout_from_names({"a0", "a1", "a2", "a3"}, {"u0"}, {});
@@ -128,25 +128,31 @@ TEST(OutputClip, TheFrameHasARailOnlyWhereTheMeasuredChannelFollowsFromItAlone) 
   m.norm.y.std = Eigen::VectorXd::Ones(4);
   m.sensor.crosstalk = {{"a0", "a3", 0.5}};
   m.sensor.drifts = {{"a1", true, 0.01}};
-  m.sensor.curves = {{"a2", {0.0, 2.0}, {0.0, 4.0}}};
+  m.sensor.curves = {{"a2", {0.0, 2.0}, {1.0, 5.0}}};
   for (const char* c : {"a0", "a1", "a2", "a3"}) {
     m.sensor.clips.push_back({c, -1, 0.0});
     m.sensor.clips.push_back({c, 1, 1.0});
   }
   EXPECT_FALSE(frame_rail(m.sensor, m.sensor.clips[0]));  // a0 = a0' + 0.5 a3': a0' < 0 is a reading of 0.5 a3' - |a0'|
   EXPECT_FALSE(frame_rail(m.sensor, m.sensor.clips[3]));  // a1 = a1' + a bias
-  EXPECT_DOUBLE_EQ(*frame_rail(m.sensor, m.sensor.clips[5]), 0.5);  // g^-1(1)
+  EXPECT_DOUBLE_EQ(*frame_rail(m.sensor, m.sensor.clips[4]), -0.5);  // g^-1(0), beyond the knots
+  EXPECT_DOUBLE_EQ(*frame_rail(m.sensor, m.sensor.clips[5]), 0.0);   // g^-1(1)
   EXPECT_DOUBLE_EQ(*frame_rail(m.sensor, m.sensor.clips[7]), 1.0);
+  SensorModel curved_target = m.sensor;  // a curve does not give a cross-talk target a rail
+  curved_target.curves.push_back({"a0", {0.0, 1.0}, {0.0, 2.0}});
+  EXPECT_FALSE(frame_rail(curved_target, m.sensor.clips[1]));
+  EXPECT_TRUE(frame_transforms(m.sensor, "a0") && frame_transforms(m.sensor, "a1") && frame_transforms(m.sensor, "a2"));
+  EXPECT_FALSE(frame_transforms(m.sensor, "a3"));
+
   Eigen::MatrixXd y(4, 2);
-  y << -0.4, 1.6, -0.4, 1.6, -0.4, 1.6, -0.4, 1.6;
+  y << -0.8, 1.6, -0.8, 1.6, -0.8, 1.6, -0.8, 1.6;
+  Matrix<float> s = y.cast<float>(), grad = Matrix<float>::Ones(4, 2);
   apply_output_clips(m, y);
   Eigen::MatrixXd want(4, 2);
-  want << -0.4, 1.6, -0.4, 1.6, 0.0, 0.5, 0.0, 1.0;
+  want << -0.8, 1.6, -0.8, 1.6, -0.5, 0.0, 0.0, 1.0;
   EXPECT_EQ(y, want);
-  Matrix<float> s = y.cast<float>(), grad = Matrix<float>::Ones(4, 2);
-  s.row(2) << -0.4f, 1.6f;
-  s.row(3) << -0.4f, 1.6f;
   EXPECT_EQ(clip_standardised(m, s, &grad), 4);  // a2 and a3 only
+  EXPECT_EQ(s, want.cast<float>());
   EXPECT_EQ(grad.topRows(2), (Matrix<float>::Ones(2, 2)));
   EXPECT_EQ(grad.bottomRows(2), (Matrix<float>::Zero(2, 2)));
   EXPECT_EQ(standardised_clips(m).size(), 4u);

@@ -644,8 +644,11 @@ namespace {
 namespace saturation {
 
 // A rail per side where the channel sits (LibraryOptions: min_rail_share
-// within rail_band), at the measured extreme over all logs.
+// within rail_band), at the measured extreme over all logs. Only on a
+// channel the frame reads as measured: a rail is the sensor's reading, and
+// the clip (an OutputClip) bounds the reading (frame_rail, sensor_model.h).
 void enumerate(const ResidualData& data, const LibraryOptions& options, int c, std::vector<Hypothesis>& out) {
+  if (!data.y_frame_transformed.empty() && data.y_frame_transformed[static_cast<std::size_t>(c)]) return;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const auto& log : data.logs) {
     lo = std::min(lo, log.seq.y.row(c).minCoeff());

@@ -80,6 +80,10 @@ struct ResidualData {
   // The model's standardisation std of each y channel (physical units): a
   // residual variance divided by its square is in the units of the model's loss.
   Eigen::VectorXd y_scale;
+  // Per y channel: the model's frame reads it through a curve or with a
+  // cross-talk or drift removed (frame_transforms, sensor_model.h), so its
+  // levels in the logs below are not sensor readings. Empty: none is.
+  std::vector<bool> y_frame_transformed;
   std::vector<ResidualLog> logs;
 };
 
