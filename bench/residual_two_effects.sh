@@ -28,7 +28,8 @@
 # models/hand-4seeds.safetensors, trained on seeds 1 and 2001-2003) and
 # with the build's model (the same logs and binary); 1261-1265 (stop 44:
 # --pb auto's check per channel, the 4-seed model; also with the mean-loss
-# check's binary on the same logs).
+# check's binary on the same logs); 1342-1346 (stop 46: clips on the
+# network's channel only where the frame has a rail; the 4-seed model).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]...
