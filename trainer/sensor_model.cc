@@ -202,23 +202,27 @@ datalog::LogTable to_model_frame(const SensorModel& sensor, const datalog::LogTa
   return time_aligned(curves_inverted(without_bias, file, sensor.curves), file, sensor.delays);
 }
 
+namespace {
+
+// The measured channel is the frame's plus a term that changes every row: a
+// cross-talk target or a drifting channel.
+bool frame_offsets(const SensorModel& sensor, const std::string& channel) {
+  return std::any_of(sensor.crosstalk.begin(), sensor.crosstalk.end(),
+                     [&](const SensorCrosstalk& x) { return x.target == channel; }) ||
+         std::any_of(sensor.drifts.begin(), sensor.drifts.end(),
+                     [&](const SensorDrift& x) { return x.channel == channel; });
+}
+
+}  // namespace
+
 std::optional<double> frame_rail(const SensorModel& sensor, const OutputClip& clip) {
-  const auto offset = [&](const auto& parts, const auto& channel_of) {
-    return std::any_of(parts.begin(), parts.end(), [&](const auto& p) { return channel_of(p) == clip.channel; });
-  };
-  if (offset(sensor.crosstalk, [](const SensorCrosstalk& x) { return x.target; }) ||
-      offset(sensor.drifts, [](const SensorDrift& x) { return x.channel; }))
-    return std::nullopt;
+  if (frame_offsets(sensor, clip.channel)) return std::nullopt;
   if (const SensorCurve* curve = sensor.curve_of(clip.channel)) return curve_level(*curve, clip.rail);
   return clip.rail;
 }
 
 bool frame_transforms(const SensorModel& sensor, const std::string& channel) {
-  if (sensor.curve_of(channel) != nullptr) return true;
-  return std::any_of(sensor.crosstalk.begin(), sensor.crosstalk.end(),
-                     [&](const SensorCrosstalk& x) { return x.target == channel; }) ||
-         std::any_of(sensor.drifts.begin(), sensor.drifts.end(),
-                     [&](const SensorDrift& x) { return x.channel == channel; });
+  return sensor.curve_of(channel) != nullptr || frame_offsets(sensor, channel);
 }
 
 }  // namespace hadynet::trainer
