@@ -83,7 +83,10 @@
 # where the frame has a rail; the 4-seed model): 1271-1280 became its
 # development (re-run on the same logs), 1302-1311 every effect at its
 # larger strength measured with it and, on the same logs, the stop-45
-# binary.
+# binary. Stop 47 (the decision on two folds; the 4-seed model): 1271-1280
+# its development (re-run on the same logs, also with a 10-step decision
+# not kept), 1347-1356 every effect at its larger strength measured with
+# it and, on the same logs, the stop-46 binary.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

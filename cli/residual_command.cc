@@ -146,8 +146,9 @@ void print_fix(const rs::FixResult& fixed) {
   if (fixed.tried) {
     std::printf("decision: against %s on", fixed.reference.c_str());
     for (const auto& c : fixed.confirmation_channels) std::printf(" %s", c.c_str());
-    std::printf(": Diebold-Mariano p %.2g: %s\n", fixed.confirmation.p_value,
-                fixed.changed ? "confirmed" : "not confirmed, nothing applied");
+    std::printf(": Diebold-Mariano p %.2g", fixed.confirmation.p_value);
+    if (fixed.folds > 1) std::printf(" (%d folds; the first alone: p %.2g)", fixed.folds, fixed.first_fold.p_value);
+    std::printf(": %s\n", fixed.changed ? "confirmed" : "not confirmed, nothing applied");
     if (fixed.candidates.size() > 1) {
       std::printf("candidates (the screen's order; * the one tested: the first whose gain over fine-tuning alone\n"
                   "on the training rows' last 25 %% is significant, else the clearest gain, else the screen's first):\n");
@@ -242,6 +243,11 @@ int run_residual(int argc, char** argv) {
             "decision on held-out rows against fine-tuning alone guards what is applied (1 names more effects\n"
             "and makes more wrong fixes on fresh plant logs: docs/residual.md)",
             "the screen's --min-excess-null");
+  opt.value("fix-folds", "1|2",
+            "with --fix: 2 also judges a mirrored fold (the candidate and fine-tuning alone trained on each\n"
+            "log's last rows, judged on the rows before them), pooled with the first fold in the decision's\n"
+            "test; 1: the first fold alone (the written model and the before/after columns are the first\n"
+            "fold's either way)", "2");
   opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
                         "unchanged model, a weaker guard)");
   if (!opt.parse(argc, argv)) return 2;
@@ -289,12 +295,13 @@ int run_residual(int argc, char** argv) {
   const auto fix_seed = opt.get_int("fix-seed", 0, (1ll << 62));
   const auto rounds = opt.get_int("rounds", 1, 20);
   const auto candidates = opt.get_int("candidates", 1, 20);
+  const auto folds = opt.get_int("fix-folds", 1, 2);
   std::optional<double> fix_min_excess;
   if (opt.has("fix-min-excess-null")) {
     fix_min_excess = opt.get_double("fix-min-excess-null", 0.0, 1e6);
     if (!fix_min_excess) return 2;
   }
-  if (!fix_epochs || !fix_lr || !fix_seed || !rounds || !candidates) return 2;
+  if (!fix_epochs || !fix_lr || !fix_seed || !rounds || !candidates || !folds) return 2;
   if (opt.has("fix-min-excess-null") && !opt.has("fix")) {
     std::fprintf(stderr, "hadynet residual: --fix-min-excess-null needs --fix\n");
     return 2;
@@ -375,6 +382,7 @@ int run_residual(int argc, char** argv) {
     fo.seed = static_cast<std::uint64_t>(*fix_seed);
     fo.control = !opt.has("no-control");
     fo.candidates = static_cast<int>(*candidates);
+    fo.folds = static_cast<int>(*folds);
     fo.min_excess_null = fix_min_excess;
     fo.reference = &reference;
     fo.reference_pb_choice = stored_null ? "state" : "auto";

@@ -70,6 +70,10 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                          {"statistic", f.confirmation.stat},
                          {"bandwidth", f.confirmation.bandwidth},
                          {"rows", f.confirmation.samples},
+                         {"folds", f.folds},
+                         {"first_fold", {{"rows", f.first_fold.samples},
+                                         {"statistic", f.first_fold.stat},
+                                         {"p_value", f.first_fold.p_value}}},
                          {"p_value", f.confirmation.p_value},
                          {"confirmed", f.changed}};
     json candidates = json::array();
@@ -139,8 +143,11 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
     for (std::size_t i = 0; i < f.confirmation_channels.size(); ++i) m += (i ? ", " : "") + f.confirmation_channels[i];
     m += " (one-sided Diebold-Mariano test of the standardised squared error, Newey-West variance over " +
          std::to_string(f.confirmation.bandwidth) + " lags, " + std::to_string(f.confirmation.samples) +
-         " rows): mean loss difference " + num("%.3g", f.confirmation.mean) + ", p " +
-         num("%.2g", f.confirmation.p_value) + ": **" + (f.changed ? "confirmed" : "not confirmed, nothing applied") +
+         " rows" + (f.folds > 1 ? " of " + std::to_string(f.folds) + " folds" : std::string()) +
+         "): mean loss difference " + num("%.3g", f.confirmation.mean) + ", p " +
+         num("%.2g", f.confirmation.p_value) +
+         (f.folds > 1 ? " (the first fold alone: p " + num("%.2g", f.first_fold.p_value) + ")" : std::string()) +
+         ": **" + (f.changed ? "confirmed" : "not confirmed, nothing applied") +
          "**.\n\n";
     m += "Verdict after (the augmented model on its own frame): " + f.after.verdict + "\n\n";
   }

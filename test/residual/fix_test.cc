@@ -254,6 +254,45 @@ TEST(ResidualFix, FrictionGetsDerivedCommandInputsAndCutsTheTendonsError) {
   expect_deployable(m);
 }
 
+// The decision's mirrored fold (FixOptions::folds 2, the default): the
+// tested candidate and its control are fine-tuned again on each log's last
+// 60 % of rows and judged on the rows before them, [d + 2, T - split); those
+// rows' loss differences join the first fold's in one test. The first fold
+// (its models, before/after columns and test) is the same as with one fold,
+// bit for bit: the second fold adds rows and changes nothing else.
+TEST(ResidualFix, TheMirroredFoldJoinsTheDecisionAndLeavesTheFirstFoldAlone) {
+  const std::vector<LogInput> logs = plant_logs("friction");
+  const trainer::HadynetModel& model = build_model();
+  const ResidualData data = compute_residuals(model, logs, "auto");
+  const Attribution attribution = attribute(data, enumerate_hypotheses(data, {}), {});
+  FixOptions one;
+  one.candidates = 1;
+  one.folds = 1;
+  FixOptions two = one;
+  two.folds = 2;
+  const FixResult a = fix(model, logs, data, attribution, one);
+  const FixResult b = fix(model, logs, data, attribution, two);
+  ASSERT_TRUE(a.tried && b.tried);
+  EXPECT_EQ(a.folds, 1);
+  EXPECT_EQ(b.folds, 2);
+  EXPECT_EQ(a.confirmation.samples, a.first_fold.samples);
+  EXPECT_EQ(a.confirmation.p_value, a.first_fold.p_value);
+  EXPECT_EQ(b.first_fold.samples, a.first_fold.samples);
+  EXPECT_EQ(b.first_fold.p_value, a.first_fold.p_value);
+  EXPECT_EQ(b.first_fold.stat, a.first_fold.stat);
+  EXPECT_TRUE(b.after.rmse == a.after.rmse);
+  ASSERT_TRUE(a.control && b.control);
+  EXPECT_TRUE(b.control->rmse == a.control->rmse);
+  // Friction adds no sensor delay (d = 0): the mirrored fold judges rows [2, T - split) of each log.
+  long mirrored = 0;
+  for (const auto& log : logs) {
+    const auto T = static_cast<long>(log.table.rows());
+    mirrored += T - static_cast<long>(std::floor(0.6 * static_cast<double>(T))) - 2;
+  }
+  EXPECT_EQ(b.confirmation.samples, b.first_fold.samples + mirrored);
+  EXPECT_NE(b.confirmation.p_value, b.first_fold.p_value);
+}
+
 // `hadynet residual --rounds` analyses the next round with the confirmed
 // change on the network before fine-tuning (FixResult::untuned). Its
 // contract: fine-tuned as fix() fine-tunes the next round's control (its

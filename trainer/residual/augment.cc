@@ -36,16 +36,21 @@ Segments standardised_loss(const HadynetModel& model, const HeldOutError& e, con
   return out;
 }
 
-// Training data: raw rows [0, cut[i]) of each log in the measured frame; a
-// frame aligned by a delay of s rows holds them in rows [0, cut[i] - s).
+// Raw rows [from[i], to[i]) of each log i.
+struct RowSpan {
+  std::vector<int> from, to;
+};
+
+// Training data: raw rows [from[i], to[i]) of each log in the model's frame;
+// a frame aligned by a delay of s rows holds them in rows [from[i], to[i] - s).
 std::vector<LogSequence> training_rows(const std::vector<LogInput>& logs, const SensorModel& sensor,
-                                       const FeatureLayout& layout, const std::vector<int>& cut) {
+                                       const FeatureLayout& layout, const RowSpan& rows) {
   std::vector<LogSequence> seqs;
   for (std::size_t i = 0; i < logs.size(); ++i) {
     LogSequence s = in_model_frame(sensor, layout, logs[i].table, logs[i].file).sequence;
-    const int keep = cut[i] - sensor.max_delay();
-    s.y = s.y.leftCols(keep).eval();
-    s.u = s.u.leftCols(keep).eval();
+    const int keep = rows.to[i] - sensor.max_delay() - rows.from[i];
+    s.y = s.y.middleCols(rows.from[i], keep).eval();
+    s.u = s.u.middleCols(rows.from[i], keep).eval();
     seqs.push_back(std::move(s));
   }
   return seqs;
@@ -222,9 +227,35 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     inner.push_back(static_cast<int>(std::floor(kSelectionFraction * first)));
     if (inner.back() < d + 2 + kMinSelectionRows || first - d - inner.back() < kMinSelectionRows) can_select = false;
   }
-  // Each model is fed the logs in its own frame and judged on the measured rows [from[i], to(i)).
-  auto eval_rows = [&](const HadynetModel& m, const std::vector<Eigen::VectorXf>& pbs, const std::vector<int>& from,
-                       bool held_out) {
+  // The spans of rows: the first fold trains on [0, split) and is judged on
+  // [split, T - d); the selection trains on [0, inner) and judges
+  // [inner, split - d).
+  RowSpan train_part, held_out_part, selection_train, selection_judged;
+  for (std::size_t i = 0; i < logs.size(); ++i) {
+    const int T = static_cast<int>(logs[i].table.rows());
+    train_part.from.push_back(0);
+    train_part.to.push_back(split[i]);
+    held_out_part.from.push_back(split[i]);
+    held_out_part.to.push_back(T - d);
+    selection_train.from.push_back(0);
+    selection_train.to.push_back(inner[i]);
+    selection_judged.from.push_back(inner[i]);
+    selection_judged.to.push_back(split[i] - d);
+  }
+  // The mirrored fold (FixOptions::folds): trains on [T - split, T), judged on
+  // [d + 2, T - split); only where every log leaves it kMinSelectionRows.
+  RowSpan mirrored_train, mirrored_judged;
+  bool mirrored_fold_fits = true;
+  for (std::size_t i = 0; i < logs.size(); ++i) {
+    const int T = static_cast<int>(logs[i].table.rows());
+    mirrored_train.from.push_back(T - split[i]);
+    mirrored_train.to.push_back(T);
+    mirrored_judged.from.push_back(d + 2);
+    mirrored_judged.to.push_back(T - split[i]);
+    if (T - split[i] - (d + 2) < kMinSelectionRows) mirrored_fold_fits = false;
+  }
+  // Each model is fed the logs in its own frame and judged on the measured rows of `rows`.
+  auto eval_rows = [&](const HadynetModel& m, const std::vector<Eigen::VectorXf>& pbs, const RowSpan& rows) {
     std::vector<HeldOutLog> out;
     for (std::size_t i = 0; i < logs.size(); ++i) {
       HeldOutLog e;
@@ -232,14 +263,14 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       e.measured = log_sequence(logs[i].table, logs[i].file, m.layout);
       e.frame = in_model_frame(m.sensor, m.layout, logs[i].table, logs[i].file).sequence;
       e.pb = pbs[i];
-      e.first = from[i];
-      e.end = held_out ? e.measured.steps() - d : split[i] - d;
+      e.first = rows.from[i];
+      e.end = rows.to[i];
       out.push_back(std::move(e));
     }
     return out;
   };
   auto eval_logs = [&](const HadynetModel& m, const std::vector<Eigen::VectorXf>& pbs) {
-    return eval_rows(m, pbs, split, true);
+    return eval_rows(m, pbs, held_out_part);
   };
   auto state_pbs = [&](const HadynetModel& m) {
     std::vector<Eigen::VectorXf> pbs;
@@ -264,17 +295,17 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
 
   // What an augmentation re-estimates before fine-tuning (drift: the rates;
   // curve: the slopes), probing the unchanged network with a sensor model on
-  // the rows before cut[i] of each log: the rows its fine-tuning will see.
+  // the rows of `rows`: the rows its fine-tuning will see.
   HadynetModel probe = model;
-  auto refined = [&](Augmentation a, const std::vector<int>& cut, std::vector<double>* fitted) {
+  auto refined = [&](Augmentation a, const RowSpan& rows, std::vector<double>* fitted) {
     TrainingRmse training_rmse;
     training_rmse.y_names = model.layout.y_names;
     training_rmse.all = [&](const SensorModel& sensor) {
       probe.sensor = sensor;
       std::vector<HeldOutLog> train = eval_logs(probe, before_pbs);
       for (std::size_t i = 0; i < train.size(); ++i) {
-        train[i].first = ResidualLog::kFirstRow + d;
-        train[i].end = cut[i];
+        train[i].first = std::max(rows.from[i], ResidualLog::kFirstRow + d);
+        train[i].end = std::min(rows.to[i], train[i].measured.steps() - d);
       }
       return Eigen::VectorXd(held_out_error(probe, train).rmse);
     };
@@ -284,22 +315,22 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     return a;
   };
 
-  // A model fine-tuned on rows [0, cut) (the control: no augmentation).
+  // A model fine-tuned on the rows of `rows` (the control: no augmentation).
   struct Tuned {
     HadynetModel model;
     std::vector<double> loss_history;
     long train_windows = 0;
   };
-  auto tune = [&](const Augmentation* a, const std::vector<int>& cut, HadynetModel* untuned = nullptr) {
+  auto tune = [&](const Augmentation* a, const RowSpan& rows, HadynetModel* untuned = nullptr) {
     Tuned t;
     const SensorModel sensor = a != nullptr ? sensor_after(model.sensor, *a) : model.sensor;
     const FeatureLayout layout = a != nullptr ? augmented_layout(model.layout, *a) : model.layout;
     // The augmented layout first (aux adds a channel, friction commands), then its training data.
-    const auto seqs = training_rows(logs, sensor, layout, cut);
+    const auto seqs = training_rows(logs, sensor, layout, rows);
     t.model = a != nullptr ? augmented_model(model, *a, seqs) : model;
-    const auto rows = ensure_states(t.model, seqs, before_pbs);
+    const auto states = ensure_states(t.model, seqs, before_pbs);
     if (untuned != nullptr) *untuned = t.model;
-    t.loss_history = fine_tune(t.model, seqs, rows, tuning, &t.train_windows);
+    t.loss_history = fine_tune(t.model, seqs, states, tuning, &t.train_windows);
     t.model.check_consistent();
     return t;
   };
@@ -329,14 +360,14 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     result.candidates.push_back(std::move(c));
   }
   if (planned.size() > 1 && can_select) {
-    const Tuned control = tune(nullptr, inner);
+    const Tuned control = tune(nullptr, selection_train);
     const HeldOutError control_rows =
-        held_out_error(control.model, eval_rows(control.model, state_pbs(control.model), inner, false));
+        held_out_error(control.model, eval_rows(control.model, state_pbs(control.model), selection_judged));
     for (std::size_t k = 0; k < planned.size(); ++k) {
       // Re-estimated on the selection's training rows alone (the rows it is judged on stay unseen).
-      const Augmentation a = refined(planned[k], inner, nullptr);
-      const Tuned t = tune(&a, inner);
-      const HeldOutError rows = held_out_error(t.model, eval_rows(t.model, state_pbs(t.model), inner, false));
+      const Augmentation a = refined(planned[k], selection_train, nullptr);
+      const Tuned t = tune(&a, selection_train);
+      const HeldOutError rows = held_out_error(t.model, eval_rows(t.model, state_pbs(t.model), selection_judged));
       CandidateTrial& c = result.candidates[k];
       c.selection = diebold_mariano(standardised_loss(model, control_rows, c.channels),
                                     standardised_loss(model, rows, c.channels));
@@ -349,7 +380,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.candidates[chosen].chosen = true;
 
   if (options.control) {
-    const Tuned c = tune(nullptr, split);
+    const Tuned c = tune(nullptr, train_part);
     result.control = held_out_error(c.model, eval_logs(c.model, state_pbs(c.model)));
   }
   const HeldOutError& reference = result.control ? *result.control : result.before;
@@ -360,16 +391,38 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // found on (the plan's found_on, of the model's own channels: the aligned,
   // cleaned, clipped, drifting or friction channels; for an aux channel, the
   // channels its significant hypotheses explain).
-  const Augmentation tested = refined(planned[chosen], split, &result.fitted_rates);
+  const Augmentation tested = refined(planned[chosen], train_part, &result.fitted_rates);
   if (!result.candidates[chosen].selected_by_training_rows) result.candidates[chosen].description = tested.description;
-  Tuned after = tune(&tested, split, &result.untuned);
+  Tuned after = tune(&tested, train_part, &result.untuned);
   result.augmentation = tested;
   result.loss_history = after.loss_history;
   result.train_windows = after.train_windows;
   result.after = held_out_error(after.model, eval_logs(after.model, state_pbs(after.model)));
   result.confirmation_channels = result.candidates[chosen].channels;
-  result.confirmation = diebold_mariano(standardised_loss(model, reference, result.confirmation_channels),
-                                        standardised_loss(model, result.after, result.confirmation_channels));
+  Segments reference_loss = standardised_loss(model, reference, result.confirmation_channels);
+  Segments after_loss = standardised_loss(model, result.after, result.confirmation_channels);
+  result.first_fold = diebold_mariano(reference_loss, after_loss);
+  // The mirrored fold (FixOptions::folds 2): the same candidate and its
+  // reference fine-tuned on each log's last rows, [T - split, T), and judged
+  // on its first, [d + 2, T - split); its rows join the test.
+  if (options.folds == 2 && mirrored_fold_fits) {
+    const Augmentation mirrored = refined(planned[chosen], mirrored_train, nullptr);
+    const Tuned a = tune(&mirrored, mirrored_train);
+    const HeldOutError a_rows = held_out_error(a.model, eval_rows(a.model, state_pbs(a.model), mirrored_judged));
+    HeldOutError r_rows;
+    if (options.control) {
+      const Tuned c = tune(nullptr, mirrored_train);
+      r_rows = held_out_error(c.model, eval_rows(c.model, state_pbs(c.model), mirrored_judged));
+    } else {
+      r_rows = held_out_error(model, eval_rows(model, before_pbs, mirrored_judged));
+    }
+    for (auto& segment : standardised_loss(model, r_rows, result.confirmation_channels))
+      reference_loss.push_back(std::move(segment));
+    for (auto& segment : standardised_loss(model, a_rows, result.confirmation_channels))
+      after_loss.push_back(std::move(segment));
+    result.folds = 2;
+  }
+  result.confirmation = diebold_mariano(reference_loss, after_loss);
 
   // The residual analysis of the augmented model (in its own frame), against
   // the calibrated null of the same model when the analysis had one.

@@ -42,6 +42,13 @@ struct FixOptions {
   double lr = 1e-3;             // Adam
   std::uint64_t seed = 1;       // window order
   bool control = true;          // also fine-tune without the augmentation (same data, epochs, seed)
+  // 2: the decision also judges a mirrored fold: the tested candidate and
+  // its reference fine-tuned on each log's last train_fraction of rows and
+  // judged on the rows before them, whose per-row loss differences join the
+  // first fold's in one Diebold-Mariano test (about twice the held-out rows;
+  // the fixed model and the before/after columns stay the first fold's).
+  // 1: the first fold alone. --fix-folds.
+  int folds = 2;
   // How many of the screen's candidates may be tried (plan_candidates: the
   // best of each effect): each is re-estimated, added and fine-tuned on the
   // first 75 % of the training rows and judged on the rest against the
@@ -301,7 +308,9 @@ bool gains_significantly(const CandidateTrial& c, double alpha);
 // model) on the held-out rows of the channels its effect was found on: a
 // one-sided Diebold-Mariano test (statistics.h) on the per-row standardised
 // squared error, mean over those channels, at the attribution's alpha (one
-// test: the held-out rows chose nothing). Otherwise the status is
+// test: the held-out rows chose nothing), pooled over FixOptions::folds
+// (the first fold's held-out rows, and the mirrored fold's: trained on each
+// log's last rows, judged on the rows before them). Otherwise the status is
 // "unexplained structure" and no model is produced.
 struct FixResult {
   // "no significant effect", "not supported: ...", "fixed" (confirmed) or
@@ -320,7 +329,9 @@ struct FixResult {
   HeldOutError before, after;  // after: the augmented model (valid if tried)
   std::vector<std::string> confirmation_channels;  // where the effect was found (the test's channels)
   std::string reference;                           // "fine-tuning alone" or "the unchanged model"
-  DieboldMariano confirmation;                     // reference's loss minus after's (valid if tried)
+  DieboldMariano confirmation;                     // reference's loss minus after's, every fold (valid if tried)
+  DieboldMariano first_fold;                       // the same on the first fold's held-out rows alone
+  int folds = 1;                                   // the folds the decision judged (2: the mirrored one too)
   std::vector<CandidateTrial> candidates;          // the screen's candidates, in its order
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
