@@ -58,6 +58,9 @@
 # smoke run 1301 of bench/pb_auto_check.sh belong to the other benches).
 # Stop 46 (clips on the network's channel only where the frame has a rail;
 # the 4-seed model): 1312-1331 measured (1302-1311 belong to the detection).
+# Stop 47 (the decision on two folds; the 4-seed model): 1357-1376 measured
+# with it, and again with --fix-min-excess-null 0 with it and the stop-46
+# binary (the decision reached on clean logs).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

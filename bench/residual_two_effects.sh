@@ -29,7 +29,9 @@
 # with the build's model (the same logs and binary); 1261-1265 (stop 44:
 # --pb auto's check per channel, the 4-seed model; also with the mean-loss
 # check's binary on the same logs); 1342-1346 (stop 46: clips on the
-# network's channel only where the frame has a rail; the 4-seed model).
+# network's channel only where the frame has a rail; the 4-seed model);
+# 1387-1391 (stop 47: the decision on two folds; the 4-seed model; also
+# with the stop-46 binary on the same logs).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]...

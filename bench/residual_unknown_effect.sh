@@ -33,7 +33,8 @@
 # model, --model models/hand-4seeds.safetensors, trained on seeds 1 and
 # 2001-2003), 1251-1260 (stop 44: --pb auto's check per channel, the
 # 4-seed model), 1332-1341 (stop 46: clips on the network's channel only
-# where the frame has a rail; the 4-seed model).
+# where the frame has a rail; the 4-seed model), 1377-1386 (stop 47: the
+# decision on two folds; the 4-seed model).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve]
