@@ -149,6 +149,7 @@ void print_fix(const rs::FixResult& fixed) {
     std::printf(": Diebold-Mariano p %.2g", fixed.confirmation.p_value);
     if (fixed.folds > 1) std::printf(" (%d folds; the first alone: p %.2g)", fixed.folds, fixed.first_fold.p_value);
     std::printf(": %s\n", fixed.changed ? "confirmed" : "not confirmed, nothing applied");
+    if (!fixed.folds_note.empty()) std::printf("note: %s\n", fixed.folds_note.c_str());
     if (fixed.candidates.size() > 1) {
       std::printf("candidates (the screen's order; * the one tested: the first whose gain over fine-tuning alone\n"
                   "on the training rows' last 25 %% is significant, else the clearest gain, else the screen's first):\n");
@@ -220,7 +221,8 @@ int run_residual(int argc, char** argv) {
                   "delay: the commands d steps earlier as inputs; aux channel: an observed channel), fine-tune\n"
                   "on the first --train-fraction of each log and report before/after on the rest; the effect is\n"
                   "confirmed (and the model kept) only when it beats fine-tuning alone on the held-out rows of\n"
-                  "the channels it changes (one-sided Diebold-Mariano test at --alpha), else 'unexplained structure'");
+                  "the channels it changes (one-sided Diebold-Mariano test at --alpha; with --fix-folds 2 also on\n"
+                  "the mirrored fold's), else 'unexplained structure'");
   opt.value("rounds", "N",
             "with --fix: repeat analysis and fix until nothing is confirmed, at most N rounds (so that two\n"
             "effects at once are both found); the next round analyses the confirmed change on the network\n"
@@ -244,10 +246,10 @@ int run_residual(int argc, char** argv) {
             "and makes more wrong fixes on fresh plant logs: docs/residual.md)",
             "the screen's --min-excess-null");
   opt.value("fix-folds", "1|2",
-            "with --fix: 2 also judges a mirrored fold (the candidate and fine-tuning alone trained on each\n"
+            "with --fix: 2 also judges a mirrored fold (the candidate and its reference fine-tuned on each\n"
             "log's last rows, judged on the rows before them), pooled with the first fold in the decision's\n"
-            "test; 1: the first fold alone (the written model and the before/after columns are the first\n"
-            "fold's either way)", "2");
+            "test (not when --train-fraction is below 4/7 or a log is too short); 1: the first fold alone\n"
+            "(the written model and the before/after columns are the first fold's either way)", "2");
   opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
                         "unchanged model, a weaker guard)");
   if (!opt.parse(argc, argv)) return 2;

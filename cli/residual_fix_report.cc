@@ -71,6 +71,7 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                          {"bandwidth", f.confirmation.bandwidth},
                          {"rows", f.confirmation.samples},
                          {"folds", f.folds},
+                         {"folds_note", f.folds_note},
                          {"first_fold", {{"rows", f.first_fold.samples},
                                          {"statistic", f.first_fold.stat},
                                          {"p_value", f.first_fold.p_value}}},
@@ -135,8 +136,8 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
   m += "\n\nFine-tuned " + std::to_string(o.epochs) + " epochs (batch norm frozen, Adam lr " + num("%g", o.lr) +
        ", seed " + std::to_string(o.seed) + ") on the first " + num("%.0f", 100 * o.train_fraction) +
        " % of each log's rows; every number below is on the remaining rows (" + std::to_string(f.before.samples) +
-       " held-out rows, causal 1-step predictions of the measured values). \"Fine-tune only\" is the same "
-       "fine-tuning without the augmentation.\n\n";
+       " held-out rows, causal 1-step predictions of the measured values), the decision's mirrored fold "
+       "apart. \"Fine-tune only\" is the same fine-tuning without the augmentation.\n\n";
   m += "Verdict before: " + f.before.verdict + "\n\n";
   if (f.tried) {
     m += "Decision: the augmented model against " + f.reference + " on the held-out rows of ";
@@ -147,7 +148,7 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
          "): mean loss difference " + num("%.3g", f.confirmation.mean) + ", p " +
          num("%.2g", f.confirmation.p_value) +
          (f.folds > 1 ? " (the first fold alone: p " + num("%.2g", f.first_fold.p_value) + ")" : std::string()) +
-         ": **" + (f.changed ? "confirmed" : "not confirmed, nothing applied") +
+         (f.folds_note.empty() ? std::string() : " (" + f.folds_note + ")") + ": **" + (f.changed ? "confirmed" : "not confirmed, nothing applied") +
          "**.\n\n";
     m += "Verdict after (the augmented model on its own frame): " + f.after.verdict + "\n\n";
   }

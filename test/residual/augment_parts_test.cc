@@ -307,5 +307,51 @@ TEST(FixCandidates, TheFirstSignificantElseTheClearestGainIsTested) {
   EXPECT_EQ(chosen({}), 0u);
 }
 
+// The rows fix() fine-tunes on and judges (decision_rows): the first fold and
+// the selection as before stop 47, and the mirrored fold only where its
+// judged rows end before the selection's (no row judged twice, none that
+// chose the candidate judged again) and no model is judged on a row it was
+// fine-tuned on. A model fine-tuned on raw rows [a, b) whose frame is
+// aligned by a delay of s <= d reads raw rows up to b - 1 and, through the
+// alignment, predicts nothing the judged rows hold. Exact integers.
+TEST(DecisionRows, TheFoldsNeverJudgeARowTwiceNorOneTheyTrainedOn) {
+  using Span = residual::DecisionRows::Span;
+  const auto eq = [](Span a, int from, int to) { return a.from == from && a.to == to; };
+  // The benchmarks' logs: 300 rows, train_fraction 0.6 (split 180), no delay and a 2-step one.
+  const residual::DecisionRows r0 = residual::decision_rows(300, 180, 0);
+  EXPECT_TRUE(eq(r0.train, 0, 180) && eq(r0.held_out, 180, 300));
+  EXPECT_TRUE(eq(r0.selection_train, 0, 135) && eq(r0.selection_judged, 135, 180));
+  EXPECT_TRUE(eq(r0.mirrored_train, 120, 300) && eq(r0.mirrored_judged, 2, 120));
+  EXPECT_TRUE(r0.can_select && r0.mirrored);
+  const residual::DecisionRows r2 = residual::decision_rows(300, 180, 2);
+  EXPECT_TRUE(eq(r2.held_out, 180, 298) && eq(r2.selection_judged, 135, 178) && eq(r2.mirrored_judged, 4, 120));
+  EXPECT_TRUE(r2.mirrored);
+  // train_fraction 0.4: the mirrored judged rows would reach [120, 180), the
+  // first fold's training rows, and the selection's judged rows [90, 120).
+  EXPECT_FALSE(residual::decision_rows(300, 120, 0).mirrored);
+  // Just at 4/7 (split 172, inner 129, T - split 128) and just below (171: inner 128, T - split 129).
+  EXPECT_TRUE(residual::decision_rows(300, 172, 0).mirrored);
+  EXPECT_FALSE(residual::decision_rows(300, 171, 0).mirrored);
+  // Too short for 20 mirrored rows.
+  EXPECT_FALSE(residual::decision_rows(50, 30, 0).mirrored);
+  // Every log length, split and delay: wherever the mirrored fold is judged,
+  // its judged rows are disjoint from every other judged span and from its
+  // own training rows, and non-empty.
+  const auto disjoint = [](Span a, Span b) { return a.to <= b.from || b.to <= a.from; };
+  for (int T = 40; T <= 400; T += 7)
+    for (int d = 0; d <= 5; ++d)
+      for (int split = d + 2; split < T - d; split += 3) {
+        const residual::DecisionRows r = residual::decision_rows(T, split, d);
+        ASSERT_TRUE(eq(r.train, 0, split) && eq(r.held_out, split, T - d));
+        if (!r.mirrored) continue;
+        ASSERT_GE(r.mirrored_judged.to - r.mirrored_judged.from, residual::DecisionRows::kMinSelectionRows);
+        ASSERT_TRUE(disjoint(r.mirrored_judged, r.held_out)) << T << " " << split << " " << d;
+        ASSERT_TRUE(disjoint(r.mirrored_judged, r.selection_judged)) << T << " " << split << " " << d;
+        ASSERT_TRUE(disjoint(r.mirrored_judged, r.mirrored_train)) << T << " " << split << " " << d;
+        ASSERT_GE(r.mirrored_judged.from, d + 2);
+        ASSERT_EQ(r.mirrored_train.to, T);
+      }
+}
+
 }  // namespace
 }  // namespace hadynet::test

@@ -71,6 +71,21 @@ std::vector<int> held_out_starts(const std::vector<LogInput>& logs, double train
 
 }  // namespace
 
+DecisionRows decision_rows(int T, int split, int d) {
+  DecisionRows r;
+  const int inner = static_cast<int>(std::floor(DecisionRows::kSelectionFraction * split));
+  r.train = {0, split};
+  r.held_out = {split, T - d};
+  r.selection_train = {0, inner};
+  r.selection_judged = {inner, split - d};
+  r.mirrored_train = {T - split, T};
+  r.mirrored_judged = {d + 2, T - split};
+  r.can_select = inner >= d + 2 + DecisionRows::kMinSelectionRows &&
+                 split - d - inner >= DecisionRows::kMinSelectionRows;
+  r.mirrored = T - split - (d + 2) >= DecisionRows::kMinSelectionRows && T - split <= inner;
+  return r;
+}
+
 std::string why_not_fixable(const ResidualData& data, const Attribution& attribution, const HypothesisResult& r) {
   const EffectInfo& info = effect_info(r.hypothesis.kind);
   if (!info.plan) return info.augmentation;
@@ -215,44 +230,25 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   int d = model.sensor.max_delay();
   for (const auto& a : planned) d = std::max(d, sensor_after(model.sensor, a).max_delay());
 
-  // Held-out rows of each log: [split, end), the same for every model. The
-  // selection among candidates uses the training part alone: its first
-  // kSelectionFraction trains, rows [inner, split - d) judge.
-  constexpr double kSelectionFraction = 0.75;
-  constexpr int kMinSelectionRows = 20;
+  // The rows each model is fine-tuned on and judged on (decision_rows):
+  // the first fold's held-out rows are the same for every model reported.
   const std::vector<int> split = held_out_starts(logs, options.train_fraction, d);
-  std::vector<int> inner;
-  bool can_select = true;
-  for (const int first : split) {
-    inner.push_back(static_cast<int>(std::floor(kSelectionFraction * first)));
-    if (inner.back() < d + 2 + kMinSelectionRows || first - d - inner.back() < kMinSelectionRows) can_select = false;
-  }
-  // The spans of rows: the first fold trains on [0, split) and is judged on
-  // [split, T - d); the selection trains on [0, inner) and judges
-  // [inner, split - d).
-  RowSpan train_part, held_out_part, selection_train, selection_judged;
+  RowSpan train_part, held_out_part, selection_train, selection_judged, mirrored_train, mirrored_judged;
+  bool can_select = true, mirrored_fold_fits = true;
+  const auto add = [](RowSpan& span, DecisionRows::Span rows) {
+    span.from.push_back(rows.from);
+    span.to.push_back(rows.to);
+  };
   for (std::size_t i = 0; i < logs.size(); ++i) {
-    const int T = static_cast<int>(logs[i].table.rows());
-    train_part.from.push_back(0);
-    train_part.to.push_back(split[i]);
-    held_out_part.from.push_back(split[i]);
-    held_out_part.to.push_back(T - d);
-    selection_train.from.push_back(0);
-    selection_train.to.push_back(inner[i]);
-    selection_judged.from.push_back(inner[i]);
-    selection_judged.to.push_back(split[i] - d);
-  }
-  // The mirrored fold (FixOptions::folds): trains on [T - split, T), judged on
-  // [d + 2, T - split); only where every log leaves it kMinSelectionRows.
-  RowSpan mirrored_train, mirrored_judged;
-  bool mirrored_fold_fits = true;
-  for (std::size_t i = 0; i < logs.size(); ++i) {
-    const int T = static_cast<int>(logs[i].table.rows());
-    mirrored_train.from.push_back(T - split[i]);
-    mirrored_train.to.push_back(T);
-    mirrored_judged.from.push_back(d + 2);
-    mirrored_judged.to.push_back(T - split[i]);
-    if (T - split[i] - (d + 2) < kMinSelectionRows) mirrored_fold_fits = false;
+    const DecisionRows r = decision_rows(static_cast<int>(logs[i].table.rows()), split[i], d);
+    add(train_part, r.train);
+    add(held_out_part, r.held_out);
+    add(selection_train, r.selection_train);
+    add(selection_judged, r.selection_judged);
+    add(mirrored_train, r.mirrored_train);
+    add(mirrored_judged, r.mirrored_judged);
+    can_select = can_select && r.can_select;
+    mirrored_fold_fits = mirrored_fold_fits && r.mirrored;
   }
   // Each model is fed the logs in its own frame and judged on the measured rows of `rows`.
   auto eval_rows = [&](const HadynetModel& m, const std::vector<Eigen::VectorXf>& pbs, const RowSpan& rows) {
@@ -405,6 +401,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // The mirrored fold (FixOptions::folds 2): the same candidate and its
   // reference fine-tuned on each log's last rows, [T - split, T), and judged
   // on its first, [d + 2, T - split); its rows join the test.
+  if (options.folds == 2 && !mirrored_fold_fits)
+    result.folds_note = "the mirrored fold was not judged: a log is too short for it, or --train-fraction is below "
+                        "4/7 (its rows would overlap the rows that chose the candidate)";
   if (options.folds == 2 && mirrored_fold_fits) {
     const Augmentation mirrored = refined(planned[chosen], mirrored_train, nullptr);
     const Tuned a = tune(&mirrored, mirrored_train);

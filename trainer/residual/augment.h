@@ -11,10 +11,12 @@
 // dynamics change the network's inputs. Then the model is fine-tuned (batch
 // norm frozen).
 //
-// Held out by time: the first `train_fraction` of each log's rows are the only
-// data fine-tuning sees; every number is reported on the remaining rows.
-// Every model (before, fine-tune only, after) is judged on the same rows by
-// its causal 1-step prediction of the measured values (held_out.h).
+// Held out by time: the models reported (the fixed model, fine-tuning
+// alone) are fine-tuned on the first `train_fraction` of each log's rows,
+// and every number is reported on the remaining rows; the decision also
+// judges a mirrored fold (DecisionRows). Every model (before, fine-tune only,
+// after) is judged on the same rows by its causal 1-step prediction of the
+// measured values (held_out.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -36,7 +38,7 @@
 namespace hadynet::trainer::residual {
 
 struct FixOptions {
-  double train_fraction = 0.6;  // of each log's rows, from its start: what fine-tuning sees
+  double train_fraction = 0.6;  // of each log's rows, from its start: what the reported models are fine-tuned on
   int epochs = 20;              // fine-tuning epochs from the current weights (batch norm frozen)
   int batch = 100;
   double lr = 1e-3;             // Adam
@@ -297,6 +299,32 @@ struct CandidateTrial {
 // on fresh logs is often the model's own misfit); 0 (the screen's first)
 // when none is judged or none gains.
 std::size_t chosen_candidate(const std::vector<CandidateTrial>& candidates, double alpha);
+
+// The raw rows [from, to) of one log that fix() fine-tunes on and judges,
+// for a log of T rows whose first `split` rows are the training part and
+// whose last d rows a sensor delay costs:
+//   first fold: trains on [0, split), judged on [split, T - d) (reported);
+//   selection:  trains on [0, inner), judges [inner, split - d),
+//               inner = floor(kSelectionFraction split);
+//   mirrored fold (FixOptions::folds 2): trains on [T - split, T), judged on
+//               [d + 2, T - split).
+// can_select: the selection's spans hold at least kMinSelectionRows each.
+// mirrored: the mirrored fold's judged rows hold at least kMinSelectionRows
+// and end before the selection's judged rows begin (T - split <= inner), so
+// no row is judged twice and the rows that chose the candidate are not
+// judged again (train_fraction 0.6: rows [2, 0.4 T) against [0.45 T, 0.6 T)
+// and [0.6 T, T)).
+struct DecisionRows {
+  static constexpr double kSelectionFraction = 0.75;
+  static constexpr int kMinSelectionRows = 20;
+  struct Span {
+    int from = 0, to = 0;
+  };
+  Span train, held_out, selection_train, selection_judged, mirrored_train, mirrored_judged;
+  bool can_select = false;
+  bool mirrored = false;
+};
+DecisionRows decision_rows(int T, int split, int d);
 // Whether `c` was judged and its gain over the control is significant at
 // `alpha` (chosen_candidate's first rule; fix() judges no further candidate).
 bool gains_significantly(const CandidateTrial& c, double alpha);
@@ -332,6 +360,7 @@ struct FixResult {
   DieboldMariano confirmation;                     // reference's loss minus after's, every fold (valid if tried)
   DieboldMariano first_fold;                       // the same on the first fold's held-out rows alone
   int folds = 1;                                   // the folds the decision judged (2: the mirrored one too)
+  std::string folds_note;  // why the mirrored fold asked for was not judged (empty: judged, or not asked for)
   std::vector<CandidateTrial> candidates;          // the screen's candidates, in its order
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
