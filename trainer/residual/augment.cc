@@ -36,21 +36,19 @@ Segments standardised_loss(const HadynetModel& model, const HeldOutError& e, con
   return out;
 }
 
-// Raw rows [from[i], to[i]) of each log i.
-struct RowSpan {
-  std::vector<int> from, to;
-};
+// Per log i: raw rows [rows[i].from, rows[i].to).
+using RowSpan = std::vector<DecisionRows::Span>;
 
-// Training data: raw rows [from[i], to[i]) of each log in the model's frame;
-// a frame aligned by a delay of s rows holds them in rows [from[i], to[i] - s).
+// Training data: raw rows [from, to) of each log in the model's frame; a
+// frame aligned by a delay of s rows holds them in rows [from, to - s).
 std::vector<LogSequence> training_rows(const std::vector<LogInput>& logs, const SensorModel& sensor,
                                        const FeatureLayout& layout, const RowSpan& rows) {
   std::vector<LogSequence> seqs;
   for (std::size_t i = 0; i < logs.size(); ++i) {
     LogSequence s = in_model_frame(sensor, layout, logs[i].table, logs[i].file).sequence;
-    const int keep = rows.to[i] - sensor.max_delay() - rows.from[i];
-    s.y = s.y.middleCols(rows.from[i], keep).eval();
-    s.u = s.u.middleCols(rows.from[i], keep).eval();
+    const int keep = rows[i].to - sensor.max_delay() - rows[i].from;
+    s.y = s.y.middleCols(rows[i].from, keep).eval();
+    s.u = s.u.middleCols(rows[i].from, keep).eval();
     seqs.push_back(std::move(s));
   }
   return seqs;
@@ -235,18 +233,14 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   const std::vector<int> split = held_out_starts(logs, options.train_fraction, d);
   RowSpan train_part, held_out_part, selection_train, selection_judged, mirrored_train, mirrored_judged;
   bool can_select = true, mirrored_fold_fits = true;
-  const auto add = [](RowSpan& span, DecisionRows::Span rows) {
-    span.from.push_back(rows.from);
-    span.to.push_back(rows.to);
-  };
   for (std::size_t i = 0; i < logs.size(); ++i) {
     const DecisionRows r = decision_rows(static_cast<int>(logs[i].table.rows()), split[i], d);
-    add(train_part, r.train);
-    add(held_out_part, r.held_out);
-    add(selection_train, r.selection_train);
-    add(selection_judged, r.selection_judged);
-    add(mirrored_train, r.mirrored_train);
-    add(mirrored_judged, r.mirrored_judged);
+    train_part.push_back(r.train);
+    held_out_part.push_back(r.held_out);
+    selection_train.push_back(r.selection_train);
+    selection_judged.push_back(r.selection_judged);
+    mirrored_train.push_back(r.mirrored_train);
+    mirrored_judged.push_back(r.mirrored_judged);
     can_select = can_select && r.can_select;
     mirrored_fold_fits = mirrored_fold_fits && r.mirrored;
   }
@@ -259,8 +253,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       e.measured = log_sequence(logs[i].table, logs[i].file, m.layout);
       e.frame = in_model_frame(m.sensor, m.layout, logs[i].table, logs[i].file).sequence;
       e.pb = pbs[i];
-      e.first = rows.from[i];
-      e.end = rows.to[i];
+      e.first = rows[i].from;
+      e.end = rows[i].to;
       out.push_back(std::move(e));
     }
     return out;
@@ -272,6 +266,10 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     std::vector<Eigen::VectorXf> pbs;
     for (const auto& log : data.logs) pbs.push_back(m.params.pb.row(m.state_index(log.seq.state)).transpose());
     return pbs;
+  };
+  // A fine-tuned model (its states' PBs) judged on `rows`.
+  auto judged = [&](const HadynetModel& m, const RowSpan& rows) {
+    return held_out_error(m, eval_rows(m, state_pbs(m), rows));
   };
   const FineTuneOptions tuning{options.epochs, options.batch, options.lr, options.seed};
   std::vector<Eigen::VectorXf> before_pbs;
@@ -300,8 +298,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       probe.sensor = sensor;
       std::vector<HeldOutLog> train = eval_logs(probe, before_pbs);
       for (std::size_t i = 0; i < train.size(); ++i) {
-        train[i].first = std::max(rows.from[i], ResidualLog::kFirstRow + d);
-        train[i].end = std::min(rows.to[i], train[i].measured.steps() - d);
+        train[i].first = std::max(rows[i].from, ResidualLog::kFirstRow + d);
+        train[i].end = std::min(rows[i].to, train[i].measured.steps() - d);
       }
       return Eigen::VectorXd(held_out_error(probe, train).rmse);
     };
@@ -357,13 +355,12 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   }
   if (planned.size() > 1 && can_select) {
     const Tuned control = tune(nullptr, selection_train);
-    const HeldOutError control_rows =
-        held_out_error(control.model, eval_rows(control.model, state_pbs(control.model), selection_judged));
+    const HeldOutError control_rows = judged(control.model, selection_judged);
     for (std::size_t k = 0; k < planned.size(); ++k) {
       // Re-estimated on the selection's training rows alone (the rows it is judged on stay unseen).
       const Augmentation a = refined(planned[k], selection_train, nullptr);
       const Tuned t = tune(&a, selection_train);
-      const HeldOutError rows = held_out_error(t.model, eval_rows(t.model, state_pbs(t.model), selection_judged));
+      const HeldOutError rows = judged(t.model, selection_judged);
       CandidateTrial& c = result.candidates[k];
       c.selection = diebold_mariano(standardised_loss(model, control_rows, c.channels),
                                     standardised_loss(model, rows, c.channels));
@@ -377,7 +374,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
 
   if (options.control) {
     const Tuned c = tune(nullptr, train_part);
-    result.control = held_out_error(c.model, eval_logs(c.model, state_pbs(c.model)));
+    result.control = judged(c.model, held_out_part);
   }
   const HeldOutError& reference = result.control ? *result.control : result.before;
   result.reference = result.control ? "fine-tuning alone" : "the unchanged model";
@@ -393,7 +390,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.augmentation = tested;
   result.loss_history = after.loss_history;
   result.train_windows = after.train_windows;
-  result.after = held_out_error(after.model, eval_logs(after.model, state_pbs(after.model)));
+  result.after = judged(after.model, held_out_part);
   result.confirmation_channels = result.candidates[chosen].channels;
   Segments reference_loss = standardised_loss(model, reference, result.confirmation_channels);
   Segments after_loss = standardised_loss(model, result.after, result.confirmation_channels);
@@ -401,20 +398,14 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // The mirrored fold (FixOptions::folds 2): the same candidate and its
   // reference fine-tuned on each log's last rows, [T - split, T), and judged
   // on its first, [d + 2, T - split); its rows join the test.
-  if (options.folds == 2 && !mirrored_fold_fits)
+  if (options.folds == 2 && !mirrored_fold_fits) {
     result.folds_note = "the mirrored fold was not judged: a log is too short for it, or --train-fraction is below "
                         "4/7 (its rows would overlap the rows that chose the candidate)";
-  if (options.folds == 2 && mirrored_fold_fits) {
+  } else if (options.folds == 2) {
     const Augmentation mirrored = refined(planned[chosen], mirrored_train, nullptr);
-    const Tuned a = tune(&mirrored, mirrored_train);
-    const HeldOutError a_rows = held_out_error(a.model, eval_rows(a.model, state_pbs(a.model), mirrored_judged));
-    HeldOutError r_rows;
-    if (options.control) {
-      const Tuned c = tune(nullptr, mirrored_train);
-      r_rows = held_out_error(c.model, eval_rows(c.model, state_pbs(c.model), mirrored_judged));
-    } else {
-      r_rows = held_out_error(model, eval_rows(model, before_pbs, mirrored_judged));
-    }
+    const HeldOutError a_rows = judged(tune(&mirrored, mirrored_train).model, mirrored_judged);
+    const HeldOutError r_rows = options.control ? judged(tune(nullptr, mirrored_train).model, mirrored_judged)
+                                                : held_out_error(model, eval_rows(model, before_pbs, mirrored_judged));
     for (auto& segment : standardised_loss(model, r_rows, result.confirmation_channels))
       reference_loss.push_back(std::move(segment));
     for (auto& segment : standardised_loss(model, a_rows, result.confirmation_channels))
