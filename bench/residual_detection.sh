@@ -86,7 +86,11 @@
 # binary. Stop 47 (the decision on two folds; the 4-seed model): 1271-1280
 # its development (re-run on the same logs, also with a 10-step decision
 # not kept), 1347-1356 every effect at its larger strength measured with
-# it and, on the same logs, the stop-46 binary.
+# it and, on the same logs, the stop-46 binary. Stop 48 (--fix's
+# candidates down to 1 by default; the 4-seed model): 1271-1280 its
+# development (re-run on the same logs, also with a family floor not kept),
+# 1392-1401 every effect at its larger strength measured at the screen's
+# floor and, on the same logs, --fix-min-excess-null 1.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

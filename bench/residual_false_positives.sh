@@ -60,7 +60,9 @@
 # the 4-seed model): 1312-1331 measured (1302-1311 belong to the detection).
 # Stop 47 (the decision on two folds; the 4-seed model): 1357-1376 measured
 # with it, and again with --fix-min-excess-null 0 with it and the stop-46
-# binary (the decision reached on clean logs).
+# binary (the decision reached on clean logs). Stop 48 (--fix's candidates
+# down to 1 by default; the 4-seed model): 1402-1421 measured at the
+# screen's floor and with --fix-min-excess-null 1.
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

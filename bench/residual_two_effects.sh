@@ -31,7 +31,9 @@
 # check's binary on the same logs); 1342-1346 (stop 46: clips on the
 # network's channel only where the frame has a rail; the 4-seed model);
 # 1387-1391 (stop 47: the decision on two folds; the 4-seed model; also
-# with the stop-46 binary on the same logs).
+# with the stop-46 binary on the same logs); 1432-1436 (stop 48: --fix's
+# candidates down to 1 by default; the 4-seed model; also with
+# --fix-min-excess-null 3, the screen's floor, on the same logs).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]...

@@ -34,7 +34,9 @@
 # 2001-2003), 1251-1260 (stop 44: --pb auto's check per channel, the
 # 4-seed model), 1332-1341 (stop 46: clips on the network's channel only
 # where the frame has a rail; the 4-seed model), 1377-1386 (stop 47: the
-# decision on two folds; the 4-seed model).
+# decision on two folds; the 4-seed model), 1422-1431 (stop 48: --fix's
+# candidates down to 1 by default; the 4-seed model; also at the screen's
+# floor on the same logs).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve]

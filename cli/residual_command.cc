@@ -242,9 +242,9 @@ int run_residual(int argc, char** argv) {
   opt.value("fix-min-excess-null", "S",
             "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"
             "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"
-            "decision on held-out rows against fine-tuning alone guards what is applied (1 names more effects\n"
-            "and makes more wrong fixes on fresh plant logs: docs/residual.md)",
-            "the screen's --min-excess-null");
+            "decision on held-out rows against fine-tuning alone guards what is applied (docs/residual.md,\n"
+            "\"Candidates down to 1 by default\"); never above --min-excess-null",
+            num("%g", rs::kDefaultFixMinExcessNull));
   opt.value("fix-folds", "1|2",
             "with --fix: 2 also judges a mirrored fold (the candidate and its reference fine-tuned on each\n"
             "log's last rows, judged on the rows before them), pooled with the first fold in the decision's\n"
@@ -298,7 +298,7 @@ int run_residual(int argc, char** argv) {
   const auto rounds = opt.get_int("rounds", 1, 20);
   const auto candidates = opt.get_int("candidates", 1, 20);
   const auto folds = opt.get_int("fix-folds", 1, 2);
-  std::optional<double> fix_min_excess;
+  std::optional<double> fix_min_excess = rs::kDefaultFixMinExcessNull;  // fix() keeps it at most the screen's
   if (opt.has("fix-min-excess-null")) {
     fix_min_excess = opt.get_double("fix-min-excess-null", 0.0, 1e6);
     if (!fix_min_excess) return 2;
@@ -308,7 +308,7 @@ int run_residual(int argc, char** argv) {
     std::fprintf(stderr, "hadynet residual: --fix-min-excess-null needs --fix\n");
     return 2;
   }
-  if (fix_min_excess && *fix_min_excess > *min_excess) {
+  if (opt.has("fix-min-excess-null") && *fix_min_excess > *min_excess) {
     std::fprintf(stderr, "hadynet residual: --fix-min-excess-null %g is above the screen's --min-excess-null %g: the\n"
                  "candidates' floor can only be lower\n", *fix_min_excess, *min_excess);
     return 2;

@@ -37,6 +37,9 @@
 
 namespace hadynet::trainer::residual {
 
+// FixOptions::min_excess_null's default (units of a channel's clean residual level).
+inline constexpr double kDefaultFixMinExcessNull = 1.0;
+
 struct FixOptions {
   double train_fraction = 0.6;  // of each log's rows, from its start: what the reported models are fine-tuned on
   int epochs = 20;              // fine-tuning epochs from the current weights (batch norm frozen)
@@ -68,10 +71,11 @@ struct FixOptions {
   // effect's other significant channels) and which leads are skipped
   // (why_not_fixable) can then differ for candidates above the screen's
   // floor as well. --fix-min-excess-null. Unset: the screen's floor; above it:
-  // the screen's floor (the CLI refuses it). Measured at 1 on fresh logs
-  // (docs/residual.md, "Candidates below the screen's floor"): more effects
-  // named, and more wrong fixes, so not the default.
-  std::optional<double> min_excess_null;
+  // the screen's floor (the CLI refuses it). 1 since stop 48, when the
+  // decision judges two folds (docs/residual.md, "Candidates down to 1 by
+  // default"): on fresh logs more effects named, no clean set confirmed;
+  // with one fold (stop 45) it made more wrong fixes and was not the default.
+  std::optional<double> min_excess_null = kDefaultFixMinExcessNull;
   // The calibrated null's logs of the analysis (analyse()'s reference), for
   // the augmented model's verdict; nullptr or empty: absolute floors.
   const std::vector<LogInput>* reference = nullptr;
