@@ -307,6 +307,50 @@ TEST(FixCandidates, TheFirstSignificantElseTheClearestGainIsTested) {
   EXPECT_EQ(chosen({}), 0u);
 }
 
+// The ranking fix() plans its candidates from (candidates_view): by
+// default (stop 48) down to an excess share of 1, below the screen's 3;
+// never above the screen's floor; unset, the screen's; without a null the
+// absolute floors. Three drift hypotheses, significant but for the floor,
+// with shares 5, 2 and 0.5.
+TEST(FixCandidates, ByDefaultTheyReachDownToAShareOfOne) {
+  residual::Attribution screen;
+  screen.null = residual::NullCalibration{};
+  const double shares[3] = {5.0, 2.0, 0.5};
+  for (int target = 0; target < 3; ++target) {
+    residual::HypothesisResult r;
+    r.hypothesis.kind = residual::EffectKind::kDriftLoad;
+    r.hypothesis.target = target;
+    r.label = "drift on y" + std::to_string(target);
+    r.p_adjusted = 1e-6;
+    r.explained = 0.5;
+    r.excess_share = shares[target];
+    screen.ranked.push_back(r);
+  }
+  screen = residual::with_null_floor(screen, residual::kDefaultMinExcessNull);  // the screen at its floor of 3
+  const auto significant = [](const residual::Attribution& a) {
+    std::vector<int> targets;
+    for (const auto& r : a.ranked)
+      if (r.significant) targets.push_back(r.hypothesis.target);
+    return targets;
+  };
+  ASSERT_EQ(significant(screen), std::vector<int>({0}));
+  residual::FixOptions options;
+  EXPECT_EQ(significant(residual::candidates_view(screen, options)), std::vector<int>({0, 1}));
+  options.min_excess_null.reset();
+  EXPECT_EQ(significant(residual::candidates_view(screen, options)), std::vector<int>({0}));
+  options.min_excess_null = 10.0;  // above the screen's: the screen's
+  EXPECT_EQ(significant(residual::candidates_view(screen, options)), std::vector<int>({0}));
+  options.min_excess_null = 0.1;
+  EXPECT_EQ(significant(residual::candidates_view(screen, options)), std::vector<int>({0, 1, 2}));
+  // A screen already below the default keeps its own floor.
+  const residual::Attribution low = residual::with_null_floor(screen, 0.4);
+  EXPECT_EQ(significant(residual::candidates_view(low, residual::FixOptions{})), std::vector<int>({0, 1, 2}));
+  // Without a null the screen's ranking stays (its absolute floors).
+  residual::Attribution absolute = screen;
+  absolute.null.reset();
+  EXPECT_EQ(significant(residual::candidates_view(absolute, residual::FixOptions{})), significant(absolute));
+}
+
 // The rows fix() fine-tunes on and judges (decision_rows): the first fold and
 // the selection as before stop 47, and the mirrored fold only where its
 // judged rows end before the selection's (no row judged twice, none that

@@ -211,18 +211,17 @@ HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
   return m;
 }
 
+Attribution candidates_view(const Attribution& attribution, const FixOptions& options) {
+  if (!options.min_excess_null || *options.min_excess_null >= attribution.options.min_excess_null) return attribution;
+  return with_null_floor(attribution, *options.min_excess_null);
+}
+
 FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, const ResidualData& data,
               const Attribution& attribution, const FixOptions& options) {
   if (logs.size() != data.logs.size()) throw std::invalid_argument("--fix: logs and analysis differ");
   FixResult result;
   result.model = model;
-  // The candidates: the screen's ranking, or with FixOptions::min_excess_null
-  // re-ranked down to that floor (never above the screen's own).
-  const Attribution candidates_view =
-      options.min_excess_null
-          ? with_null_floor(attribution, std::min(attribution.options.min_excess_null, *options.min_excess_null))
-          : attribution;
-  std::vector<Augmentation> planned = plan_candidates(data, candidates_view, options.candidates);
+  std::vector<Augmentation> planned = plan_candidates(data, candidates_view(attribution, options), options.candidates);
   // Rows a sensor delay costs at the end of each log, before or after: the
   // largest over every candidate, so that all are judged on the same rows.
   int d = model.sensor.max_delay();

@@ -254,6 +254,12 @@ std::string why_not_fixable(const ResidualData& data, const Attribution& attribu
 // "not supported"). Empty without a winner.
 std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attribution& attribution, int count);
 
+// The ranking fix() plans its candidates from: `attribution` re-floored at
+// options.min_excess_null (with_null_floor) when that is below the screen's
+// floor, else `attribution` itself (never above the screen's floor; unset:
+// the screen's; without a null the absolute floors stay).
+Attribution candidates_view(const Attribution& attribution, const FixOptions& options);
+
 // The sensor model after adding the augmentation's part (add_to_sensor:
 // delay, cross-talk, drift, clips; the others leave it as it is). A delay
 // found in the model's frame adds to a channel's existing delay.
