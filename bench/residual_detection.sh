@@ -90,14 +90,16 @@
 # candidates down to 1 by default; the 4-seed model): 1271-1280 its
 # development (re-run on the same logs, also with a family floor not kept),
 # 1392-1401 every effect at its larger strength measured at the screen's
-# floor and, on the same logs, --fix-min-excess-null 1.
+# floor (the stop-47 binary; now --fix-min-excess-null 3) and, on the same
+# logs, --fix-min-excess-null 1.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...
 #   defaults: models/hand.safetensors, build/residual-detection, 10, 231, the tool's --candidates (5), every case
 #   (--case: only those; repeatable), the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
-#   --fix-min-excess-null S: passed to `hadynet residual --fix` (candidates below the screen's floor)
+#   --fix-min-excess-null S: passed to `hadynet residual --fix` (candidates below the screen's floor;
+#   the tool's default 1 since stop 48, the screen's floor 3 before)
 #   --rezeroed-first-init I: the k-th seed's sets are recorded under the zeroing I + k, one the model
 #   never saw, and keep the trained state names (a re-zeroed hand; bench/residual_grasps.sh)
 # Environment: HADYNET (default build/release/cli/hadynet).

@@ -62,7 +62,8 @@
 # with it, and again with --fix-min-excess-null 0 with it and the stop-46
 # binary (the decision reached on clean logs). Stop 48 (--fix's candidates
 # down to 1 by default; the 4-seed model): 1402-1421 measured at the
-# screen's floor and with --fix-min-excess-null 1.
+# screen's floor (the stop-47 binary; now --fix-min-excess-null 3) and with
+# --fix-min-excess-null 1.
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

@@ -38,6 +38,7 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
             {"lr", o.lr},
             {"seed", o.seed},
             {"min_excess_null", o.min_excess_null ? json(*o.min_excess_null) : json(nullptr)},
+            {"candidates_floor", f.candidates_floor ? json(*f.candidates_floor) : json(nullptr)},
             {"before", held_out_json(f.before)}};
   if (f.augmentation) {
     const rs::Augmentation& a = *f.augmentation;

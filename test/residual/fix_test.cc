@@ -52,7 +52,8 @@ FixRun run_fix(const std::vector<LogInput>& logs, const std::string& label,
   FixRun r;
   FixOptions fo;
   // The screen's winner alone: these tests check each effect's fix (and
-  // fix_margins.h's margins were measured so). With several candidates (the
+  // fix_margins.h's margins were measured so; with a null, its family read at
+  // the candidates' default floor of 1 since stop 48). With several candidates (the
   // default) and no rated ranges, a contact-free loadcell's real 0 N floor
   // wins the selection on the cross-talk and drift logs and on seed 12's clean
   // logs (docs/residual.md, "Several candidates"); the choice itself is
@@ -176,6 +177,7 @@ TEST(ResidualFix, SensorDelayIsTimeAlignedAndCutsTheDelayedChannelsError) {
   const std::vector<LogInput> logs = plant_logs("sensor-delay");
   const FixRun r = run_fix(logs, "sensor-delay");
   ASSERT_TRUE(fixed_as(r, EffectKind::kSensorDelay));
+  EXPECT_FALSE(r.fix.candidates_floor.has_value());  // no null: the screen's absolute floors
   // Its look-alike is said (one signature in 1-step residuals; docs/residual.md, "Open").
   EXPECT_NE(r.fix.look_alike.find("an input dead time"), std::string::npos) << r.fix.look_alike;
   const Augmentation& a = *r.fix.augmentation;
@@ -368,6 +370,9 @@ TEST(ResidualFix, InputDelayGetsTheLaggedCommandsAndCutsTheDelayedChannelsError)
   // time").
   const FixRun r = run_fix(plant_logs("input-delay"), "input-delay", build_model(), &stored_null());
   ASSERT_TRUE(fixed_as(r, EffectKind::kInputDelay));
+  // With a null the candidates reach down to the default share of 1 (its
+  // family then takes f3-f5 too: fix_margins.h).
+  EXPECT_EQ(r.fix.candidates_floor, std::optional<double>(kDefaultFixMinExcessNull));
   EXPECT_NE(r.fix.look_alike.find("a sensor delay"), std::string::npos) << r.fix.look_alike;
   const Augmentation& a = *r.fix.augmentation;
   // Every command 2 steps earlier, appended to u and computed from the

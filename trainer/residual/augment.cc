@@ -221,7 +221,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   if (logs.size() != data.logs.size()) throw std::invalid_argument("--fix: logs and analysis differ");
   FixResult result;
   result.model = model;
-  std::vector<Augmentation> planned = plan_candidates(data, candidates_view(attribution, options), options.candidates);
+  const Attribution view = candidates_view(attribution, options);
+  if (view.null) result.candidates_floor = view.options.min_excess_null;
+  std::vector<Augmentation> planned = plan_candidates(data, view, options.candidates);
   // Rows a sensor delay costs at the end of each log, before or after: the
   // largest over every candidate, so that all are judged on the same rows.
   int d = model.sensor.max_delay();

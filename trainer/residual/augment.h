@@ -371,6 +371,10 @@ struct FixResult {
   DieboldMariano first_fold;                       // the same on the first fold's held-out rows alone
   int folds = 1;                                   // the folds the decision judged (2: the mirrored one too)
   std::string folds_note;  // why the mirrored fold asked for was not judged (empty: judged, or not asked for)
+  // The floor of excess_share the candidates were taken at (candidates_view:
+  // FixOptions::min_excess_null, at most the screen's floor); none without a
+  // null (the screen's absolute floors).
+  std::optional<double> candidates_floor;
   std::vector<CandidateTrial> candidates;          // the screen's candidates, in its order
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
