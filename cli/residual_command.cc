@@ -298,7 +298,7 @@ int run_residual(int argc, char** argv) {
   const auto rounds = opt.get_int("rounds", 1, 20);
   const auto candidates = opt.get_int("candidates", 1, 20);
   const auto folds = opt.get_int("fix-folds", 1, 2);
-  std::optional<double> fix_min_excess = rs::kDefaultFixMinExcessNull;  // fix() keeps it at most the screen's
+  std::optional<double> fix_min_excess;  // given; else FixOptions' default (fix() keeps it at most the screen's)
   if (opt.has("fix-min-excess-null")) {
     fix_min_excess = opt.get_double("fix-min-excess-null", 0.0, 1e6);
     if (!fix_min_excess) return 2;
@@ -308,7 +308,7 @@ int run_residual(int argc, char** argv) {
     std::fprintf(stderr, "hadynet residual: --fix-min-excess-null needs --fix\n");
     return 2;
   }
-  if (opt.has("fix-min-excess-null") && *fix_min_excess > *min_excess) {
+  if (fix_min_excess && *fix_min_excess > *min_excess) {
     std::fprintf(stderr, "hadynet residual: --fix-min-excess-null %g is above the screen's --min-excess-null %g: the\n"
                  "candidates' floor can only be lower\n", *fix_min_excess, *min_excess);
     return 2;
@@ -385,7 +385,7 @@ int run_residual(int argc, char** argv) {
     fo.control = !opt.has("no-control");
     fo.candidates = static_cast<int>(*candidates);
     fo.folds = static_cast<int>(*folds);
-    fo.min_excess_null = fix_min_excess;
+    if (fix_min_excess) fo.min_excess_null = fix_min_excess;
     fo.reference = &reference;
     fo.reference_pb_choice = stored_null ? "state" : "auto";
     fo.library = ao.library;
