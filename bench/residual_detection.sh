@@ -91,7 +91,13 @@
 # development (re-run on the same logs, also with a family floor not kept),
 # 1392-1401 every effect at its larger strength measured at the screen's
 # floor (the stop-47 binary; now --fix-min-excess-null 3) and, on the same
-# logs, --fix-min-excess-null 1.
+# logs, --fix-min-excess-null 1. Stop 49 (the stop-48 defaults, nothing
+# changed; the 4-seed model): 1271-1280 development of a curve criterion
+# not kept (the curve logs); 1437-1446 every effect at its smaller
+# strength measured; 1447-1449 under the zeroings of init ids 531-533
+# (--rezeroed-first-init 531) started and stopped for time, not reported;
+# 1457-1466 every effect at its larger strength measured on 600-row logs
+# (RESIDUAL_ROWS=600).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

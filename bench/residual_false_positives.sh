@@ -63,7 +63,8 @@
 # binary (the decision reached on clean logs). Stop 48 (--fix's candidates
 # down to 1 by default; the 4-seed model): 1402-1421 measured at the
 # screen's floor (the stop-47 binary; now --fix-min-excess-null 3) and with
-# --fix-min-excess-null 1.
+# --fix-min-excess-null 1. Stop 49 (the same defaults): 1467-1486 measured
+# on 600-row logs (RESIDUAL_ROWS=600).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

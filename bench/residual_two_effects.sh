@@ -33,7 +33,9 @@
 # 1387-1391 (stop 47: the decision on two folds; the 4-seed model; also
 # with the stop-46 binary on the same logs); 1432-1436 (stop 48: --fix's
 # candidates down to 1 by default; the 4-seed model; also with
-# --fix-min-excess-null 3, the screen's floor, on the same logs).
+# --fix-min-excess-null 3, the screen's floor, on the same logs);
+# 1497-1501 (stop 49: the same defaults on 600-row logs,
+# RESIDUAL_ROWS=600).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]...

@@ -36,7 +36,8 @@
 # where the frame has a rail; the 4-seed model), 1377-1386 (stop 47: the
 # decision on two folds; the 4-seed model), 1422-1431 (stop 48: --fix's
 # candidates down to 1 by default; the 4-seed model; also at the screen's
-# floor on the same logs).
+# floor on the same logs), 1487-1496 (stop 49: the same defaults on
+# 600-row logs, RESIDUAL_ROWS=600).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve]
