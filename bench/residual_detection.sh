@@ -97,7 +97,9 @@
 # strength measured; 1447-1449 under the zeroings of init ids 531-533
 # (--rezeroed-first-init 531) started and stopped for time, not reported;
 # 1457-1466 every effect at its larger strength measured on 600-row logs
-# (RESIDUAL_ROWS=600).
+# (RESIDUAL_ROWS=600); 1502-1506 every effect at its larger strength
+# measured under the zeroings of init ids 534-538 (--seeds 5
+# --rezeroed-first-init 534).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...
