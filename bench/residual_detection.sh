@@ -99,7 +99,8 @@
 # 1457-1466 every effect at its larger strength measured on 600-row logs
 # (RESIDUAL_ROWS=600); 1502-1506 every effect at its larger strength
 # measured under the zeroings of init ids 534-538 (--seeds 5
-# --rezeroed-first-init 534).
+# --rezeroed-first-init 534); 1507-1516 drift=0.01 and saturation=3
+# measured on 600-row logs.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...
