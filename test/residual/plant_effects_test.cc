@@ -227,6 +227,32 @@ TEST(PlantEffects, SaturationIsNamedWithItsRailAtTwoNewtons) {
   EXPECT_EQ(w.hypothesis.side, +1) << w.label;
   EXPECT_EQ(channel_group(name_of(o, w.hypothesis.target)), "fc") << w.label;
   EXPECT_NEAR(w.hypothesis.rail, 2.0, 0.1) << w.label;
+
+  // The plan clips the winner's family and every other loadcell whose upper
+  // rail passes the test without the floors (Holm p < alpha, a positive
+  // gain), each at its own rail: the plant clips every loadcell at 2 N, and
+  // a rail belongs to the acquisition chain, as a sensor delay does.
+  const std::vector<Augmentation> plan = plan_candidates(o.data, o.attribution, 1);
+  ASSERT_EQ(plan.size(), 1u);
+  const auto& clips = std::get<OutputClips>(plan.front().change).clips;
+  std::set<std::string> clipped, family, passing;
+  for (const auto& clip : clips) {
+    clipped.insert(clip.channel);
+    EXPECT_EQ(clip.side, +1) << clip.channel;
+    EXPECT_NEAR(clip.rail, 2.0, 0.1) << clip.channel;  // the rail plus noise and quantisation, as above
+  }
+  for (const auto& r : o.attribution.family_of(w)) family.insert(name_of(o, r.hypothesis.target));
+  for (const auto& r : o.attribution.ranked)
+    if (r.hypothesis.kind == EffectKind::kSaturation && r.hypothesis.side > 0 && r.testable && r.plausible &&
+        r.p_adjusted < o.attribution.options.alpha && channel_group(name_of(o, r.hypothesis.target)) == "fc")
+      passing.insert(name_of(o, r.hypothesis.target));
+  for (const auto& c : family) EXPECT_EQ(clipped.count(c), 1u) << c;
+  for (const auto& c : passing) EXPECT_EQ(clipped.count(c), 1u) << c;
+  EXPECT_EQ(plan.front().found_on, plan.front().channels);
+  std::printf("rails clipped: %zu (family %zu, passing the test in fc %zu): %s\n", clipped.size(), family.size(),
+              passing.size(), plan.front().description.c_str());
+  // On these logs the test finds the rail on loadcells outside the family: the extension is exercised.
+  EXPECT_GT(clipped.size(), family.size());
 }
 
 // The plant logs no aux_* channel, so this one is synthetic on top of clean

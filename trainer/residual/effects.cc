@@ -684,18 +684,37 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
          fmt(" %.4g", h.rail) + " (gain" + fmt(" %.2f)", p);
 }
 
+// The winner's family, extended to the other channels of the winner's group
+// where a rail on the same side passes the test (Holm-adjusted p < alpha,
+// positive gain) without the practical floors: a rail is the range of an
+// acquisition chain, and sensors of one group are of one kind, so, as for a
+// sensor delay or a calibration curve, once a rail is established the test
+// only says where else in the group it is. Each channel is clipped at its
+// own measured rail.
 void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
   auto& change = a.change.emplace<OutputClips>();
-  std::vector<std::string> rails;
-  for (const auto& r : attribution.family_of(w)) {
-    const auto& hr = r.hypothesis;
+  std::vector<std::string> rails, extended;
+  const auto add = [&](const Hypothesis& hr) {
     a.channels.push_back(y_name(data, hr.target));
     change.clips.push_back({a.channels.back(), hr.side, hr.rail});
     char text[96];
     std::snprintf(text, sizeof text, "%s %s %.4g", a.channels.back().c_str(), hr.side > 0 ? "<=" : ">=", hr.rail);
     rails.push_back(text);
+  };
+  for (const auto& r : attribution.family_of(w)) add(r.hypothesis);
+  const std::string group = channel_group(y_name(data, w.hypothesis.target));
+  for (const auto& r : attribution.ranked) {
+    const auto& hr = r.hypothesis;
+    const std::string& name = y_name(data, hr.target);
+    if (hr.kind != EffectKind::kSaturation || hr.side != w.hypothesis.side || channel_group(name) != group) continue;
+    if (!r.testable || !r.plausible || r.p_adjusted >= attribution.options.alpha) continue;
+    if (std::find(a.channels.begin(), a.channels.end(), name) != a.channels.end()) continue;
+    add(hr);
+    extended.push_back(name);
   }
-  a.description = "clip the prediction at the measured rail: " + join(rails) + " (trained on the clipped output)";
+  a.description = "clip the prediction at the measured rail: " + join(rails) +
+                  (extended.empty() ? "" : " (" + join(extended) + ": a rail on the same side in the same group)") +
+                  " (trained on the clipped output)";
   a.found_on = a.channels;
 }
 
