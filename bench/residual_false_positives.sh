@@ -64,7 +64,8 @@
 # down to 1 by default; the 4-seed model): 1402-1421 measured at the
 # screen's floor (the stop-47 binary; now --fix-min-excess-null 3) and with
 # --fix-min-excess-null 1. Stop 49 (the same defaults): 1467-1486 measured
-# on 600-row logs (RESIDUAL_ROWS=600).
+# on 600-row logs (RESIDUAL_ROWS=600). Stop 50 (a rail extends to its
+# group): 1527-1546 measured.
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

@@ -1188,8 +1188,9 @@ const std::vector<EffectInfo>& effect_library() {
        "min(y_hat_c, R) - y_hat_c (upper rail R = the largest measured value over the logs; lower: max(y_hat_c, "
        "R) - y_hat_c with the smallest): the part of the prediction a clipped sensor cannot show",
        "the rail R (target units) and the gain (1: fully clipped)",
-       "clipping in the sensor model: the prediction of y_c passes min(., R) (max for a lower rail); "
-       "fine-tuned on the clipped output",
+       "clipping in the sensor model: the prediction of y_c passes min(., R) (max for a lower rail), for the "
+       "winner's family and the channels of the winner's group where a rail on the same side passes the test "
+       "without the floors; fine-tuned on the clipped output",
        SourceKind::kNone, saturation::enumerate, saturation::features, first_coefficient, positive,
        saturation::describe, saturation::plan, nullptr},
       {EffectKind::kSensorCurve, "sensor-curve",
