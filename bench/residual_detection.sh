@@ -101,10 +101,12 @@
 # measured under the zeroings of init ids 534-538 (--seeds 5
 # --rezeroed-first-init 534); 1507-1516 drift=0.01 and saturation=3
 # measured on 600-row logs. Stop 50 (a rail extends to its group; the
-# 4-seed model): the rail and curve logs of 1302-1311, 1347-1356 and
-# 1392-1401 its development (re-run on the same logs with the stop-49
-# binary and this one); 1517-1526 every effect at its larger strength and
-# saturation=3 measured with it and, on the same logs, the stop-49 binary.
+# 4-seed model): the saturation=2 logs of 1302-1311, 1347-1356 and
+# 1392-1401 and the sensor-curve=0.7 logs of 1392-1401 its development
+# (re-run on the same logs with this binary, and with the stop-49 binary
+# where stop 48 had not run its default); 1517-1526 every effect at its
+# larger strength and saturation=3 measured with it and, on the same
+# logs, the stop-49 binary.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

@@ -234,6 +234,7 @@ TEST(PlantEffects, SaturationIsNamedWithItsRailAtTwoNewtons) {
   // a rail belongs to the acquisition chain, as a sensor delay does.
   const std::vector<Augmentation> plan = plan_candidates(o.data, o.attribution, 1);
   ASSERT_EQ(plan.size(), 1u);
+  ASSERT_TRUE(std::holds_alternative<OutputClips>(plan.front().change)) << plan.front().effect;
   const auto& clips = std::get<OutputClips>(plan.front().change).clips;
   std::set<std::string> clipped, family, passing;
   for (const auto& clip : clips) {
@@ -246,8 +247,11 @@ TEST(PlantEffects, SaturationIsNamedWithItsRailAtTwoNewtons) {
     if (r.hypothesis.kind == EffectKind::kSaturation && r.hypothesis.side > 0 && r.testable && r.plausible &&
         r.p_adjusted < o.attribution.options.alpha && channel_group(name_of(o, r.hypothesis.target)) == "fc")
       passing.insert(name_of(o, r.hypothesis.target));
-  for (const auto& c : family) EXPECT_EQ(clipped.count(c), 1u) << c;
-  for (const auto& c : passing) EXPECT_EQ(clipped.count(c), 1u) << c;
+  // Exactly those: nothing of another group, side or test result.
+  std::set<std::string> expected = family;
+  expected.insert(passing.begin(), passing.end());
+  EXPECT_EQ(clipped, expected);
+  EXPECT_EQ(clips.size(), clipped.size());  // one clip per channel
   EXPECT_EQ(plan.front().found_on, plan.front().channels);
   std::printf("rails clipped: %zu (family %zu, passing the test in fc %zu): %s\n", clipped.size(), family.size(),
               passing.size(), plan.front().description.c_str());

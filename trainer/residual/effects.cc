@@ -708,7 +708,10 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
     const std::string& name = y_name(data, hr.target);
     if (hr.kind != EffectKind::kSaturation || hr.side != w.hypothesis.side || channel_group(name) != group) continue;
     if (!r.testable || !r.plausible || r.p_adjusted >= attribution.options.alpha) continue;
-    if (std::find(a.channels.begin(), a.channels.end(), name) != a.channels.end()) continue;
+    const bool clipped = std::any_of(change.clips.begin(), change.clips.end(), [&](const OutputClip& c) {
+      return c.channel == name && c.side == hr.side;
+    });
+    if (clipped) continue;
     add(hr);
     extended.push_back(name);
   }
