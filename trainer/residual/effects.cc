@@ -87,6 +87,25 @@ std::vector<std::string> family_groups(const ResidualData& data, const Attributi
   return groups;
 }
 
+// The results of `kind` on the other channels of `group` that pass the test
+// without the practical floors (testable, Holm-adjusted p < alpha) and
+// `also` (the lead's delay or side, a plausible parameter), in ranking
+// order. The floors keep the model's own misfit from being named as a new
+// effect; once a sensor effect is established, the test only says where
+// else in the group it is (the group extension of a sensor delay, a
+// calibration curve and a rail).
+template <typename Also>
+std::vector<const HypothesisResult*> passing_in_group(const ResidualData& data, const Attribution& attribution,
+                                                      EffectKind kind, const std::string& group, Also also) {
+  std::vector<const HypothesisResult*> out;
+  for (const auto& r : attribution.ranked) {
+    if (r.hypothesis.kind != kind || channel_group(y_name(data, r.hypothesis.target)) != group) continue;
+    if (!r.testable || r.p_adjusted >= attribution.options.alpha || !also(r)) continue;
+    out.push_back(&r);
+  }
+  return out;
+}
+
 // The groups of the channels where any sensor delay (any number of steps)
 // is significant.
 std::vector<std::string> sensor_delay_groups(const ResidualData& data, const Attribution& attribution) {
@@ -253,13 +272,11 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   // test only says where else it is. A loadcell that barely moves leaves a
   // small residual, and its predicted change D is mostly noise, which
   // attenuates its gain, but aligning it is still right (docs/residual.md).
-  const std::string group = channel_group(y_name(data, h.target));
   std::vector<std::string> extended;
-  for (const auto& r : attribution.ranked) {
-    const auto& hr = r.hypothesis;
-    const std::string& name = y_name(data, hr.target);
-    if (hr.kind != EffectKind::kSensorDelay || hr.delay != h.delay || channel_group(name) != group) continue;
-    if (!r.testable || r.p_adjusted >= attribution.options.alpha || !(r.parameter > 0)) continue;
+  const auto same_delay = [&](const HypothesisResult& r) { return r.hypothesis.delay == h.delay && r.parameter > 0; };
+  for (const HypothesisResult* r : passing_in_group(data, attribution, EffectKind::kSensorDelay,
+                                                    channel_group(y_name(data, h.target)), same_delay)) {
+    const std::string& name = y_name(data, r->hypothesis.target);
     if (std::find(a.channels.begin(), a.channels.end(), name) != a.channels.end()) continue;
     a.channels.push_back(name);
     extended.push_back(name);
@@ -685,12 +702,9 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
 }
 
 // The winner's family, extended to the other channels of the winner's group
-// where a rail on the same side passes the test (Holm-adjusted p < alpha,
-// positive gain) without the practical floors: a rail is the range of an
-// acquisition chain, and sensors of one group are of one kind, so, as for a
-// sensor delay or a calibration curve, once a rail is established the test
-// only says where else in the group it is. Each channel is clipped at its
-// own measured rail.
+// where a rail on the same side passes the test (passing_in_group; positive
+// gain): a rail is the range of an acquisition chain, and sensors of one
+// group are of one kind. Each channel is clipped at its own measured rail.
 void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
   auto& change = a.change.emplace<OutputClips>();
   std::vector<std::string> rails, extended;
@@ -702,17 +716,17 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
     rails.push_back(text);
   };
   for (const auto& r : attribution.family_of(w)) add(r.hypothesis);
-  const std::string group = channel_group(y_name(data, w.hypothesis.target));
-  for (const auto& r : attribution.ranked) {
-    const auto& hr = r.hypothesis;
-    const std::string& name = y_name(data, hr.target);
-    if (hr.kind != EffectKind::kSaturation || hr.side != w.hypothesis.side || channel_group(name) != group) continue;
-    if (!r.testable || !r.plausible || r.p_adjusted >= attribution.options.alpha) continue;
+  const auto same_side = [&](const HypothesisResult& r) {
+    return r.hypothesis.side == w.hypothesis.side && r.plausible;
+  };
+  for (const HypothesisResult* r : passing_in_group(data, attribution, EffectKind::kSaturation,
+                                                    channel_group(y_name(data, w.hypothesis.target)), same_side)) {
+    const std::string& name = y_name(data, r->hypothesis.target);
     const bool clipped = std::any_of(change.clips.begin(), change.clips.end(), [&](const OutputClip& c) {
-      return c.channel == name && c.side == hr.side;
+      return c.channel == name && c.side == r->hypothesis.side;
     });
     if (clipped) continue;
-    add(hr);
+    add(r->hypothesis);
     extended.push_back(name);
   }
   a.description = "clip the prediction at the measured rail: " + join(rails) +
@@ -860,13 +874,12 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   for (const auto& r : attribution.family_of(w))
     if (channel_group(y_name(data, r.hypothesis.target)) == group) targets.push_back(r.hypothesis.target);
   std::vector<std::string> extended;
-  for (const auto& r : attribution.ranked) {
-    const auto& hr = r.hypothesis;
-    if (hr.kind != EffectKind::kSensorCurve || channel_group(y_name(data, hr.target)) != group) continue;
-    if (!r.testable || !r.plausible || r.p_adjusted >= attribution.options.alpha) continue;
-    if (std::find(targets.begin(), targets.end(), hr.target) != targets.end()) continue;
-    targets.push_back(hr.target);
-    extended.push_back(y_name(data, hr.target));
+  const auto plausible = [](const HypothesisResult& r) { return r.plausible; };
+  for (const HypothesisResult* r : passing_in_group(data, attribution, EffectKind::kSensorCurve, group, plausible)) {
+    const int c = r->hypothesis.target;
+    if (std::find(targets.begin(), targets.end(), c) != targets.end()) continue;
+    targets.push_back(c);
+    extended.push_back(y_name(data, c));
   }
   for (int c : targets) {
     SensorCurve curve{y_name(data, c), knot_levels(data, c), {}};
