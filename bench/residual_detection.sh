@@ -106,7 +106,9 @@
 # (re-run on the same logs with this binary, and with the stop-49 binary
 # where stop 48 had not run its default); 1517-1526 every effect at its
 # larger strength and saturation=3 measured with it and, on the same
-# logs, the stop-49 binary.
+# logs, the stop-49 binary; stop 49's 600-row logs of saturation=2 and
+# sensor-curve=0.7 (1457-1466) and saturation=3 (1507-1516) re-run with
+# it (nothing chosen on them).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

@@ -65,7 +65,8 @@
 # screen's floor (the stop-47 binary; now --fix-min-excess-null 3) and with
 # --fix-min-excess-null 1. Stop 49 (the same defaults): 1467-1486 measured
 # on 600-row logs (RESIDUAL_ROWS=600). Stop 50 (a rail extends to its
-# group): 1527-1546 measured.
+# group): 1527-1546 measured, and with --fix-min-excess-null 0 (a check
+# of the decision, not the default) with it and the stop-49 binary.
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
