@@ -28,6 +28,11 @@ print(f"trained {t} V, adapted {a} V: {'ok' if ok else 'FAIL'}")
 sys.exit(0 if ok else 1)
 PY
 grep -q "rows at the 10 V rail" <<<"$out" && grep -q "^residual verdict:" <<<"$out" || { echo "FAIL: no overflow/verdict lines"; exit 1; }
+# What the loop says of the overflow at 10 V: the rail tested, or why not
+# with its evidence (issue 12: before, only "not testable: a regressor is
+# constant in the training part", which said nothing of the data).
+grep -Eq "^  upper rail of y0 at 10 .*(testable True|not testable: the 1-step prediction passes the rail in [0-9]+ of [0-9]+ training rows)" <<<"$out" \
+  || { echo "FAIL: the 10 V rail without a test or its evidence: $(grep '^  upper rail' <<<"$out")"; exit 1; }
 # The loop's floors on real data come from a calibrated null: the estimation
 # record's held-out rows stored in the model (before: absolute floors set on
 # the hand, two orders of magnitude above this model's whole residual).

@@ -25,15 +25,23 @@
 #   cyclic:l3:0.05:0.5     an encoder's interpolation error on a tendon length
 #                          (static, outside the library): nothing confirmed.
 # A named effect must also cut its winner's held-out 1-step RMSE to at most
-# 0.7 of before and below fine-tuning alone (the benchmarks' rule,
-# bench/residual_named.py); the margins are the issue's 30 % cut.
-#   residual_injected_effects.sh CASE HADYNET MODEL WORKDIR
+# 0.7 of before and below fine-tuning alone (the issue's 30 % cut and its
+# control). The rules: test/cli/injected_effect_check.py.
+#
+# SEED (default 11) records the clean logs with another seed. Seed 1557: the
+# 2-step delay on fc3 alone also passed the test on fc1, fc4, fc5 and fc7
+# (through the network, which reads fc3), the delay planned on all five
+# lost the selection on the training rows, and friction on fc3 was
+# confirmed, a wrong class; since the same delay on the family alone (fc3)
+# is a candidate too, it is the one confirmed (docs/residual.md, "The
+# family alone beside its group").
+#   residual_injected_effects.sh CASE HADYNET MODEL WORKDIR [SEED]
 set -uo pipefail
-case=$1 hadynet=$2 model=$3 work=$4
+case=$1 hadynet=$2 model=$3 work=$4 seed=${5:-11}
 here=$(cd "$(dirname "$0")/../.." && pwd)
 rm -rf "$work" && mkdir -p "$work" || exit 2
 source "$here/bench/residual_grasps.sh"
-collect_residual_grasps "$hadynet" "$work/raw" 11 || { echo "FAIL: collect"; exit 1; }
+collect_residual_grasps "$hadynet" "$work/raw" "$seed" || { echo "FAIL: collect"; exit 1; }
 if [[ $case == clean ]]; then
   mkdir -p "$work/logs" && find "$work/raw" -name "*.csv" -exec cp {} "$work/logs/" \;
 else
@@ -42,53 +50,4 @@ fi
 "$hadynet" residual "$model" "$work/logs" --rated-range fc=0..50 --rated-range f=0..200 --fix \
   --json "$work/residual.json" --out "$work/fixed.safetensors" >"$work/out.txt" 2>&1 \
   || { echo "FAIL: residual"; tail -5 "$work/out.txt"; exit 1; }
-python3 - "$case" "$work/residual.json" "$work/fixed.safetensors" <<'PY'
-import json, os, re, sys
-case, path, fixed = sys.argv[1:]
-j = json.load(open(path))
-fix = j.get("fix", {})
-aug = fix.get("augmentation") or {}
-print(f"{case}: screen: {j['verdict'][:120]}")
-print(f"{case}: fix: {fix.get('status', '-')[:200]}")
-failures = []
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-def rmse(part, channel):
-    return next(c["rmse"] for c in fix[part]["channels"] if c["channel"] == channel)
-def cut(channel):
-    before, control, after = rmse("before", channel), rmse("control", channel), rmse("after", channel)
-    print(f"{case}: {channel} held-out RMSE before {before:.4g}, fine-tuning alone {control:.4g}, fixed {after:.4g}")
-    check(after <= 0.7 * before, f"{channel}: not cut by 30 %")
-    check(after < control, f"{channel}: not below fine-tuning alone")
-
-kind = case.split(":")[0]
-if kind in ("clean", "backlash", "cyclic"):
-    check(not fix.get("changed"), "a fix was confirmed: " + aug.get("description", "")[:120])
-    check(not os.path.exists(fixed), "a model was written")
-    check(fix.get("status", "").startswith(("no significant effect", "unexplained structure")),
-          "status " + fix.get("status", "")[:80])
-else:
-    check(bool(fix.get("changed")), "nothing confirmed")
-    channels = aug.get("channels", [])
-    if kind == "delay":
-        check(aug.get("effect") == "sensor-delay" and aug.get("delay_steps") == 2, "not a 2-step sensor delay")
-        check(channels[:1] == ["fc3"], f"winner {channels[:1]}, not fc3")
-    elif kind == "drift":
-        check(aug.get("effect") == "drift-load", "not a load drift: " + aug.get("effect", "-"))
-        check(bool(channels) and all(re.fullmatch(r"f\d+", c) for c in channels), f"channels {channels}")
-        rates = [float(r) for r in re.findall(r"f\d+ ([0-9.eE+-]+)", aug.get("description", "").split("re-estimated:")[-1])]
-        print(f"{case}: re-estimated rates {rates}")
-        check(len(rates) == len(channels) and all(0.001 <= r <= 0.003 for r in rates), f"rates {rates}")
-    elif kind == "leak":
-        gain = aug.get("gain", 0.0)
-        check(aug.get("effect") == "crosstalk" and channels == ["fc6"] and aug.get("source") == "f5",
-              f"not the cross-talk f5 -> fc6: {aug.get('description', '')[:100]}")
-        check(0.1 <= gain <= 0.3, f"gain {gain}")
-    check(os.path.exists(fixed), "no model written")
-    if fix.get("changed") and channels:
-        cut(channels[0])
-for f in failures:
-    print("FAIL:", f)
-sys.exit(1 if failures else 0)
-PY
+python3 "$here/test/cli/injected_effect_check.py" "$case" "$work/residual.json" "$work/fixed.safetensors"

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <set>
 #include <variant>
 
@@ -257,6 +258,24 @@ TEST(PlantEffects, SaturationIsNamedWithItsRailAtTwoNewtons) {
               passing.size(), plan.front().description.c_str());
   // On these logs the test finds the rail on loadcells outside the family: the extension is exercised.
   EXPECT_GT(clipped.size(), family.size());
+  std::set<std::string> added(plan.front().extended.begin(), plan.front().extended.end()), outside_family;
+  std::set_difference(expected.begin(), expected.end(), family.begin(), family.end(),
+                      std::inserter(outside_family, outside_family.end()));
+  EXPECT_EQ(added, outside_family);
+
+  // With room for two candidates the same rail follows on the family alone,
+  // so that the selection on the training rows judges whether the group
+  // shares it (a rail of one sensor would leave traces on the others
+  // through the network).
+  const std::vector<Augmentation> two = plan_candidates(o.data, o.attribution, 2);
+  ASSERT_EQ(two.size(), 2u);
+  EXPECT_EQ(two[0].description, plan.front().description);
+  ASSERT_TRUE(std::holds_alternative<OutputClips>(two[1].change)) << two[1].effect;
+  EXPECT_FALSE(two[1].group_extension);
+  EXPECT_TRUE(two[1].extended.empty());
+  std::set<std::string> alone;
+  for (const auto& clip : std::get<OutputClips>(two[1].change).clips) alone.insert(clip.channel);
+  EXPECT_EQ(alone, family);
 }
 
 // The plant logs no aux_* channel, so this one is synthetic on top of clean

@@ -112,13 +112,22 @@ HypothesisResult test_hypothesis(const ResidualData& data, const Hypothesis& h, 
     res.label = describe(h, data, res.coef) + " (logs too short)";
     return res;
   }
-  bool constant = false;
   Eigen::VectorXd spread = Eigen::VectorXd::Zero(k);
-  for (const auto& z : train.z) spread += z.colwise().squaredNorm().transpose();
-  for (Eigen::Index j = 0; j < k; ++j) constant = constant || support(j) < options.min_support || !(spread(j) > 1e-18);
-  if (constant) {
+  long training_rows = 0;
+  for (const auto& z : train.z) {
+    spread += z.colwise().squaredNorm().transpose();
+    training_rows += z.rows();
+  }
+  for (Eigen::Index j = 0; j < k; ++j) {
+    if (support(j) >= options.min_support && spread(j) > 1e-18) continue;
     res.testable = false;
-    res.label = describe(h, data, res.coef) + " (not testable: a regressor is constant in the training part)";
+    const char* nonzero = effect_info(h.kind).support;
+    res.label = describe(h, data, res.coef) + " (not testable: " +
+                (support(j) < options.min_support
+                     ? std::string(nonzero ? nonzero : "a regressor is non-zero") + " in " +
+                           std::to_string(support(j)) + " of " + std::to_string(training_rows) +
+                           " training rows, at least " + std::to_string(options.min_support) + " needed)"
+                     : std::string("a regressor is constant in the training part)"));
     return res;
   }
 

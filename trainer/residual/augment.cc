@@ -169,7 +169,16 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
                       winner_not_fixable + "); the best significant effect that can be: " + r.label + "; " +
                       a.description;
     leads.push_back(r.hypothesis.kind);
+    const bool extended = !a.extended.empty();
     out.push_back(std::move(a));
+    if (!extended || static_cast<int>(out.size()) >= count) continue;
+    Augmentation family_alone;
+    family_alone.kind = r.hypothesis.kind;
+    family_alone.effect = r.effect;
+    family_alone.screen_statistic = out.back().screen_statistic;
+    family_alone.group_extension = false;
+    effect_info(family_alone.kind).plan(data, attribution, r, family_alone);
+    if (family_alone.not_fixable.empty()) out.push_back(std::move(family_alone));
   }
   if (out.empty()) {  // nothing significant can be added: fix() says "not supported"
     Augmentation a;

@@ -225,6 +225,12 @@ struct Augmentation {
   // The screen's floor statistic of the hypothesis that led to it
   // (floor_statistic: excess_share with a null, else explained_std).
   double screen_statistic = 0;
+  // The group extension of a sensor delay, a calibration curve or a rail
+  // (effects.cc, passing_in_group): whether the plan may extend the family
+  // to the other channels of its group where the test finds the effect (set
+  // before planning), and the channels it added.
+  bool group_extension = true;
+  std::vector<std::string> extended;
   std::variant<TimeAlignment, CrosstalkRemoval, BiasState, OutputClips, CalibrationCurves, DerivedCommandInputs,
                ObservedAuxChannel>
       change;
@@ -247,7 +253,12 @@ std::string why_not_fixable(const ResidualData& data, const Attribution& attribu
 // family: the effect's plan, effects.cc) of the significant hypotheses in
 // ranking order that --fix can add (why_not_fixable), the best of each
 // effect, at most `count`; a plan that finds nothing to add (it sets
-// not_fixable) is skipped like an unfixable hypothesis. When the winner
+// not_fixable) is skipped like an unfixable hypothesis. A plan extended to
+// its group is followed by the same plan without the extension (the family
+// alone), as one more candidate within `count`: the selection on the
+// training rows then says whether the group shares the effect (a delay,
+// curve or rail of one sensor leaves traces on its group's other channels
+// through the network, which the test alone can take for the effect). When the winner
 // cannot be added, the first
 // candidate's description says why; when no significant hypothesis can, the
 // winner's alone with Augmentation::not_fixable set (fix() then reports

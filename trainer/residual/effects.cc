@@ -106,6 +106,16 @@ std::vector<const HypothesisResult*> passing_in_group(const ResidualData& data, 
   return out;
 }
 
+// passing_in_group for a plan that may extend its family (Augmentation::
+// group_extension), else none.
+template <typename Also>
+std::vector<const HypothesisResult*> in_group_if_extended(const ResidualData& data, const Attribution& attribution,
+                                                          const Augmentation& a, EffectKind kind,
+                                                          const std::string& group, Also also) {
+  if (!a.group_extension) return {};
+  return passing_in_group(data, attribution, kind, group, also);
+}
+
 // The groups of the channels where any sensor delay (any number of steps)
 // is significant.
 std::vector<std::string> sensor_delay_groups(const ResidualData& data, const Attribution& attribution) {
@@ -272,17 +282,16 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   // test only says where else it is. A loadcell that barely moves leaves a
   // small residual, and its predicted change D is mostly noise, which
   // attenuates its gain, but aligning it is still right (docs/residual.md).
-  std::vector<std::string> extended;
   const auto same_delay = [&](const HypothesisResult& r) { return r.hypothesis.delay == h.delay && r.parameter > 0; };
-  for (const HypothesisResult* r : passing_in_group(data, attribution, EffectKind::kSensorDelay,
-                                                    channel_group(y_name(data, h.target)), same_delay)) {
+  for (const HypothesisResult* r : in_group_if_extended(data, attribution, a, EffectKind::kSensorDelay,
+                                                        channel_group(y_name(data, h.target)), same_delay)) {
     const std::string& name = y_name(data, r->hypothesis.target);
     if (std::find(a.channels.begin(), a.channels.end(), name) != a.channels.end()) continue;
     a.channels.push_back(name);
-    extended.push_back(name);
+    a.extended.push_back(name);
   }
   a.description = "time-align " + join(a.channels) + " by " + std::to_string(change.delay) + " steps" +
-                  (extended.empty() ? "" : " (" + join(extended) + ": the same delay in the same group)") +
+                  (a.extended.empty() ? "" : " (" + join(a.extended) + ": the same delay in the same group)") +
                   "; the model predicts the true-time signal";
   a.found_on = a.channels;
 }
@@ -707,7 +716,7 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
 // group are of one kind. Each channel is clipped at its own measured rail.
 void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
   auto& change = a.change.emplace<OutputClips>();
-  std::vector<std::string> rails, extended;
+  std::vector<std::string> rails;
   const auto add = [&](const Hypothesis& hr) {
     a.channels.push_back(y_name(data, hr.target));
     change.clips.push_back({a.channels.back(), hr.side, hr.rail});
@@ -719,18 +728,18 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   const auto same_side = [&](const HypothesisResult& r) {
     return r.hypothesis.side == w.hypothesis.side && r.plausible;
   };
-  for (const HypothesisResult* r : passing_in_group(data, attribution, EffectKind::kSaturation,
-                                                    channel_group(y_name(data, w.hypothesis.target)), same_side)) {
+  for (const HypothesisResult* r : in_group_if_extended(data, attribution, a, EffectKind::kSaturation,
+                                                        channel_group(y_name(data, w.hypothesis.target)), same_side)) {
     const std::string& name = y_name(data, r->hypothesis.target);
     const bool clipped = std::any_of(change.clips.begin(), change.clips.end(), [&](const OutputClip& c) {
       return c.channel == name && c.side == r->hypothesis.side;
     });
     if (clipped) continue;
     add(r->hypothesis);
-    extended.push_back(name);
+    a.extended.push_back(name);
   }
   a.description = "clip the prediction at the measured rail: " + join(rails) +
-                  (extended.empty() ? "" : " (" + join(extended) + ": a rail on the same side in the same group)") +
+                  (a.extended.empty() ? "" : " (" + join(a.extended) + ": a rail on the same side in the same group)") +
                   " (trained on the clipped output)";
   a.found_on = a.channels;
 }
@@ -873,13 +882,12 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   std::vector<int> targets;
   for (const auto& r : attribution.family_of(w))
     if (channel_group(y_name(data, r.hypothesis.target)) == group) targets.push_back(r.hypothesis.target);
-  std::vector<std::string> extended;
   const auto plausible = [](const HypothesisResult& r) { return r.plausible; };
-  for (const HypothesisResult* r : passing_in_group(data, attribution, EffectKind::kSensorCurve, group, plausible)) {
+  for (const HypothesisResult* r : in_group_if_extended(data, attribution, a, EffectKind::kSensorCurve, group, plausible)) {
     const int c = r->hypothesis.target;
     if (std::find(targets.begin(), targets.end(), c) != targets.end()) continue;
     targets.push_back(c);
-    extended.push_back(y_name(data, c));
+    a.extended.push_back(y_name(data, c));
   }
   for (int c : targets) {
     SensorCurve curve{y_name(data, c), knot_levels(data, c), {}};
@@ -893,7 +901,7 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
     return;
   }
   a.description = "a static calibration curve of " + join(a.channels) +
-                  (extended.empty() ? "" : " (" + join(extended) + ": a curve in the same group)") +
+                  (a.extended.empty() ? "" : " (" + join(a.extended) + ": a curve in the same group)") +
                   " (piecewise linear, monotone): the logs read through its inverse, the prediction through it";
   a.found_on = a.channels;
 }
@@ -1208,7 +1216,7 @@ const std::vector<EffectInfo>& effect_library() {
        "winner's family and the channels of the winner's group where a rail on the same side passes the test "
        "without the floors; fine-tuned on the clipped output",
        SourceKind::kNone, saturation::enumerate, saturation::features, first_coefficient, positive,
-       saturation::describe, saturation::plan, nullptr},
+       saturation::describe, saturation::plan, nullptr, nullptr, "the 1-step prediction passes the rail"},
       {EffectKind::kSensorCurve, "sensor-curve",
        "y_hat_c(t), y_c(t-1) and their bends q = (v - m)^2 / (2 w) (m, w: the midpoint and half-width of the "
        "target's range): a sensor that reports a monotone curve g of its own level, and what the network "

@@ -147,6 +147,10 @@ struct EffectInfo {
   // found_on): the effect that leaves nearly the same 1-step residual there
   // and what tells them apart, in words; nullptr: none is known.
   std::string (*look_alike)(const std::vector<std::string>& channels) = nullptr;
+  // What a non-zero regressor row means, for the label of a hypothesis that
+  // is not testable for too few of them (e.g. "the 1-step prediction passes
+  // the rail"); nullptr: "a regressor is non-zero".
+  const char* support = nullptr;
 };
 // The table, in EffectKind order (the order hypotheses are enumerated in).
 const std::vector<EffectInfo>& effect_library();
