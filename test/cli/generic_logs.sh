@@ -101,5 +101,27 @@ grep -q "^floors: no calibrated null (the model stores no held-out logs" <<<"$ou
 out=$("$hadynet" residual all.safetensors d.csv --min-excess-null 2 2>&1); status=$?
 [[ $status -eq 2 && "$out" == *"--min-excess-null needs a null"* ]] || fail "--min-excess-null without a null: $status $out"
 
+# Measured timestamps with jitter (issue 12: rejected with no way in):
+# `hadynet import --time` resamples steps within --max-jitter of the median
+# onto a regular grid and writes a log that validates; a lost sample (a step
+# of twice the median) is an error naming its line.
+python3 - <<'PY'
+import math
+with open("jitter.csv", "w") as f:
+    f.write("time,position,command\n")
+    for r in range(200):
+        t = 0.1 * r + 0.004 * math.sin(1.7 * r)  # +-4 % of the 0.1 s step
+        f.write("%.5f,%.6f,%.6f\n" % (t, math.sin(0.05 * r), math.cos(0.03 * r)))
+with open("lost.csv", "w") as f:
+    f.write("time,position,command\n")
+    for r in [r for r in range(50) if r != 20]:
+        f.write("%.2f,%.6f,%.6f\n" % (0.1 * r, math.sin(0.05 * r), math.cos(0.03 * r)))
+PY
+out=$("$hadynet" import jitter.csv --out jitter_log.csv --time time --column position=y0 --column command=u0 2>&1) \
+  || fail "import --time of jittered timestamps: $out"
+out=$("$hadynet" validate jitter_log.csv 2>&1) || fail "the resampled log does not validate: $out"
+out=$("$hadynet" import lost.csv --out lost_log.csv --time time --column position=y0 --column command=u0 2>&1); status=$?
+[[ $status -eq 1 && "$out" == *"lost.csv:22:"*"a lost sample"* ]] || fail "a lost sample: exit $status: $out"
+
 echo "generic_logs: $failures failed"
 [[ $failures -eq 0 ]]
