@@ -108,7 +108,14 @@
 # larger strength and saturation=3 measured with it and, on the same
 # logs, the stop-49 binary; stop 49's 600-row logs of saturation=2 and
 # sensor-curve=0.7 (1457-1466) and saturation=3 (1507-1516) re-run with
-# it (nothing chosen on them).
+# it (nothing chosen on them). Stop 51: 1547-1556 drift=0.02 measured on
+# 1000-row logs (RESIDUAL_ROWS=1000; stop 50's code); the family alone
+# beside its group: 1517-1526 re-run where a candidate was extended to its
+# group (the sensor-delay=2 set of 1517 then chose how the family alone is
+# judged: development), and effects added after recording
+# (test/cli/residual_injected_effects.sh): 1557 development, 1558-1561
+# every case and 1562-1571 the delay of one loadcell measured, each with
+# stop 50's code and this one on the same logs.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

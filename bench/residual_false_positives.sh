@@ -66,7 +66,11 @@
 # --fix-min-excess-null 1. Stop 49 (the same defaults): 1467-1486 measured
 # on 600-row logs (RESIDUAL_ROWS=600). Stop 50 (a rail extends to its
 # group): 1527-1546 measured, and with --fix-min-excess-null 0 (a check
-# of the decision, not the default) with it and the stop-49 binary.
+# of the decision, not the default) with it and the stop-49 binary. Stop
+# 51 (the family alone beside its group): 1538 and 1543 re-run (the only
+# sets of 1527-1546 with a candidate extended to its group), unchanged;
+# clean logs of seeds 11 and 1557-1561 through the default path of
+# test/cli/residual_injected_effects.sh, nothing confirmed.
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
