@@ -115,7 +115,8 @@
 # judged: development), and effects added after recording
 # (test/cli/residual_injected_effects.sh): 1557 development, 1558-1561
 # every case and 1562-1571 the delay of one loadcell measured, each with
-# stop 50's code and this one on the same logs.
+# stop 50's code and this one on the same logs, 1572-1581 every case
+# measured with this one.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

@@ -69,8 +69,8 @@
 # of the decision, not the default) with it and the stop-49 binary. Stop
 # 51 (the family alone beside its group): 1538 and 1543 re-run (the only
 # sets of 1527-1546 with a candidate extended to its group), unchanged;
-# clean logs of seeds 11 and 1557-1561 through the default path of
-# test/cli/residual_injected_effects.sh, nothing confirmed.
+# clean logs of seeds 11, 1557-1561 and 1572-1581 through the default
+# path of test/cli/residual_injected_effects.sh, nothing confirmed.
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

@@ -11,8 +11,8 @@
 # leak was fixed as a lower rail by clipping.
 #
 # The cases and their strengths were fixed before the first run and not
-# changed after (fresh seeds 1557-1561 with the same cases: docs/residual.md,
-# "Effects added after recording"):
+# changed after (fresh seeds 1558-1561 and 1572-1581 with the same cases:
+# docs/residual.md, "Effects added after recording"):
 #   clean                  nothing confirmed, no model written;
 #   delay:fc3:2            one loadcell 2 steps late: its delay, fc3 the winner;
 #   drift:f:0.002          every tension drifts with its load at 0.002 /s: a
