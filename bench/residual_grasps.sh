@@ -13,7 +13,7 @@ collect_residual_grasps() {
   for g in "${residual_grasps[@]}"; do
     set -- $g "$@"
     "$hadynet" collect --object "$1" --motion "$2" --init "$3" --rows "${RESIDUAL_ROWS:-300}" --seed "$seed" --out "$out" \
-      "${@:4}" --quiet >/dev/null
+      "${@:4}" --quiet >/dev/null || return 1
     shift 3
   done
 }
@@ -31,7 +31,7 @@ collect_rezeroed_grasps() {
   for g in "${residual_grasps[@]}"; do
     set -- $g "$@"
     "$hadynet" collect --object "$1" --motion "$2" --init "$rezero" --rows "${RESIDUAL_ROWS:-300}" --seed "$seed" \
-      --out "${out%/}.raw" "${@:4}" --quiet >/dev/null
+      --out "${out%/}.raw" "${@:4}" --quiet >/dev/null || return 1
     f=$(ls "${out%/}".raw/*/"$1_$2_i${rezero}_w0.csv")
     sed "s|^# state: .*|# state: $1/i$3/w0|" "$f" >"$out/$1_$2_i$3.csv"
     shift 3

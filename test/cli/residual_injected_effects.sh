@@ -44,7 +44,8 @@ case=$1 hadynet=$2 model=$3 work=$4 seed=${5:-11}
 here=$(cd "$(dirname "$0")/../.." && pwd)
 rm -rf "$work" && mkdir -p "$work" || exit 2
 source "$here/bench/residual_grasps.sh"
-collect_residual_grasps "$hadynet" "$work/raw" "$seed" || { echo "FAIL: collect"; exit 1; }
+RESIDUAL_ROWS=300 collect_residual_grasps "$hadynet" "$work/raw" "$seed" || { echo "FAIL: collect"; exit 1; }
+[[ $(find "$work/raw" -name "*.csv" | wc -l) -eq 4 ]] || { echo "FAIL: not the four grasps' logs"; exit 1; }
 if [[ $case == clean ]]; then
   mkdir -p "$work/logs" && find "$work/raw" -name "*.csv" -exec cp {} "$work/logs/" \;
 else

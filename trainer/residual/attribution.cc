@@ -121,7 +121,7 @@ HypothesisResult test_hypothesis(const ResidualData& data, const Hypothesis& h, 
   for (Eigen::Index j = 0; j < k; ++j) {
     if (support(j) >= options.min_support && spread(j) > 1e-18) continue;
     res.testable = false;
-    const char* nonzero = effect_info(h.kind).support;
+    const char* nonzero = effect_info(h.kind).support_phrase;
     res.label = describe(h, data, res.coef) + " (not testable: " +
                 (support(j) < options.min_support
                      ? std::string(nonzero ? nonzero : "a regressor is non-zero") + " in " +

@@ -169,7 +169,7 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
                       winner_not_fixable + "); the best significant effect that can be: " + r.label + "; " +
                       a.description;
     leads.push_back(r.hypothesis.kind);
-    const bool extended = !a.extended.empty();
+    const bool extended = !a.extended_channels.empty();
     out.push_back(std::move(a));
     if (!extended || static_cast<int>(out.size()) >= count) continue;
     Augmentation family_alone;

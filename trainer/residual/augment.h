@@ -55,12 +55,14 @@ struct FixOptions {
   // 1: the first fold alone. --fix-folds.
   int folds = 2;
   // How many of the screen's candidates may be tried (plan_candidates: the
-  // best of each effect): each is re-estimated, added and fine-tuned on the
+  // best of each effect, and a plan extended to its group also on its
+  // family alone, each one of the `candidates`): each is re-estimated, added and fine-tuned on the
   // first 75 % of the training rows and judged on the rest against the
   // control; the first significant there, else the clearest gain
   // (chosen_candidate), goes to the decision.
   // 1: the screen's winner alone. 5 was chosen on development seeds 771-775
-  // (docs/residual.md, "Detection on fresh logs").
+  // (docs/residual.md, "Detection on fresh logs"), when every candidate was
+  // another effect; since stop 51 a family alone takes one of them.
   int candidates = 5;
   // With a calibrated null: the floor of excess_share (in units of the
   // channel's clean residual level) of the candidates fix() may try
@@ -230,7 +232,7 @@ struct Augmentation {
   // to the other channels of its group where the test finds the effect (set
   // before planning), and the channels it added.
   bool group_extension = true;
-  std::vector<std::string> extended;
+  std::vector<std::string> extended_channels;
   std::variant<TimeAlignment, CrosstalkRemoval, BiasState, OutputClips, CalibrationCurves, DerivedCommandInputs,
                ObservedAuxChannel>
       change;
@@ -255,10 +257,11 @@ std::string why_not_fixable(const ResidualData& data, const Attribution& attribu
 // effect, at most `count`; a plan that finds nothing to add (it sets
 // not_fixable) is skipped like an unfixable hypothesis. A plan extended to
 // its group is followed by the same plan without the extension (the family
-// alone), as one more candidate within `count`: the selection on the
-// training rows then says whether the group shares the effect (a delay,
-// curve or rail of one sensor leaves traces on its group's other channels
-// through the network, which the test alone can take for the effect). When the winner
+// alone), as one more candidate within `count`, which fix()'s selection
+// tries when the extended plan does not gain significantly on the training
+// rows (a delay, curve or rail of one sensor leaves traces on its group's
+// other channels through the network, which the test alone can take for
+// the effect). When the winner
 // cannot be added, the first
 // candidate's description says why; when no significant hypothesis can, the
 // winner's alone with Augmentation::not_fixable set (fix() then reports

@@ -106,10 +106,10 @@ std::vector<const HypothesisResult*> passing_in_group(const ResidualData& data, 
   return out;
 }
 
-// passing_in_group for a plan that may extend its family (Augmentation::
+// passing_in_group for a plan allowed to extend its family (Augmentation::
 // group_extension), else none.
 template <typename Also>
-std::vector<const HypothesisResult*> in_group_if_extended(const ResidualData& data, const Attribution& attribution,
+std::vector<const HypothesisResult*> in_group_if_allowed(const ResidualData& data, const Attribution& attribution,
                                                           const Augmentation& a, EffectKind kind,
                                                           const std::string& group, Also also) {
   if (!a.group_extension) return {};
@@ -283,15 +283,15 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   // small residual, and its predicted change D is mostly noise, which
   // attenuates its gain, but aligning it is still right (docs/residual.md).
   const auto same_delay = [&](const HypothesisResult& r) { return r.hypothesis.delay == h.delay && r.parameter > 0; };
-  for (const HypothesisResult* r : in_group_if_extended(data, attribution, a, EffectKind::kSensorDelay,
+  for (const HypothesisResult* r : in_group_if_allowed(data, attribution, a, EffectKind::kSensorDelay,
                                                         channel_group(y_name(data, h.target)), same_delay)) {
     const std::string& name = y_name(data, r->hypothesis.target);
     if (std::find(a.channels.begin(), a.channels.end(), name) != a.channels.end()) continue;
     a.channels.push_back(name);
-    a.extended.push_back(name);
+    a.extended_channels.push_back(name);
   }
   a.description = "time-align " + join(a.channels) + " by " + std::to_string(change.delay) + " steps" +
-                  (a.extended.empty() ? "" : " (" + join(a.extended) + ": the same delay in the same group)") +
+                  (a.extended_channels.empty() ? "" : " (" + join(a.extended_channels) + ": the same delay in the same group)") +
                   "; the model predicts the true-time signal";
   a.found_on = a.channels;
 }
@@ -728,7 +728,7 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   const auto same_side = [&](const HypothesisResult& r) {
     return r.hypothesis.side == w.hypothesis.side && r.plausible;
   };
-  for (const HypothesisResult* r : in_group_if_extended(data, attribution, a, EffectKind::kSaturation,
+  for (const HypothesisResult* r : in_group_if_allowed(data, attribution, a, EffectKind::kSaturation,
                                                         channel_group(y_name(data, w.hypothesis.target)), same_side)) {
     const std::string& name = y_name(data, r->hypothesis.target);
     const bool clipped = std::any_of(change.clips.begin(), change.clips.end(), [&](const OutputClip& c) {
@@ -736,10 +736,10 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
     });
     if (clipped) continue;
     add(r->hypothesis);
-    a.extended.push_back(name);
+    a.extended_channels.push_back(name);
   }
   a.description = "clip the prediction at the measured rail: " + join(rails) +
-                  (a.extended.empty() ? "" : " (" + join(a.extended) + ": a rail on the same side in the same group)") +
+                  (a.extended_channels.empty() ? "" : " (" + join(a.extended_channels) + ": a rail on the same side in the same group)") +
                   " (trained on the clipped output)";
   a.found_on = a.channels;
 }
@@ -883,17 +883,17 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   for (const auto& r : attribution.family_of(w))
     if (channel_group(y_name(data, r.hypothesis.target)) == group) targets.push_back(r.hypothesis.target);
   const auto plausible = [](const HypothesisResult& r) { return r.plausible; };
-  for (const HypothesisResult* r : in_group_if_extended(data, attribution, a, EffectKind::kSensorCurve, group, plausible)) {
+  const std::size_t family = targets.size();
+  for (const HypothesisResult* r : in_group_if_allowed(data, attribution, a, EffectKind::kSensorCurve, group, plausible)) {
     const int c = r->hypothesis.target;
-    if (std::find(targets.begin(), targets.end(), c) != targets.end()) continue;
-    targets.push_back(c);
-    a.extended.push_back(y_name(data, c));
+    if (std::find(targets.begin(), targets.end(), c) == targets.end()) targets.push_back(c);
   }
-  for (int c : targets) {
-    SensorCurve curve{y_name(data, c), knot_levels(data, c), {}};
-    if (curve.level.empty()) continue;
+  for (std::size_t k = 0; k < targets.size(); ++k) {
+    SensorCurve curve{y_name(data, targets[k]), knot_levels(data, targets[k]), {}};
+    if (curve.level.empty()) continue;  // fewer than two distinct levels for its knots
     curve.reading = curve.level;
     a.channels.push_back(curve.channel);
+    if (k >= family) a.extended_channels.push_back(curve.channel);
     change.curves.push_back(std::move(curve));
   }
   if (change.curves.empty()) {
@@ -901,7 +901,7 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
     return;
   }
   a.description = "a static calibration curve of " + join(a.channels) +
-                  (a.extended.empty() ? "" : " (" + join(a.extended) + ": a curve in the same group)") +
+                  (a.extended_channels.empty() ? "" : " (" + join(a.extended_channels) + ": a curve in the same group)") +
                   " (piecewise linear, monotone): the logs read through its inverse, the prediction through it";
   a.found_on = a.channels;
 }

@@ -150,7 +150,7 @@ struct EffectInfo {
   // What a non-zero regressor row means, for the label of a hypothesis that
   // is not testable for too few of them (e.g. "the 1-step prediction passes
   // the rail"); nullptr: "a regressor is non-zero".
-  const char* support = nullptr;
+  const char* support_phrase = nullptr;
 };
 // The table, in EffectKind order (the order hypotheses are enumerated in).
 const std::vector<EffectInfo>& effect_library();
