@@ -80,27 +80,12 @@ for ((k = 0; k < n; ++k)); do
   rm -rf "$d" && mkdir -p "$d/logs"
   collect_residual_grasps "$hadynet" "$d/raw" "$seed"
   # The effect, on the recorded values (comments and header kept).
-  python3 - "$d/raw" "$d/logs" "$kind" <<'PY'
-import glob, math, os, sys
-src, dst, kind = sys.argv[1:4]
-if kind not in ("gain-wobble", "curve"):
-    sys.exit("residual_unknown_effect: --effect-kind must be gain-wobble or curve")
-for path in glob.glob(os.path.join(src, "*", "*.csv")):
-    lines = open(path).read().splitlines()
-    header = next(i for i, l in enumerate(lines) if not l.startswith("#"))
-    cols = lines[header].split(",")
-    c = cols.index("fc1")
-    for i in range(header + 1, len(lines)):
-        v = lines[i].split(",")
-        x = max(float(v[c]), 0.0)
-        if kind == "curve":
-            v[c] = repr(round(50.0 * (x / 50.0) ** 0.85, 6))
-        else:
-            t = (i - header - 1) * 0.2
-            v[c] = repr(round(x * (1.0 + 0.3 * math.sin(2.0 * math.pi * t / 30.0)), 6))
-        lines[i] = ",".join(v)
-    open(os.path.join(dst, os.path.basename(path)), "w").write("\n".join(lines) + "\n")
-PY
+  case "$kind" in
+    curve) effect=curve:fc1:0.85:50 ;;
+    gain-wobble) effect=wobble:fc1:0.3:30 ;;
+    *) echo "residual_unknown_effect: --effect-kind must be gain-wobble or curve" >&2; exit 2 ;;
+  esac
+  python3 test/cli/inject_effect.py "$effect" "$d/raw" "$d/logs"
   "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 "${reference_args[@]}" --fix \
     --json "$d/residual.json" >"$d/out.txt" 2>"$d/err.txt" ||
     { echo "seed $seed: residual failed: $(tail -1 "$d/err.txt")" | tee -a "$summary"; continue; }

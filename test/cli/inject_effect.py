@@ -23,6 +23,13 @@ dt_s):
                            CH reads y + AMPLITUDE sin(2 pi y / PERIOD) (an
                            incremental encoder's interpolation error: static,
                            periodic in the reading)
+  curve:CH:EXPONENT:REFERENCE
+                           CH (a force, read from 0) reads REFERENCE
+                           (max(y, 0) / REFERENCE)^EXPONENT (a calibration curve)
+  wobble:CH:AMPLITUDE:PERIOD
+                           CH (a force, read from 0) reads max(y, 0) (1 +
+                           AMPLITUDE sin(2 pi t / PERIOD)), t in s from the
+                           log's start (a gain that swings with temperature)
 """
 import glob
 import math
@@ -86,6 +93,13 @@ def inject(effect, path, lines):
     elif kind == "cyclic" and len(args) == 3:
         c, amplitude, period = column(header, args[0], path), float(args[1]), float(args[2])
         write(c, [v + amplitude * math.sin(2 * math.pi * v / period) for v in values(c)])
+    elif kind == "curve" and len(args) == 3:
+        c, exponent, reference = column(header, args[0], path), float(args[1]), float(args[2])
+        write(c, [reference * (max(v, 0.0) / reference) ** exponent for v in values(c)])
+    elif kind == "wobble" and len(args) == 3:
+        c, amplitude, period = column(header, args[0], path), float(args[1]), float(args[2])
+        write(c, [max(v, 0.0) * (1.0 + amplitude * math.sin(2.0 * math.pi * (i * dt) / period))
+                  for i, v in enumerate(values(c))])
     else:
         die("unknown effect " + effect + " (see --help)")
     return lines[:header_row + 1] + [",".join(r) for r in rows]

@@ -121,13 +121,14 @@ HypothesisResult test_hypothesis(const ResidualData& data, const Hypothesis& h, 
   for (Eigen::Index j = 0; j < k; ++j) {
     if (support(j) >= options.min_support && spread(j) > 1e-18) continue;
     res.testable = false;
-    const char* nonzero = effect_info(h.kind).support_phrase;
-    res.label = describe(h, data, res.coef) + " (not testable: " +
-                (support(j) < options.min_support
-                     ? std::string(nonzero ? nonzero : "a regressor is non-zero") + " in " +
-                           std::to_string(support(j)) + " of " + std::to_string(training_rows) +
-                           " training rows, at least " + std::to_string(options.min_support) + " needed)"
-                     : std::string("a regressor is constant in the training part)"));
+    std::string why = "a regressor is constant in the training part";
+    if (support(j) < options.min_support) {
+      const char* nonzero = effect_info(h.kind).support_phrase;
+      why = std::string(nonzero ? nonzero : "a regressor is non-zero") + " in " + std::to_string(support(j)) +
+            " of " + std::to_string(training_rows) + " training rows, at least " +
+            std::to_string(options.min_support) + " needed";
+    }
+    res.label = describe(h, data, res.coef) + " (not testable: " + why + ")";
     return res;
   }
 

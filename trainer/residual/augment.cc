@@ -138,6 +138,15 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   // on other groups too is planned as the commands' dead time.
   std::string winner_not_fixable;
   std::vector<EffectKind> leads;
+  const auto plan_of = [&](const HypothesisResult& r, bool group_extension) {
+    Augmentation a;
+    a.kind = r.hypothesis.kind;
+    a.effect = r.effect;
+    a.screen_statistic = floor_statistic(attribution, r);
+    a.group_extension = group_extension;
+    effect_info(a.kind).plan(data, attribution, r, a);
+    return a;
+  };
   for (const auto& r : attribution.ranked) {
     if (!r.significant || static_cast<int>(out.size()) >= count) break;
     const std::string why = why_not_fixable(data, attribution, r);
@@ -151,11 +160,7 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
       return std::any_of(out.begin(), out.end(), [&](const Augmentation& b) { return b.kind == kind; });
     };
     if (planned(r.hypothesis.kind) || std::find(leads.begin(), leads.end(), r.hypothesis.kind) != leads.end()) continue;
-    Augmentation a;
-    a.kind = r.hypothesis.kind;
-    a.effect = r.effect;
-    a.screen_statistic = floor_statistic(attribution, r);
-    effect_info(a.kind).plan(data, attribution, r, a);
+    Augmentation a = plan_of(r, true);
     if (!a.not_fixable.empty()) {  // the plan found nothing to add (a curve without two distinct levels)
       if (r.label == winner->label) winner_not_fixable = a.not_fixable;
       continue;
@@ -172,12 +177,7 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
     const bool extended = !a.extended_channels.empty();
     out.push_back(std::move(a));
     if (!extended || static_cast<int>(out.size()) >= count) continue;
-    Augmentation family_alone;
-    family_alone.kind = r.hypothesis.kind;
-    family_alone.effect = r.effect;
-    family_alone.screen_statistic = out.back().screen_statistic;
-    family_alone.group_extension = false;
-    effect_info(family_alone.kind).plan(data, attribution, r, family_alone);
+    Augmentation family_alone = plan_of(r, false);
     if (family_alone.not_fixable.empty()) out.push_back(std::move(family_alone));
   }
   if (out.empty()) {  // nothing significant can be added: fix() says "not supported"

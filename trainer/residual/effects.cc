@@ -90,30 +90,23 @@ std::vector<std::string> family_groups(const ResidualData& data, const Attributi
 // The results of `kind` on the other channels of `group` that pass the test
 // without the practical floors (testable, Holm-adjusted p < alpha) and
 // `also` (the lead's delay or side, a plausible parameter), in ranking
-// order. The floors keep the model's own misfit from being named as a new
-// effect; once a sensor effect is established, the test only says where
-// else in the group it is (the group extension of a sensor delay, a
-// calibration curve and a rail).
+// order; none when plan `a` may not extend its family
+// (Augmentation::group_extension). The floors keep the model's own misfit
+// from being named as a new effect; once a sensor effect is established,
+// the test only says where else in the group it is (the group extension of
+// a sensor delay, a calibration curve and a rail).
 template <typename Also>
 std::vector<const HypothesisResult*> passing_in_group(const ResidualData& data, const Attribution& attribution,
-                                                      EffectKind kind, const std::string& group, Also also) {
+                                                      const Augmentation& a, EffectKind kind,
+                                                      const std::string& group, Also also) {
   std::vector<const HypothesisResult*> out;
+  if (!a.group_extension) return out;
   for (const auto& r : attribution.ranked) {
     if (r.hypothesis.kind != kind || channel_group(y_name(data, r.hypothesis.target)) != group) continue;
     if (!r.testable || r.p_adjusted >= attribution.options.alpha || !also(r)) continue;
     out.push_back(&r);
   }
   return out;
-}
-
-// passing_in_group for a plan allowed to extend its family (Augmentation::
-// group_extension), else none.
-template <typename Also>
-std::vector<const HypothesisResult*> in_group_if_allowed(const ResidualData& data, const Attribution& attribution,
-                                                          const Augmentation& a, EffectKind kind,
-                                                          const std::string& group, Also also) {
-  if (!a.group_extension) return {};
-  return passing_in_group(data, attribution, kind, group, also);
 }
 
 // The groups of the channels where any sensor delay (any number of steps)
@@ -283,7 +276,7 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   // small residual, and its predicted change D is mostly noise, which
   // attenuates its gain, but aligning it is still right (docs/residual.md).
   const auto same_delay = [&](const HypothesisResult& r) { return r.hypothesis.delay == h.delay && r.parameter > 0; };
-  for (const HypothesisResult* r : in_group_if_allowed(data, attribution, a, EffectKind::kSensorDelay,
+  for (const HypothesisResult* r : passing_in_group(data, attribution, a, EffectKind::kSensorDelay,
                                                         channel_group(y_name(data, h.target)), same_delay)) {
     const std::string& name = y_name(data, r->hypothesis.target);
     if (std::find(a.channels.begin(), a.channels.end(), name) != a.channels.end()) continue;
@@ -291,7 +284,9 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
     a.extended_channels.push_back(name);
   }
   a.description = "time-align " + join(a.channels) + " by " + std::to_string(change.delay) + " steps" +
-                  (a.extended_channels.empty() ? "" : " (" + join(a.extended_channels) + ": the same delay in the same group)") +
+                  (a.extended_channels.empty()
+                       ? ""
+                       : " (" + join(a.extended_channels) + ": the same delay in the same group)") +
                   "; the model predicts the true-time signal";
   a.found_on = a.channels;
 }
@@ -728,7 +723,7 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   const auto same_side = [&](const HypothesisResult& r) {
     return r.hypothesis.side == w.hypothesis.side && r.plausible;
   };
-  for (const HypothesisResult* r : in_group_if_allowed(data, attribution, a, EffectKind::kSaturation,
+  for (const HypothesisResult* r : passing_in_group(data, attribution, a, EffectKind::kSaturation,
                                                         channel_group(y_name(data, w.hypothesis.target)), same_side)) {
     const std::string& name = y_name(data, r->hypothesis.target);
     const bool clipped = std::any_of(change.clips.begin(), change.clips.end(), [&](const OutputClip& c) {
@@ -739,7 +734,9 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
     a.extended_channels.push_back(name);
   }
   a.description = "clip the prediction at the measured rail: " + join(rails) +
-                  (a.extended_channels.empty() ? "" : " (" + join(a.extended_channels) + ": a rail on the same side in the same group)") +
+                  (a.extended_channels.empty()
+                       ? ""
+                       : " (" + join(a.extended_channels) + ": a rail on the same side in the same group)") +
                   " (trained on the clipped output)";
   a.found_on = a.channels;
 }
@@ -884,7 +881,7 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
     if (channel_group(y_name(data, r.hypothesis.target)) == group) targets.push_back(r.hypothesis.target);
   const auto plausible = [](const HypothesisResult& r) { return r.plausible; };
   const std::size_t family = targets.size();
-  for (const HypothesisResult* r : in_group_if_allowed(data, attribution, a, EffectKind::kSensorCurve, group, plausible)) {
+  for (const HypothesisResult* r : passing_in_group(data, attribution, a, EffectKind::kSensorCurve, group, plausible)) {
     const int c = r->hypothesis.target;
     if (std::find(targets.begin(), targets.end(), c) == targets.end()) targets.push_back(c);
   }
@@ -901,7 +898,9 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
     return;
   }
   a.description = "a static calibration curve of " + join(a.channels) +
-                  (a.extended_channels.empty() ? "" : " (" + join(a.extended_channels) + ": a curve in the same group)") +
+                  (a.extended_channels.empty()
+                       ? ""
+                       : " (" + join(a.extended_channels) + ": a curve in the same group)") +
                   " (piecewise linear, monotone): the logs read through its inverse, the prediction through it";
   a.found_on = a.channels;
 }
