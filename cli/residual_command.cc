@@ -149,6 +149,7 @@ void print_fix(const rs::FixResult& fixed) {
     std::printf(": Diebold-Mariano p %.2g", fixed.confirmation.p_value);
     if (fixed.folds > 1) std::printf(" (%d folds; the first alone: p %.2g)", fixed.folds, fixed.first_fold.p_value);
     std::printf(": %s\n", fixed.changed ? "confirmed" : "not confirmed, nothing applied");
+    if (fixed.extension) std::printf("%s\n", extension_sentence(fixed).c_str());
     if (!fixed.folds_note.empty()) std::printf("note: %s\n", fixed.folds_note.c_str());
     if (fixed.candidates.size() > 1) {
       std::printf("candidates (the screen's order; * the one tested: the first whose gain over fine-tuning alone\n"
@@ -239,7 +240,8 @@ int run_residual(int argc, char** argv) {
                               "each added, fine-tuned on the first 75 % of the training rows and compared with\n"
                               "fine-tuning alone on the rest; the first significant there, else the clearest gain,\n"
                               "else the screen's first, is the one the decision tests on the held-out rows (1: the\n"
-                              "screen's winner)", "5");
+                              "screen's winner); a family alone confirmed there is then extended to its group when the\n"
+                              "extended plan predicts the channels it adds significantly better", "5");
   opt.value("fix-min-excess-null", "S",
             "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"
             "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"

@@ -390,6 +390,19 @@ struct FixResult {
   // null (the screen's absolute floors).
   std::optional<double> candidates_floor;
   std::vector<CandidateTrial> candidates;          // the screen's candidates, in its order
+  // The extension, tested after a confirmed family alone (a candidate
+  // planned without its group, Augmentation::group_extension false, right
+  // after its extended plan): the extended plan, re-estimated and fine-tuned
+  // as the family alone was, against the family alone on the held-out rows
+  // of the channels it adds (`extension_channels`; the family alone's loss
+  // minus the extended plan's, every fold). A fixed sequence, each test at
+  // the attribution's alpha: the family alone's confirmation first, then
+  // this. Significant, the extended plan is applied (extension_applied) and
+  // `augmentation`, `after`, `untuned` and `model` are its; the
+  // confirmation stays the family alone's, on its channels.
+  std::optional<DieboldMariano> extension;
+  std::vector<std::string> extension_channels;
+  bool extension_applied = false;
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
   std::vector<double> fitted_rates;     // drift: the attribution's rate per channel, before refine(); else empty

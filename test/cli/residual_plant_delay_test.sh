@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# The plant's 2-step delay of every loadcell on fresh logs (seed 1583, the
+# four grasps of docs/residual.md, 300 rows), through `hadynet residual
+# MODEL LOGS --fix` with the plant's rated ranges and every other setting a
+# default: the delay must be aligned on at least 8 of the 9 loadcells, not
+# on the few its family alone holds (docs/residual.md, "The extension,
+# tested after the family alone"). Before stop 52 the family alone (fc4,
+# fc3, fc1, fc2) was confirmed and applied, the five other loadcells stayed
+# late and the fixed model predicted fc6 1.33 times worse than fine-tuning
+# alone. Now the extended plan is tested against the family alone on the
+# channels it adds and applied (p 2e-5 on this machine). Either path that
+# aligns the group passes: on another CPU the selection may choose the
+# extended plan at once (its training-rows p is 0.0103, at alpha 0.01).
+# Also checked: the winner's held-out RMSE cut by 30 % and below fine-tuning
+# alone (issue 12's bar), and the summed loadcell RMSE below fine-tuning
+# alone's (the group as a whole is better, not only the channels claimed).
+#   residual_plant_delay_test.sh HADYNET MODEL WORKDIR
+set -uo pipefail
+hadynet=$1 model=$2 work=$3
+here=$(cd "$(dirname "$0")/../.." && pwd)
+rm -rf "$work" && mkdir -p "$work/logs" || exit 2
+source "$here/bench/residual_grasps.sh"
+RESIDUAL_ROWS=300 collect_residual_grasps "$hadynet" "$work/raw" 1583 --effect sensor-delay=2 || { echo "FAIL: collect"; exit 1; }
+find "$work/raw" -name "*.csv" -exec cp {} "$work/logs/" \;
+[[ $(ls "$work/logs" | wc -l) -eq 4 ]] || { echo "FAIL: not the four grasps' logs"; exit 1; }
+"$hadynet" residual "$model" "$work/logs" --rated-range fc=0..50 --rated-range f=0..200 --fix \
+  --json "$work/residual.json" >"$work/out.txt" 2>&1 || { echo "FAIL: residual"; tail -5 "$work/out.txt"; exit 1; }
+grep -E "^(decision|Extension)" "$work/out.txt"
+python3 - "$work/residual.json" <<'PY'
+import json, sys
+fix = json.load(open(sys.argv[1]))["fix"]
+aug = fix.get("augmentation") or {}
+channels = aug.get("channels", [])
+failures = []
+def check(ok, what):
+    if not ok:
+        failures.append(what)
+check(bool(fix.get("changed")), "nothing confirmed: " + fix.get("status", "")[:120])
+check(aug.get("effect") == "sensor-delay" and aug.get("delay_steps") == 2, "not a 2-step sensor delay: " + aug.get("effect", "-"))
+print("aligned:", channels)
+check(len(channels) >= 8 and all(c.startswith("fc") for c in channels), f"aligned on {len(channels)} loadcells, not 8 or more")
+if fix.get("changed") and channels:
+    rmse = lambda part: {c["channel"]: c["rmse"] for c in fix[part]["channels"]}
+    before, control, after = rmse("before"), rmse("control"), rmse("after")
+    w = channels[0]
+    print(f"{w}: before {before[w]:.4g}, fine-tuning alone {control[w]:.4g}, fixed {after[w]:.4g}")
+    check(after[w] <= 0.7 * before[w] and after[w] < control[w], f"{w}: not cut by 30 % below fine-tuning alone")
+    fc = [c for c in before if c.startswith("fc")]
+    total_after, total_control = sum(after[c] for c in fc), sum(control[c] for c in fc)
+    print(f"summed loadcell RMSE: fixed {total_after:.4g}, fine-tuning alone {total_control:.4g}")
+    check(total_after < total_control, "the loadcells as a whole not below fine-tuning alone")
+for f in failures:
+    print("FAIL:", f)
+sys.exit(1 if failures else 0)
+PY
