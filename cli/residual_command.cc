@@ -149,7 +149,7 @@ void print_fix(const rs::FixResult& fixed) {
     std::printf(": Diebold-Mariano p %.2g", fixed.confirmation.p_value);
     if (fixed.folds > 1) std::printf(" (%d folds; the first alone: p %.2g)", fixed.folds, fixed.first_fold.p_value);
     std::printf(": %s\n", fixed.changed ? "confirmed" : "not confirmed, nothing applied");
-    if (fixed.extension) std::printf("%s\n", extension_sentence(fixed).c_str());
+    for (const auto& wider : fixed.extensions) std::printf("%s\n", extension_sentence(wider).c_str());
     if (!fixed.folds_note.empty()) std::printf("note: %s\n", fixed.folds_note.c_str());
     if (fixed.candidates.size() > 1) {
       std::printf("candidates (the screen's order; * the one tested: the first whose gain over fine-tuning alone\n"
@@ -241,7 +241,8 @@ int run_residual(int argc, char** argv) {
                               "fine-tuning alone on the rest; the first significant there, else the clearest gain,\n"
                               "else the screen's first, is the one the decision tests on the held-out rows (1: the\n"
                               "screen's winner); a family alone confirmed there is then extended to its group when the\n"
-                              "extended plan predicts the channels it adds significantly better", "5");
+                              "extended plan predicts the channels it adds significantly better on the held-out rows,\n"
+                              "and a delay seen beyond its family likewise to every channel of its group", "5");
   opt.value("fix-min-excess-null", "S",
             "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"
             "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"
@@ -420,6 +421,7 @@ int run_residual(int argc, char** argv) {
       if (!out) throw std::runtime_error(path + ": cannot write");
       out << j.dump(1) << '\n';
       if (!out) throw std::runtime_error(path + ": write failed");
+      std::fflush(stdout);  // the report's lines whole before this one, when both go to one file
       std::fprintf(stderr, "wrote %s\n", path.c_str());
     };
     trainer::HadynetModel current = model;
@@ -450,6 +452,7 @@ int run_residual(int argc, char** argv) {
           if (opt.has("out")) {
             round_written = opt.get("out");
             trainer::save_model(round_written, fixed->model);
+            std::fflush(stdout);
             std::fprintf(stderr, "wrote %s (round %d)\n", round_written.c_str(), round);
             j["fix"]["model"] = round_written;
             written = round_written;

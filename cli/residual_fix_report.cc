@@ -78,16 +78,17 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                                          {"p_value", f.first_fold.p_value}}},
                          {"p_value", f.confirmation.p_value},
                          {"confirmed", f.changed}};
-    // After a confirmed family alone: its extended plan against it on the channels the extension adds.
-    j["extension"] = nullptr;
-    if (f.extension)
-      j["extension"] = {{"channels", f.extension_channels},
-                        {"against", "the family alone"},
-                        {"mean_loss_difference", f.extension->mean},
-                        {"statistic", f.extension->stat},
-                        {"rows", f.extension->samples},
-                        {"p_value", f.extension->p_value},
-                        {"applied", f.extension_applied}};
+    // Wider plans tested after the confirmation (FixResult::extensions).
+    j["extensions"] = json::array();
+    for (const auto& e : f.extensions)
+      j["extensions"].push_back({{"what", e.what},
+                                 {"channels", e.channels},
+                                 {"against", "the plan applied before it"},
+                                 {"mean_loss_difference", e.test.mean},
+                                 {"statistic", e.test.stat},
+                                 {"rows", e.test.samples},
+                                 {"p_value", e.test.p_value},
+                                 {"applied", e.applied}});
     json candidates = json::array();
     for (const auto& c : f.candidates)
       candidates.push_back({{"effect", c.effect},
@@ -139,14 +140,12 @@ std::string fix_table(const rs::FixResult& f) {
 
 }  // namespace
 
-std::string extension_sentence(const rs::FixResult& f) {
-  std::string m = "Extension: the same plan on its group's channels ";
-  for (std::size_t i = 0; i < f.extension_channels.size(); ++i) m += (i ? ", " : "") + f.extension_channels[i];
-  m += " too, against the family alone on their held-out rows (Diebold-Mariano, " +
-       std::to_string(f.extension->samples) + " rows): mean loss difference " + num("%.3g", f.extension->mean) +
-       ", p " + num("%.2g", f.extension->p_value) + ": " +
-       (f.extension_applied ? "applied (the before/after below are the extended plan's)"
-                            : "not applied (the family alone is)");
+std::string extension_sentence(const rs::FixResult::Extension& e) {
+  std::string m = "Extension to " + e.what + ": ";
+  for (std::size_t i = 0; i < e.channels.size(); ++i) m += (i ? ", " : "") + e.channels[i];
+  m += ", against the plan applied before it on their held-out rows (Diebold-Mariano, " +
+       std::to_string(e.test.samples) + " rows): mean loss difference " + num("%.3g", e.test.mean) + ", p " +
+       num("%.2g", e.test.p_value) + ": " + (e.applied ? "applied" : "not applied");
   return m;
 }
 
@@ -172,7 +171,9 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
          (f.folds > 1 ? " (the first fold alone: p " + num("%.2g", f.first_fold.p_value) + ")" : std::string()) +
          (f.folds_note.empty() ? std::string() : " (" + f.folds_note + ")") + ": **" + (f.changed ? "confirmed" : "not confirmed, nothing applied") +
          "**.\n\n";
-    if (f.extension) m += extension_sentence(f) + "\n\n";
+    for (const auto& e : f.extensions) m += extension_sentence(e) + ".\n\n";
+    if (!f.extensions.empty() && f.extensions.back().applied)
+      m += "The before/after below are the widest plan applied.\n\n";
     m += "Verdict after (the augmented model on its own frame): " + f.after.verdict + "\n\n";
   }
   if (f.changed && !f.model.sensor.empty()) {

@@ -17,10 +17,10 @@ nlohmann::json fix_json(const trainer::residual::FixResult& f, const trainer::re
 std::string fix_markdown(const trainer::residual::FixResult& f, const trainer::residual::FixOptions& o,
                          const std::string& out, const std::string& png);
 
-// One sentence on the extension tested after a confirmed family alone
-// (FixResult::extension, which must be set): its channels, the test and
-// whether it was applied. For stdout and REPORT.md.
-std::string extension_sentence(const trainer::residual::FixResult& f);
+// One sentence on a wider plan tested after the confirmation
+// (FixResult::extensions): the channels it adds, the test and whether it was
+// applied. For stdout and REPORT.md.
+std::string extension_sentence(const trainer::residual::FixResult::Extension& e);
 
 // fix.png: each channel's held-out RMSE after the fix and after fine-tuning
 // alone, relative to before. Returns "" on success (or nothing to plot), else

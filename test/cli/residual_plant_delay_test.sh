@@ -3,8 +3,8 @@
 # four grasps of docs/residual.md, 300 rows), through `hadynet residual
 # MODEL LOGS --fix` with the plant's rated ranges and every other setting a
 # default: the delay must be aligned on at least 8 of the 9 loadcells, not
-# on the few its family alone holds (docs/residual.md, "The extension,
-# tested after the family alone"). Before stop 52 the family alone (fc4,
+# on the few its family alone holds (docs/residual.md, "Wider plans,
+# tested after the confirmation"). Before stop 52 the family alone (fc4,
 # fc3, fc1, fc2) was confirmed and applied, the five other loadcells stayed
 # late and the fixed model predicted fc6 1.33 times worse than fine-tuning
 # alone. Now the extended plan is tested against the family alone on the

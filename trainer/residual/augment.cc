@@ -200,6 +200,27 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   return out;
 }
 
+std::optional<Augmentation> on_whole_group(const std::vector<std::string>& y_names, const Augmentation& a) {
+  if (a.kind != EffectKind::kSensorDelay || !std::holds_alternative<TimeAlignment>(a.change) || a.channels.empty())
+    return std::nullopt;
+  const std::string group = channel_group(a.channels.front());
+  Augmentation whole = a;
+  std::vector<std::string> added;
+  for (const auto& name : y_names)
+    if (channel_group(name) == group && std::find(a.channels.begin(), a.channels.end(), name) == a.channels.end())
+      added.push_back(name);
+  if (added.empty()) return std::nullopt;
+  std::string names;
+  for (const auto& name : added) {
+    whole.channels.push_back(name);
+    whole.extended_channels.push_back(name);
+    whole.found_on.push_back(name);
+    names += (names.empty() ? "" : ", ") + name;
+  }
+  whole.description += " (" + names + ": every channel of the group)";
+  return whole;
+}
+
 SensorModel sensor_after(const SensorModel& before, const Augmentation& a) {
   SensorModel s = before;
   std::visit([&](const auto& change) { change.add_to_sensor(s, a); }, a.change);
@@ -437,41 +458,62 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.confirmation = diebold_mariano(reference_loss, after_loss);
   const bool confirmed = result.confirmation.mean > 0 && result.confirmation.p_value < attribution.options.alpha;
 
-  // A confirmed family alone: does its extended plan predict the channels it
-  // adds better? (FixResult::extension; the plant's delay of every loadcell
-  // aligned on a few, the others left late: docs/residual.md, "The
-  // extension, tested after the family alone".)
-  if (confirmed && is_family_alone_of(planned, chosen)) {
-    for (const auto& name : planned[chosen - 1].extended_channels)
-      if (index_of(model.layout.y_names, name) >= 0) result.extension_channels.push_back(name);
-  }
-  if (!result.extension_channels.empty()) {
-    std::vector<double> extended_rates;
-    const Augmentation extended = refined(planned[chosen - 1], train_part, &extended_rates);
-    HadynetModel extended_untuned;
-    Tuned extended_after = tune(&extended, train_part, &extended_untuned);
-    HeldOutError extended_rows = judged(extended_after.model, held_out_part);
-    Segments alone_loss = standardised_loss(model, result.after, result.extension_channels);
-    Segments extended_loss = standardised_loss(model, extended_rows, result.extension_channels);
+  // A wider plan, tested only after the test before it rejected (a fixed
+  // sequence at alpha; FixResult::extensions): the plan applied so far
+  // against `wider` on the held-out rows, both folds, of the channels
+  // `wider` adds; applied when significant. Returns whether it was.
+  const auto try_wider = [&](const Augmentation& wider, const std::string& what) {
+    const Augmentation& current = *result.augmentation;
+    FixResult::Extension e;
+    e.what = what;
+    for (const auto& name : wider.channels)
+      if (index_of(model.layout.y_names, name) >= 0 &&
+          std::find(current.channels.begin(), current.channels.end(), name) == current.channels.end())
+        e.channels.push_back(name);
+    if (e.channels.empty()) return false;
+    std::vector<double> rates;
+    const Augmentation tested_wider = refined(wider, train_part, &rates);
+    HadynetModel wider_untuned;
+    Tuned wider_after = tune(&tested_wider, train_part, &wider_untuned);
+    HeldOutError wider_rows = judged(wider_after.model, held_out_part);
+    Segments current_loss = standardised_loss(model, result.after, e.channels);
+    Segments wider_loss = standardised_loss(model, wider_rows, e.channels);
+    std::optional<HeldOutError> wider_mirrored;
     if (mirrored_after) {
-      const Augmentation mirrored = refined(planned[chosen - 1], mirrored_train, nullptr);
-      const HeldOutError e_rows = judged(tune(&mirrored, mirrored_train).model, mirrored_judged);
-      for (auto& segment : standardised_loss(model, *mirrored_after, result.extension_channels))
-        alone_loss.push_back(std::move(segment));
-      for (auto& segment : standardised_loss(model, e_rows, result.extension_channels))
-        extended_loss.push_back(std::move(segment));
+      const Augmentation mirrored = refined(wider, mirrored_train, nullptr);
+      wider_mirrored = judged(tune(&mirrored, mirrored_train).model, mirrored_judged);
+      for (auto& segment : standardised_loss(model, *mirrored_after, e.channels))
+        current_loss.push_back(std::move(segment));
+      for (auto& segment : standardised_loss(model, *wider_mirrored, e.channels))
+        wider_loss.push_back(std::move(segment));
     }
-    result.extension = diebold_mariano(alone_loss, extended_loss);
-    if (result.extension->mean > 0 && result.extension->p_value < attribution.options.alpha) {
-      result.extension_applied = true;
-      result.augmentation = extended;
-      result.fitted_rates = std::move(extended_rates);
-      result.untuned = std::move(extended_untuned);
-      result.loss_history = extended_after.loss_history;
-      result.train_windows = extended_after.train_windows;
-      result.after = std::move(extended_rows);
-      after = std::move(extended_after);
-    }
+    e.test = diebold_mariano(current_loss, wider_loss);
+    e.applied = e.test.mean > 0 && e.test.p_value < attribution.options.alpha;
+    result.extensions.push_back(e);
+    if (!e.applied) return false;
+    result.augmentation = tested_wider;
+    result.fitted_rates = std::move(rates);
+    result.untuned = std::move(wider_untuned);
+    result.loss_history = wider_after.loss_history;
+    result.train_windows = wider_after.train_windows;
+    result.after = std::move(wider_rows);
+    mirrored_after = std::move(wider_mirrored);
+    after = std::move(wider_after);
+    return true;
+  };
+  // A confirmed family alone: does its extended plan predict the channels it
+  // adds better? (The plant's delay of every loadcell aligned on a few, the
+  // others left late: docs/residual.md, "Wider plans, tested after the
+  // confirmation".) Then a delay seen beyond its family, on the channels of
+  // its group the test did not find it on (an acquisition chain delays
+  // every channel it carries, and a channel that barely moves hides it).
+  if (confirmed) {
+    bool beyond_family = !planned[chosen].extended_channels.empty();
+    if (is_family_alone_of(planned, chosen))
+      beyond_family = try_wider(planned[chosen - 1], "its group's channels where the test finds the same effect");
+    if (beyond_family)
+      if (const auto whole = on_whole_group(model.layout.y_names, *result.augmentation))
+        try_wider(*whole, "every channel of its group");
   }
 
   // The residual analysis of the augmented model (in its own frame), against

@@ -390,19 +390,25 @@ struct FixResult {
   // null (the screen's absolute floors).
   std::optional<double> candidates_floor;
   std::vector<CandidateTrial> candidates;          // the screen's candidates, in its order
-  // The extension, tested after a confirmed family alone (a candidate
-  // planned without its group, Augmentation::group_extension false, right
-  // after its extended plan): the extended plan, re-estimated and fine-tuned
-  // as the family alone was, against the family alone on the held-out rows
-  // of the channels it adds (`extension_channels`; the family alone's loss
-  // minus the extended plan's, every fold). A fixed sequence, each test at
-  // the attribution's alpha: the family alone's confirmation first, then
-  // this. Significant, the extended plan is applied (extension_applied) and
-  // `augmentation`, `after`, `untuned` and `model` are its; the
-  // confirmation stays the family alone's, on its channels.
-  std::optional<DieboldMariano> extension;
-  std::vector<std::string> extension_channels;
-  bool extension_applied = false;
+  // Wider plans tested after the confirmation, in order: a confirmed family
+  // alone (a candidate planned without its group, Augmentation::
+  // group_extension false, right after its extended plan) against that
+  // extended plan; then a time alignment seen beyond its family (chosen
+  // extended, or so extended) against its whole group (on_whole_group).
+  // Each wider plan is re-estimated and fine-tuned as the tested candidate
+  // was (both folds) and judged against the plan applied so far on the
+  // held-out rows of the channels it adds; significant, it is applied:
+  // `augmentation`, `after`, `untuned` and `model` are then its. A fixed
+  // sequence (each test only after the one before rejected), each at the
+  // attribution's alpha. The confirmation stays the tested candidate's, on
+  // its channels.
+  struct Extension {
+    std::string what;                   // the wider plan's channels, in words
+    std::vector<std::string> channels;  // the channels it adds
+    DieboldMariano test;                // the applied plan's loss minus the wider one's there
+    bool applied = false;
+  };
+  std::vector<Extension> extensions;
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
   std::vector<double> fitted_rates;     // drift: the attribution's rate per channel, before refine(); else empty
@@ -411,6 +417,14 @@ struct FixResult {
   std::string look_alike;
   long train_windows = 0;
 };
+
+// A sensor delay's time alignment `a` on every y channel of its winner's
+// group (`y_names`: the model's), whether the test found the delay there or
+// not: an acquisition chain delays every channel it carries, and a channel
+// that barely moves hides its delay from the test. nullopt when `a` is not a
+// time alignment or holds the whole group. fix() tests it after a delay
+// seen beyond its family (FixResult::extensions).
+std::optional<Augmentation> on_whole_group(const std::vector<std::string>& y_names, const Augmentation& a);
 
 // What leaves nearly the same 1-step residual as the change `a`, in words,
 // for a report next to a confirmed change (its effect's EffectInfo::look_alike
