@@ -2,6 +2,7 @@
 // the JSON object, the Markdown section and the before/after plot.
 #include "cli/residual_fix_report.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "cli/gnuplot.h"
@@ -140,6 +141,10 @@ std::string fix_table(const rs::FixResult& f) {
 
 }  // namespace
 
+bool widest_applied(const rs::FixResult& f) {
+  return std::any_of(f.extensions.begin(), f.extensions.end(), [](const auto& e) { return e.applied; });
+}
+
 std::string extension_sentence(const rs::FixResult::Extension& e) {
   std::string m = "Extension to " + e.what + ": ";
   for (std::size_t i = 0; i < e.channels.size(); ++i) m += (i ? ", " : "") + e.channels[i];
@@ -172,8 +177,7 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
          (f.folds_note.empty() ? std::string() : " (" + f.folds_note + ")") + ": **" + (f.changed ? "confirmed" : "not confirmed, nothing applied") +
          "**.\n\n";
     for (const auto& e : f.extensions) m += extension_sentence(e) + ".\n\n";
-    if (!f.extensions.empty() && f.extensions.back().applied)
-      m += "The before/after below are the widest plan applied.\n\n";
+    if (widest_applied(f)) m += "The before/after below are the widest plan applied.\n\n";
     m += "Verdict after (the augmented model on its own frame): " + f.after.verdict + "\n\n";
   }
   if (f.changed && !f.model.sensor.empty()) {

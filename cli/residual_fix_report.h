@@ -22,6 +22,10 @@ std::string fix_markdown(const trainer::residual::FixResult& f, const trainer::r
 // applied. For stdout and REPORT.md.
 std::string extension_sentence(const trainer::residual::FixResult::Extension& e);
 
+// Whether a wider plan was applied after the confirmation: the before/after
+// are then the widest plan's.
+bool widest_applied(const trainer::residual::FixResult& f);
+
 // fix.png: each channel's held-out RMSE after the fix and after fine-tuning
 // alone, relative to before. Returns "" on success (or nothing to plot), else
 // a message (gnuplot missing or failed).

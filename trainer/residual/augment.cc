@@ -200,24 +200,25 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   return out;
 }
 
-std::optional<Augmentation> on_whole_group(const std::vector<std::string>& y_names, const Augmentation& a) {
+std::optional<Augmentation> on_whole_group(const std::vector<std::string>& y_names, const SensorModel& sensor,
+                                           const Augmentation& a) {
   if (a.kind != EffectKind::kSensorDelay || !std::holds_alternative<TimeAlignment>(a.change) || a.channels.empty())
     return std::nullopt;
   const std::string group = channel_group(a.channels.front());
+  const auto delayed = [&](const std::string& name) {
+    return std::any_of(sensor.delays.begin(), sensor.delays.end(),
+                       [&](const SensorDelay& x) { return x.channel == name && x.steps > 0; });
+  };
   Augmentation whole = a;
-  std::vector<std::string> added;
-  for (const auto& name : y_names)
-    if (channel_group(name) == group && std::find(a.channels.begin(), a.channels.end(), name) == a.channels.end())
-      added.push_back(name);
-  if (added.empty()) return std::nullopt;
-  std::string names;
-  for (const auto& name : added) {
+  std::string added;
+  for (const auto& name : y_names) {
+    if (channel_group(name) != group || delayed(name)) continue;
+    if (std::find(a.channels.begin(), a.channels.end(), name) != a.channels.end()) continue;
     whole.channels.push_back(name);
-    whole.extended_channels.push_back(name);
-    whole.found_on.push_back(name);
-    names += (names.empty() ? "" : ", ") + name;
+    added += (added.empty() ? "" : ", ") + name;
   }
-  whole.description += " (" + names + ": every channel of the group)";
+  if (added.empty()) return std::nullopt;
+  whole.description += " (" + added + ": every channel of the group)";
   return whole;
 }
 
@@ -458,10 +459,13 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.confirmation = diebold_mariano(reference_loss, after_loss);
   const bool confirmed = result.confirmation.mean > 0 && result.confirmation.p_value < attribution.options.alpha;
 
-  // A wider plan, tested only after the test before it rejected (a fixed
+  // A wider plan, tested only after the test before it was significant (a fixed
   // sequence at alpha; FixResult::extensions): the plan applied so far
-  // against `wider` on the held-out rows, both folds, of the channels
-  // `wider` adds; applied when significant. Returns whether it was.
+  // against `wider` on the held-out rows of the channels `wider` adds (the
+  // first fold's, and the mirrored fold's when the decision judged it);
+  // applied when significant. `wider` is re-estimated on each fold's
+  // training rows as the tested candidate was. Returns whether it was
+  // applied.
   const auto try_wider = [&](const Augmentation& wider, const std::string& what) {
     const Augmentation& current = *result.augmentation;
     FixResult::Extension e;
@@ -512,7 +516,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     if (is_family_alone_of(planned, chosen))
       beyond_family = try_wider(planned[chosen - 1], "its group's channels where the test finds the same effect");
     if (beyond_family)
-      if (const auto whole = on_whole_group(model.layout.y_names, *result.augmentation))
+      if (const auto whole = on_whole_group(model.layout.y_names, model.sensor, *result.augmentation))
         try_wider(*whole, "every channel of its group");
   }
 

@@ -396,12 +396,15 @@ struct FixResult {
   // extended plan; then a time alignment seen beyond its family (chosen
   // extended, or so extended) against its whole group (on_whole_group).
   // Each wider plan is re-estimated and fine-tuned as the tested candidate
-  // was (both folds) and judged against the plan applied so far on the
-  // held-out rows of the channels it adds; significant, it is applied:
-  // `augmentation`, `after`, `untuned` and `model` are then its. A fixed
-  // sequence (each test only after the one before rejected), each at the
-  // attribution's alpha. The confirmation stays the tested candidate's, on
-  // its channels.
+  // was (on each fold the decision judged) and judged against the plan
+  // applied so far on the held-out rows of the channels it adds;
+  // significant, it is applied: `augmentation`, `after`, `untuned`,
+  // `model`, `loss_history`, `train_windows`, `fitted_rates` and the
+  // verdict after are then its. A fixed sequence (each test only after the
+  // one before was significant), each at the attribution's alpha. `confirmation`
+  // stays the tested candidate's test on its channels: the applied wider
+  // plan is not tested against the reference again (it holds the tested
+  // candidate's change on those channels).
   struct Extension {
     std::string what;                   // the wider plan's channels, in words
     std::vector<std::string> channels;  // the channels it adds
@@ -418,13 +421,17 @@ struct FixResult {
   long train_windows = 0;
 };
 
-// A sensor delay's time alignment `a` on every y channel of its winner's
-// group (`y_names`: the model's), whether the test found the delay there or
-// not: an acquisition chain delays every channel it carries, and a channel
-// that barely moves hides its delay from the test. nullopt when `a` is not a
-// time alignment or holds the whole group. fix() tests it after a delay
+// A sensor delay's time alignment `a` on every y channel of its group (the
+// group of its first channel, its family's lead; `y_names`: the model's)
+// that `sensor` (the model's sensor model) does not delay yet, whether the
+// test found the delay there or not: an acquisition chain delays every
+// channel it carries, and a channel that barely moves hides its delay from
+// the test. The added channels join `channels` only: `found_on` and
+// `extended_channels` keep where the test found the delay. nullopt when `a`
+// is not a time alignment or nothing is added. fix() tests it after a delay
 // seen beyond its family (FixResult::extensions).
-std::optional<Augmentation> on_whole_group(const std::vector<std::string>& y_names, const Augmentation& a);
+std::optional<Augmentation> on_whole_group(const std::vector<std::string>& y_names, const SensorModel& sensor,
+                                           const Augmentation& a);
 
 // What leaves nearly the same 1-step residual as the change `a`, in words,
 // for a report next to a confirmed change (its effect's EffectInfo::look_alike
