@@ -116,7 +116,16 @@
 # (test/cli/residual_injected_effects.sh): 1557 development, 1558-1561
 # every case and 1562-1571 the delay of one loadcell measured, each with
 # stop 50's code and this one on the same logs, 1572-1581 every case
-# measured with this one.
+# measured with this one. Stop 52 (wider plans tested after the
+# confirmation): the sensor-delay=2 sets of 1517, 1520 and 1525 and the
+# injected delays of 11 and 1558-1581 development; 1582-1591
+# sensor-delay=2 (and the injected delay of fc3 on their clean logs)
+# measured with the first step, then development of the whole-group step;
+# 1592-1601 sensor-delay=1, saturation=2 and saturation=3 measured with the
+# first step; 1602-1611 sensor-delay=2, sensor-delay=1 and the injected
+# delay measured with the final code (stop 51's code re-run on the same
+# logs where a wider plan was applied); 1583 then a test seed
+# (test/cli/residual_plant_delay_test.sh); 1517-1526 sensor-delay=2 re-run.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

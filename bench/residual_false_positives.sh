@@ -70,7 +70,9 @@
 # 51 (the family alone beside its group): 1538 and 1543 re-run (the only
 # sets of 1527-1546 with a candidate extended to its group), unchanged;
 # clean logs of seeds 11, 1557-1561 and 1572-1581 through the default
-# path of test/cli/residual_injected_effects.sh, nothing confirmed.
+# path of test/cli/residual_injected_effects.sh, nothing confirmed. Stop
+# 52 (wider plans tested after the confirmation): 1582-1591 and 1602-1611
+# measured, 1 confirmed (1609, a calibration curve; stop 51's code too).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
