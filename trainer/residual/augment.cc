@@ -443,7 +443,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     result.folds_note = "the mirrored fold was not judged: a log is too short for it, or --train-fraction is below "
                         "4/7 (its rows would overlap the rows that chose the candidate)";
   }
-  // The chosen plan's rows of the mirrored fold (options.folds 2), kept for the extension's test below.
+  // The chosen plan's rows of the mirrored fold (options.folds 2), kept for the wider plans' tests below.
   std::optional<HeldOutError> mirrored_after;
   if (options.folds == 2 && mirrored_fold_fits) {
     const Augmentation mirrored = refined(planned[chosen], mirrored_train, nullptr);
