@@ -115,9 +115,8 @@ void expect_one_candidate_per_effect(const std::vector<Augmentation>& candidates
   std::set<EffectKind> kinds;
   for (std::size_t k = 0; k < candidates.size(); ++k) {
     const Augmentation& a = candidates[k];
-    const bool family_alone = !a.group_extension && k > 0 && candidates[k - 1].kind == a.kind &&
-                              !candidates[k - 1].extended_channels.empty();
-    EXPECT_TRUE(kinds.insert(a.kind).second || family_alone) << "a second " << a.effect << ": " << a.description;
+    EXPECT_TRUE(kinds.insert(a.kind).second || is_family_alone(candidates, k))
+        << "a second " << a.effect << ": " << a.description;
   }
 }
 

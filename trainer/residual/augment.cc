@@ -105,15 +105,6 @@ std::string look_alike(const Augmentation& a) {
   return info.look_alike != nullptr ? info.look_alike(a.found_on) : "";
 }
 
-namespace {
-// Whether planned[k] is the family alone planned right after its extended
-// plan (plan_candidates).
-bool is_family_alone_of(const std::vector<Augmentation>& planned, std::size_t k) {
-  return k > 0 && k < planned.size() && !planned[k].group_extension && planned[k - 1].kind == planned[k].kind &&
-         !planned[k - 1].extended_channels.empty();
-}
-}  // namespace
-
 std::size_t chosen_candidate(const std::vector<CandidateTrial>& candidates, double alpha) {
   for (std::size_t k = 0; k < candidates.size(); ++k)
     if (gains_significantly(candidates[k], alpha)) return k;
@@ -198,6 +189,11 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
     out.push_back(std::move(a));
   }
   return out;
+}
+
+bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k) {
+  return k > 0 && k < planned.size() && !planned[k].group_extension && planned[k - 1].kind == planned[k].kind &&
+         !planned[k - 1].extended_channels.empty();
 }
 
 std::optional<Augmentation> on_whole_group(const std::vector<std::string>& y_names, const SensorModel& sensor,
@@ -513,7 +509,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // every channel it carries, and a channel that barely moves hides it).
   if (confirmed) {
     bool beyond_family = !planned[chosen].extended_channels.empty();
-    if (is_family_alone_of(planned, chosen))
+    if (is_family_alone(planned, chosen))
       beyond_family = try_wider(planned[chosen - 1], "its group's channels where the test finds the same effect");
     if (beyond_family)
       if (const auto whole = on_whole_group(model.layout.y_names, model.sensor, *result.augmentation))

@@ -56,10 +56,10 @@ struct FixOptions {
   int folds = 2;
   // How many of the screen's candidates may be tried (plan_candidates: the
   // best of each effect, and a plan extended to its group also on its
-  // family alone, each one of the `candidates`): each is re-estimated, added and fine-tuned on the
-  // first 75 % of the training rows and judged on the rest against the
-  // control; the first significant there, else the clearest gain
-  // (chosen_candidate), goes to the decision.
+  // family alone, each one of the `candidates`): each is re-estimated,
+  // added and fine-tuned on the first 75 % of the training rows and judged
+  // on the rest against the control; the first significant there, else the
+  // clearest gain (chosen_candidate), goes to the decision.
   // 1: the screen's winner alone. 5 was chosen on development seeds 771-775
   // (docs/residual.md, "Detection on fresh logs"), when every candidate was
   // another effect; since stop 51 a family alone takes one of them.
@@ -261,12 +261,15 @@ std::string why_not_fixable(const ResidualData& data, const Attribution& attribu
 // tries when the extended plan does not gain significantly on the training
 // rows (a delay, curve or rail of one sensor leaves traces on its group's
 // other channels through the network, which the test alone can take for
-// the effect). When the winner
-// cannot be added, the first
-// candidate's description says why; when no significant hypothesis can, the
-// winner's alone with Augmentation::not_fixable set (fix() then reports
-// "not supported"). Empty without a winner.
+// the effect). When the winner cannot be added, the first candidate's
+// description says why; when no significant hypothesis can, the winner's
+// alone with Augmentation::not_fixable set (fix() then reports "not
+// supported"). Empty without a winner.
 std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attribution& attribution, int count);
+
+// Whether planned[k] of plan_candidates() is a family alone: the plan right
+// after the same plan extended to its group.
+bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k);
 
 // The ranking fix() plans its candidates from: `attribution` re-floored at
 // options.min_excess_null (with_null_floor) when that is below the screen's

@@ -277,7 +277,7 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   // attenuates its gain, but aligning it is still right (docs/residual.md).
   const auto same_delay = [&](const HypothesisResult& r) { return r.hypothesis.delay == h.delay && r.parameter > 0; };
   for (const HypothesisResult* r : passing_in_group(data, attribution, a, EffectKind::kSensorDelay,
-                                                        channel_group(y_name(data, h.target)), same_delay)) {
+                                                    channel_group(y_name(data, h.target)), same_delay)) {
     const std::string& name = y_name(data, r->hypothesis.target);
     if (std::find(a.channels.begin(), a.channels.end(), name) != a.channels.end()) continue;
     a.channels.push_back(name);
@@ -724,7 +724,7 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
     return r.hypothesis.side == w.hypothesis.side && r.plausible;
   };
   for (const HypothesisResult* r : passing_in_group(data, attribution, a, EffectKind::kSaturation,
-                                                        channel_group(y_name(data, w.hypothesis.target)), same_side)) {
+                                                    channel_group(y_name(data, w.hypothesis.target)), same_side)) {
     const std::string& name = y_name(data, r->hypothesis.target);
     const bool clipped = std::any_of(change.clips.begin(), change.clips.end(), [&](const OutputClip& c) {
       return c.channel == name && c.side == r->hypothesis.side;
