@@ -149,8 +149,9 @@ void print_fix(const rs::FixResult& fixed) {
     std::printf(": Diebold-Mariano p %.2g", fixed.confirmation.p_value);
     if (fixed.folds > 1) std::printf(" (%d folds; the first alone: p %.2g)", fixed.folds, fixed.first_fold.p_value);
     std::printf(": %s\n", fixed.changed ? "confirmed" : "not confirmed, nothing applied");
+    if (fixed.simpler) std::printf("%s\n", simpler_sentence(*fixed.simpler, fixed.reference).c_str());
     for (const auto& wider : fixed.extensions) std::printf("%s\n", extension_sentence(wider).c_str());
-    if (widest_applied(fixed)) std::printf("the before/after above are the widest plan applied\n");
+    if (replaced_after_decision(fixed)) std::printf("the before/after above are the plan applied last\n");
     if (!fixed.folds_note.empty()) std::printf("note: %s\n", fixed.folds_note.c_str());
     if (fixed.candidates.size() > 1) {
       std::printf("candidates (the screen's order; * the one tested: the first whose gain over fine-tuning alone\n"

@@ -90,6 +90,25 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                                  {"rows", e.test.samples},
                                  {"p_value", e.test.p_value},
                                  {"applied", e.applied}});
+    // The simpler account tried after the confirmation (FixResult::simpler).
+    if (f.simpler) {
+      const rs::FixResult::SimplerAccount& a = *f.simpler;
+      json account = {{"effect", a.effect},
+                      {"replaces", a.replaces},
+                      {"channels", a.channels},
+                      {"against_reference", {{"against", f.reference},
+                                             {"mean_loss_difference", a.against_reference.mean},
+                                             {"statistic", a.against_reference.stat},
+                                             {"rows", a.against_reference.samples},
+                                             {"p_value", a.against_reference.p_value}}},
+                      {"applied", a.applied}};
+      if (a.gain_tested)
+        account["confirmed_gain"] = {{"mean_loss_difference", a.confirmed_gain.mean},
+                                     {"statistic", a.confirmed_gain.stat},
+                                     {"rows", a.confirmed_gain.samples},
+                                     {"p_value", a.confirmed_gain.p_value}};
+      j["simpler"] = account;
+    }
     json candidates = json::array();
     for (const auto& c : f.candidates)
       candidates.push_back({{"effect", c.effect},
@@ -141,8 +160,22 @@ std::string fix_table(const rs::FixResult& f) {
 
 }  // namespace
 
-bool widest_applied(const rs::FixResult& f) {
-  return std::any_of(f.extensions.begin(), f.extensions.end(), [](const auto& e) { return e.applied; });
+bool replaced_after_decision(const rs::FixResult& f) {
+  return (f.simpler && f.simpler->applied) ||
+         std::any_of(f.extensions.begin(), f.extensions.end(), [](const auto& e) { return e.applied; });
+}
+
+std::string simpler_sentence(const rs::FixResult::SimplerAccount& s, const std::string& reference) {
+  std::string m = "Simpler account: " + s.effect + " on ";
+  for (std::size_t i = 0; i < s.channels.size(); ++i) m += (i ? ", " : "") + s.channels[i];
+  m += ", against " + reference + " on their held-out rows (Diebold-Mariano, " +
+       std::to_string(s.against_reference.samples) + " rows): mean loss difference " +
+       num("%.3g", s.against_reference.mean) + ", p " + num("%.2g", s.against_reference.p_value);
+  if (!s.gain_tested) return m + ": not confirmed, " + s.replaces + " kept";
+  m += "; " + s.replaces + " against it there: mean loss difference " + num("%.3g", s.confirmed_gain.mean) +
+       ", p " + num("%.2g", s.confirmed_gain.p_value) + ": ";
+  return m + (s.applied ? "no significant gain, " + s.effect + " applied in its place"
+                        : "a significant gain, " + s.replaces + " kept");
 }
 
 std::string extension_sentence(const rs::FixResult::Extension& e) {
@@ -176,8 +209,9 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
          (f.folds > 1 ? " (the first fold alone: p " + num("%.2g", f.first_fold.p_value) + ")" : std::string()) +
          (f.folds_note.empty() ? std::string() : " (" + f.folds_note + ")") + ": **" + (f.changed ? "confirmed" : "not confirmed, nothing applied") +
          "**.\n\n";
+    if (f.simpler) m += simpler_sentence(*f.simpler, f.reference) + ".\n\n";
     for (const auto& e : f.extensions) m += extension_sentence(e) + ".\n\n";
-    if (widest_applied(f)) m += "The before/after below are the widest plan applied.\n\n";
+    if (replaced_after_decision(f)) m += "The before/after below are the plan applied last.\n\n";
     m += "Verdict after (the augmented model on its own frame): " + f.after.verdict + "\n\n";
   }
   if (f.changed && !f.model.sensor.empty()) {

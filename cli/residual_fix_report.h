@@ -22,9 +22,16 @@ std::string fix_markdown(const trainer::residual::FixResult& f, const trainer::r
 // applied. For stdout and REPORT.md.
 std::string extension_sentence(const trainer::residual::FixResult::Extension& e);
 
-// Whether a wider plan was applied after the confirmation: the before/after
-// are then the widest plan's.
-bool widest_applied(const trainer::residual::FixResult& f);
+// One sentence on the simpler account tried after the confirmation
+// (FixResult::simpler): its channels, its test against the reference, the
+// confirmed change's gain over it when tested, and whether it was applied.
+// For stdout and REPORT.md.
+std::string simpler_sentence(const trainer::residual::FixResult::SimplerAccount& s, const std::string& reference);
+
+// Whether a plan other than the decision's was applied after the
+// confirmation (the simpler account or a wider plan): the before/after are
+// then the plan applied last.
+bool replaced_after_decision(const trainer::residual::FixResult& f);
 
 // fix.png: each channel's held-out RMSE after the fix and after fine-tuning
 // alone, relative to before. Returns "" on success (or nothing to plot), else

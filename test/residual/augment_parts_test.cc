@@ -307,6 +307,40 @@ TEST(FixCandidates, TheFirstSignificantElseTheClearestGainIsTested) {
   EXPECT_EQ(chosen({}), 0u);
 }
 
+// The plan fix() tries as the simpler account of a confirmed calibration
+// curve (EffectInfo::simpler: a rail): a rail planned on the curve's lead
+// channel, its family alone before its extended plan; none for a rail on
+// another channel only, for a plan that cannot be added, or for an effect
+// without a simpler one.
+TEST(FixCandidates, TheSimplerAccountIsARailOnTheCurvesLeadChannel) {
+  const auto plan = [](residual::EffectKind kind, std::vector<std::string> channels, bool group_extension = true) {
+    residual::Augmentation a;
+    a.kind = kind;
+    a.channels = std::move(channels);
+    a.group_extension = group_extension;
+    return a;
+  };
+  using residual::EffectKind;
+  const residual::Augmentation curve = plan(EffectKind::kSensorCurve, {"fc4", "fc3", "fc0"});
+  std::vector<residual::Augmentation> planned = {curve, plan(EffectKind::kSaturation, {"fc4", "fc3", "fc7"}),
+                                                 plan(EffectKind::kSaturation, {"fc4"}, false)};
+  EXPECT_EQ(residual::simpler_account(planned, 0), std::optional<std::size_t>(2));
+  planned.pop_back();  // the extended rail alone
+  EXPECT_EQ(residual::simpler_account(planned, 0), std::optional<std::size_t>(1));
+  // A rail of fc3 only (not the curve's lead) is no account of it.
+  planned = {curve, plan(EffectKind::kSaturation, {"fc3"})};
+  EXPECT_EQ(residual::simpler_account(planned, 0), std::nullopt);
+  // A rail plan that cannot be added.
+  planned = {curve, plan(EffectKind::kSaturation, {"fc4"})};
+  planned[1].not_fixable = "nothing to clip";
+  EXPECT_EQ(residual::simpler_account(planned, 0), std::nullopt);
+  // A rail has no simpler account; neither has a delay.
+  planned = {plan(EffectKind::kSaturation, {"fc4"}), plan(EffectKind::kSensorCurve, {"fc4"})};
+  EXPECT_EQ(residual::simpler_account(planned, 0), std::nullopt);
+  planned = {plan(EffectKind::kSensorDelay, {"fc4"}), plan(EffectKind::kSaturation, {"fc4"})};
+  EXPECT_EQ(residual::simpler_account(planned, 0), std::nullopt);
+}
+
 // The ranking fix() plans its candidates from (candidates_view): by
 // default (stop 48) down to an excess share of 1, below the screen's 3;
 // never above the screen's floor; unset, the screen's; without a null the

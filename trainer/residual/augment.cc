@@ -196,6 +196,20 @@ bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k) {
          !planned[k - 1].extended_channels.empty();
 }
 
+std::optional<std::size_t> simpler_account(const std::vector<Augmentation>& planned, std::size_t k) {
+  const std::optional<EffectKind> simpler = effect_info(planned[k].kind).simpler;
+  if (!simpler || planned[k].channels.empty()) return std::nullopt;
+  const std::string& lead = planned[k].channels.front();
+  std::optional<std::size_t> found;
+  for (std::size_t s = 0; s < planned.size(); ++s) {
+    const Augmentation& a = planned[s];
+    if (a.kind != *simpler || !a.not_fixable.empty()) continue;
+    if (std::find(a.channels.begin(), a.channels.end(), lead) == a.channels.end()) continue;
+    if (!found || a.channels.size() < planned[*found].channels.size()) found = s;
+  }
+  return found;
+}
+
 std::optional<Augmentation> on_whole_group(const std::vector<std::string>& y_names, const SensorModel& sensor,
                                            const Augmentation& a) {
   if (a.kind != EffectKind::kSensorDelay || !std::holds_alternative<TimeAlignment>(a.change) || a.channels.empty())
@@ -439,14 +453,15 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     result.folds_note = "the mirrored fold was not judged: a log is too short for it, or --train-fraction is below "
                         "4/7 (its rows would overlap the rows that chose the candidate)";
   }
-  // The chosen plan's rows of the mirrored fold (options.folds 2), kept for the wider plans' tests below.
-  std::optional<HeldOutError> mirrored_after;
+  // The applied plan's and the reference's rows of the mirrored fold
+  // (options.folds 2), kept for the tests after the confirmation.
+  std::optional<HeldOutError> mirrored_after, mirrored_reference;
   if (options.folds == 2 && mirrored_fold_fits) {
     const Augmentation mirrored = refined(planned[chosen], mirrored_train, nullptr);
     mirrored_after = judged(tune(&mirrored, mirrored_train).model, mirrored_judged);
-    const HeldOutError r_rows = options.control ? judged(tune(nullptr, mirrored_train).model, mirrored_judged)
-                                                : held_out_error(model, eval_rows(model, before_pbs, mirrored_judged));
-    for (auto& segment : standardised_loss(model, r_rows, result.confirmation_channels))
+    mirrored_reference = options.control ? judged(tune(nullptr, mirrored_train).model, mirrored_judged)
+                                         : held_out_error(model, eval_rows(model, before_pbs, mirrored_judged));
+    for (auto& segment : standardised_loss(model, *mirrored_reference, result.confirmation_channels))
       reference_loss.push_back(std::move(segment));
     for (auto& segment : standardised_loss(model, *mirrored_after, result.confirmation_channels))
       after_loss.push_back(std::move(segment));
@@ -455,13 +470,82 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.confirmation = diebold_mariano(reference_loss, after_loss);
   const bool confirmed = result.confirmation.mean > 0 && result.confirmation.p_value < attribution.options.alpha;
 
+  // Another plan, re-estimated and fine-tuned as the tested candidate was,
+  // on each fold the decision judged (the mirrored fold's when it did).
+  struct FoldTrial {
+    Augmentation tested;
+    std::vector<double> rates;
+    HadynetModel untuned;
+    Tuned after;
+    HeldOutError rows;                     // the first fold's held-out rows
+    std::optional<HeldOutError> mirrored;  // the mirrored fold's
+  };
+  const auto fold_trial = [&](const Augmentation& plan) {
+    FoldTrial t;
+    t.tested = refined(plan, train_part, &t.rates);
+    t.after = tune(&t.tested, train_part, &t.untuned);
+    t.rows = judged(t.after.model, held_out_part);
+    if (mirrored_after) {
+      const Augmentation mirrored = refined(plan, mirrored_train, nullptr);
+      t.mirrored = judged(tune(&mirrored, mirrored_train).model, mirrored_judged);
+    }
+    return t;
+  };
+  // One-sided Diebold-Mariano on `channels`, on every fold judged: the loss
+  // of `a` (first fold, mirrored fold) minus that of `b`.
+  const auto compare = [&](const HeldOutError& a, const std::optional<HeldOutError>& a_mirrored, const HeldOutError& b,
+                           const std::optional<HeldOutError>& b_mirrored, const std::vector<std::string>& channels) {
+    Segments a_loss = standardised_loss(model, a, channels), b_loss = standardised_loss(model, b, channels);
+    if (a_mirrored && b_mirrored) {
+      for (auto& segment : standardised_loss(model, *a_mirrored, channels)) a_loss.push_back(std::move(segment));
+      for (auto& segment : standardised_loss(model, *b_mirrored, channels)) b_loss.push_back(std::move(segment));
+    }
+    return diebold_mariano(a_loss, b_loss);
+  };
+  const auto significant = [&](const DieboldMariano& t) {
+    return t.mean > 0 && t.p_value < attribution.options.alpha;
+  };
+  // The trial's plan becomes the applied one.
+  const auto apply = [&](FoldTrial& t) {
+    result.augmentation = t.tested;
+    result.fitted_rates = std::move(t.rates);
+    result.untuned = std::move(t.untuned);
+    result.loss_history = t.after.loss_history;
+    result.train_windows = t.after.train_windows;
+    result.after = std::move(t.rows);
+    mirrored_after = std::move(t.mirrored);
+    after = std::move(t.after);
+  };
+
+  // The simpler account (FixResult::simpler): a confirmed change that can
+  // imitate a simpler effect on its lead channel stands only if it predicts
+  // that plan's channels significantly better than the plan does, once the
+  // plan is confirmed against the reference itself.
+  std::size_t applied_plan = chosen;
+  if (confirmed)
+    if (const auto s = simpler_account(planned, chosen)) {
+      FixResult::SimplerAccount account;
+      account.effect = planned[*s].effect;
+      account.replaces = planned[chosen].effect;
+      account.channels = channels_of(planned[*s]);
+      FoldTrial t = fold_trial(planned[*s]);
+      account.against_reference = compare(reference, mirrored_reference, t.rows, t.mirrored, account.channels);
+      if (significant(account.against_reference)) {
+        account.gain_tested = true;
+        account.confirmed_gain = compare(t.rows, t.mirrored, result.after, mirrored_after, account.channels);
+        account.applied = !significant(account.confirmed_gain);
+      }
+      if (account.applied) {
+        apply(t);
+        applied_plan = *s;
+      }
+      result.simpler = std::move(account);
+    }
+
   // A wider plan, tested only after the test before it was significant (a fixed
   // sequence at alpha; FixResult::extensions): the plan applied so far
-  // against `wider` on the held-out rows of the channels `wider` adds (the
-  // first fold's, and the mirrored fold's when the decision judged it);
-  // applied when significant. `wider` is re-estimated on each fold's
-  // training rows as the tested candidate was. Returns whether it was
-  // applied.
+  // against `wider` on the held-out rows of the channels `wider` adds;
+  // applied when significant. Returns whether it was applied.
   const auto try_wider = [&](const Augmentation& wider, const std::string& what) {
     const Augmentation& current = *result.augmentation;
     FixResult::Extension e;
@@ -471,35 +555,12 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
           std::find(current.channels.begin(), current.channels.end(), name) == current.channels.end())
         e.channels.push_back(name);
     if (e.channels.empty()) return false;
-    std::vector<double> rates;
-    const Augmentation tested_wider = refined(wider, train_part, &rates);
-    HadynetModel wider_untuned;
-    Tuned wider_after = tune(&tested_wider, train_part, &wider_untuned);
-    HeldOutError wider_rows = judged(wider_after.model, held_out_part);
-    Segments current_loss = standardised_loss(model, result.after, e.channels);
-    Segments wider_loss = standardised_loss(model, wider_rows, e.channels);
-    std::optional<HeldOutError> wider_mirrored;
-    if (mirrored_after) {
-      const Augmentation mirrored = refined(wider, mirrored_train, nullptr);
-      wider_mirrored = judged(tune(&mirrored, mirrored_train).model, mirrored_judged);
-      for (auto& segment : standardised_loss(model, *mirrored_after, e.channels))
-        current_loss.push_back(std::move(segment));
-      for (auto& segment : standardised_loss(model, *wider_mirrored, e.channels))
-        wider_loss.push_back(std::move(segment));
-    }
-    e.test = diebold_mariano(current_loss, wider_loss);
-    e.applied = e.test.mean > 0 && e.test.p_value < attribution.options.alpha;
+    FoldTrial t = fold_trial(wider);
+    e.test = compare(result.after, mirrored_after, t.rows, t.mirrored, e.channels);
+    e.applied = significant(e.test);
     result.extensions.push_back(e);
-    if (!e.applied) return false;
-    result.augmentation = tested_wider;
-    result.fitted_rates = std::move(rates);
-    result.untuned = std::move(wider_untuned);
-    result.loss_history = wider_after.loss_history;
-    result.train_windows = wider_after.train_windows;
-    result.after = std::move(wider_rows);
-    mirrored_after = std::move(wider_mirrored);
-    after = std::move(wider_after);
-    return true;
+    if (e.applied) apply(t);
+    return e.applied;
   };
   // A confirmed family alone: does its extended plan predict the channels it
   // adds better? (The plant's delay of every loadcell aligned on a few, the
@@ -508,9 +569,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // its group the test did not find it on (an acquisition chain delays
   // every channel it carries, and a channel that barely moves hides it).
   if (confirmed) {
-    bool beyond_family = !planned[chosen].extended_channels.empty();
-    if (is_family_alone(planned, chosen))
-      beyond_family = try_wider(planned[chosen - 1], "its group's channels where the test finds the same effect");
+    bool beyond_family = !planned[applied_plan].extended_channels.empty();
+    if (is_family_alone(planned, applied_plan))
+      beyond_family = try_wider(planned[applied_plan - 1], "its group's channels where the test finds the same effect");
     if (beyond_family)
       if (const auto whole = on_whole_group(model.layout.y_names, model.sensor, *result.augmentation))
         try_wider(*whole, "every channel of its group");

@@ -271,6 +271,14 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
 // after the same plan extended to its group.
 bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k);
 
+// The candidate fix() tries as the simpler account of a confirmed
+// planned[k] (its effect's EffectInfo::simpler): the first plan of that
+// effect whose channels hold planned[k]'s lead channel (its first), its
+// family alone before its extended plan (the fewest channels first: a
+// wider plan is then tested as after any confirmed family alone); nullopt
+// when none was planned.
+std::optional<std::size_t> simpler_account(const std::vector<Augmentation>& planned, std::size_t k);
+
 // The ranking fix() plans its candidates from: `attribution` re-floored at
 // options.min_excess_null (with_null_floor) when that is below the screen's
 // floor, else `attribution` itself (never above the screen's floor; unset:
@@ -415,6 +423,30 @@ struct FixResult {
     bool applied = false;
   };
   std::vector<Extension> extensions;
+  // The simpler account, tried after a confirmed change whose effect has
+  // one (EffectInfo::simpler; simpler_account() names the plan) and before
+  // the wider plans: the simpler plan, re-estimated and fine-tuned as the
+  // tested candidate was (on each fold the decision judged), judged on the
+  // held-out rows of its channels against the reference (it must be
+  // confirmed itself), then, only if it is, the confirmed change against
+  // it there. It replaces the confirmed change (`augmentation`, `after`,
+  // `untuned`, `model`, `loss_history`, `train_windows`, `fitted_rates`,
+  // the verdict after) unless that change predicts those channels
+  // significantly better: of two accounts of one channel, the one with
+  // fewer parameters stands until the data reject it. The wider plans then
+  // start from the plan applied. Both tests at the attribution's alpha; the
+  // first runs only after the decision confirmed, so nothing is applied
+  // that the decision did not confirm. `confirmation` stays the decision's.
+  struct SimplerAccount {
+    std::string effect;                 // the simpler plan's effect
+    std::string replaces;               // the confirmed change's effect
+    std::vector<std::string> channels;  // the simpler plan's channels of the model (the tests' channels)
+    DieboldMariano against_reference;   // the reference's loss minus the simpler plan's there
+    DieboldMariano confirmed_gain;      // the simpler plan's loss minus the confirmed change's there (if tested)
+    bool gain_tested = false;           // against_reference was significant, so confirmed_gain was tested
+    bool applied = false;
+  };
+  std::optional<SimplerAccount> simpler;
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
   std::vector<double> fitted_rates;     // drift: the attribution's rate per channel, before refine(); else empty

@@ -1226,7 +1226,8 @@ const std::vector<EffectInfo>& effect_library() {
        "network, its prediction through g; g piecewise linear through 9 quantile knots, its slopes "
        "re-estimated on the training rows",
        SourceKind::kNone, sensor_curve::enumerate, sensor_curve::features, sensor_curve::slope_ratio,
-       sensor_curve::plausible_curve, sensor_curve::describe, sensor_curve::plan, nullptr},
+       sensor_curve::plausible_curve, sensor_curve::describe, sensor_curve::plan, nullptr, nullptr, nullptr,
+       EffectKind::kSaturation},
       {EffectKind::kCrosstalk, "crosstalk",
        "y_s(t) and y_s(t-1): another channel's measured value (by default of the target's group or unit) "
        "leaking into the target, and what the network carries over of it from x_{t-1}",
