@@ -242,7 +242,10 @@ int run_residual(int argc, char** argv) {
                               "each added, fine-tuned on the first 75 % of the training rows and compared with\n"
                               "fine-tuning alone on the rest; the first significant there, else the clearest gain,\n"
                               "else the screen's first, is the one the decision tests on the held-out rows (1: the\n"
-                              "screen's winner); a family alone confirmed there is then extended to its group when the\n"
+                              "screen's winner); a confirmed calibration curve gives way to a rail planned on its lead\n"
+                              "channel when the rail is confirmed itself and the curve does not predict the rail's\n"
+                              "channels significantly better (the simpler account); a family alone confirmed there is\n"
+                              "then extended to its group when the\n"
                               "extended plan predicts the channels it adds significantly better on the held-out rows,\n"
                               "and a delay seen beyond its family likewise to every channel of its group", "5");
   opt.value("fix-min-excess-null", "S",
