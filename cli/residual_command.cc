@@ -245,9 +245,9 @@ int run_residual(int argc, char** argv) {
                               "screen's winner); a confirmed calibration curve gives way to a rail planned on its lead\n"
                               "channel when the rail is confirmed itself and the curve does not predict the rail's\n"
                               "channels significantly better (the simpler account); a family alone confirmed there is\n"
-                              "then extended to its group when the\n"
-                              "extended plan predicts the channels it adds significantly better on the held-out rows,\n"
-                              "and a delay seen beyond its family likewise to every channel of its group", "5");
+                              "then extended to its group when the extended plan predicts the channels it adds\n"
+                              "significantly better on the held-out rows, and a delay seen beyond its family likewise\n"
+                              "to every channel of its group", "5");
   opt.value("fix-min-excess-null", "S",
             "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"
             "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"
