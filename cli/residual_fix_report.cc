@@ -95,7 +95,9 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
       const rs::FixResult::SimplerAccount& a = *f.simpler;
       json account = {{"effect", a.effect},
                       {"replaces", a.replaces},
+                      {"description", a.description},
                       {"channels", a.channels},
+                      {"a_candidate", a.a_candidate},
                       {"against_reference", {{"against", f.reference},
                                              {"mean_loss_difference", a.against_reference.mean},
                                              {"statistic", a.against_reference.stat},
@@ -168,6 +170,7 @@ bool replaced_after_decision(const rs::FixResult& f) {
 std::string simpler_sentence(const rs::FixResult::SimplerAccount& s, const std::string& reference) {
   std::string m = "Simpler account: " + s.effect + " on ";
   for (std::size_t i = 0; i < s.channels.size(); ++i) m += (i ? ", " : "") + s.channels[i];
+  if (!s.a_candidate) m += " (planned from below the candidates' floor)";
   m += ", against " + reference + " on their held-out rows (Diebold-Mariano, " +
        std::to_string(s.against_reference.samples) + " rows): mean loss difference " +
        num("%.3g", s.against_reference.mean) + ", p " + num("%.2g", s.against_reference.p_value);

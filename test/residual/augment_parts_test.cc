@@ -307,11 +307,12 @@ TEST(FixCandidates, TheFirstSignificantElseTheClearestGainIsTested) {
   EXPECT_EQ(chosen({}), 0u);
 }
 
-// The plan fix() tries as the simpler account of a confirmed calibration
-// curve (EffectInfo::simpler: a rail): a rail planned on the curve's lead
-// channel, its family alone before its extended plan; none for a rail on
-// another channel only, for a plan that cannot be added, or for an effect
-// without a simpler one.
+// The plans fix() tries as the simpler account of a confirmed calibration
+// curve (EffectInfo::simpler: a rail): the rails planned on the curve's
+// lead channel, fewest channels first; none for a rail on another channel
+// only, for a plan that cannot be added, or for an effect without a
+// simpler one. (With none planned, the ranking without the floor is
+// searched: here it is empty; cli.residual.rail_simpler_account runs it.)
 TEST(FixCandidates, TheSimplerAccountIsARailOnTheCurvesLeadChannel) {
   const auto plan = [](residual::EffectKind kind, std::vector<std::string> channels, bool group_extension = true) {
     residual::Augmentation a;
@@ -321,24 +322,33 @@ TEST(FixCandidates, TheSimplerAccountIsARailOnTheCurvesLeadChannel) {
     return a;
   };
   using residual::EffectKind;
+  residual::ResidualData data;
+  data.y_names = {"fc0", "fc1", "fc2", "fc3", "fc4", "fc5", "fc6", "fc7", "fc8"};
+  const residual::Attribution floorless;
+  const auto simpler = [&](const std::vector<residual::Augmentation>& planned) {
+    std::vector<std::vector<std::string>> out;
+    for (const auto& a : residual::simpler_plans(data, floorless, planned, 0)) out.push_back(a.channels);
+    return out;
+  };
+  using Channels = std::vector<std::vector<std::string>>;
   const residual::Augmentation curve = plan(EffectKind::kSensorCurve, {"fc4", "fc3", "fc0"});
   std::vector<residual::Augmentation> planned = {curve, plan(EffectKind::kSaturation, {"fc4", "fc3", "fc7"}),
                                                  plan(EffectKind::kSaturation, {"fc4"}, false)};
-  EXPECT_EQ(residual::simpler_account(planned, 0), std::optional<std::size_t>(2));
+  EXPECT_EQ(simpler(planned), (Channels{{"fc4"}, {"fc4", "fc3", "fc7"}}));
   planned.pop_back();  // the extended rail alone
-  EXPECT_EQ(residual::simpler_account(planned, 0), std::optional<std::size_t>(1));
+  EXPECT_EQ(simpler(planned), (Channels{{"fc4", "fc3", "fc7"}}));
   // A rail of fc3 only (not the curve's lead) is no account of it.
   planned = {curve, plan(EffectKind::kSaturation, {"fc3"})};
-  EXPECT_EQ(residual::simpler_account(planned, 0), std::nullopt);
+  EXPECT_EQ(simpler(planned), Channels{});
   // A rail plan that cannot be added.
   planned = {curve, plan(EffectKind::kSaturation, {"fc4"})};
   planned[1].not_fixable = "nothing to clip";
-  EXPECT_EQ(residual::simpler_account(planned, 0), std::nullopt);
+  EXPECT_EQ(simpler(planned), Channels{});
   // A rail has no simpler account; neither has a delay.
   planned = {plan(EffectKind::kSaturation, {"fc4"}), plan(EffectKind::kSensorCurve, {"fc4"})};
-  EXPECT_EQ(residual::simpler_account(planned, 0), std::nullopt);
+  EXPECT_EQ(simpler(planned), Channels{});
   planned = {plan(EffectKind::kSensorDelay, {"fc4"}), plan(EffectKind::kSaturation, {"fc4"})};
-  EXPECT_EQ(residual::simpler_account(planned, 0), std::nullopt);
+  EXPECT_EQ(simpler(planned), Channels{});
 }
 
 // The ranking fix() plans its candidates from (candidates_view): by

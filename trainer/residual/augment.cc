@@ -120,6 +120,23 @@ std::size_t chosen_candidate(const std::vector<CandidateTrial>& candidates, doub
   return chosen;
 }
 
+namespace {
+
+// The augmentation of significant hypothesis `r` (its effect's plan), with
+// or without its group extension.
+Augmentation planned_for(const ResidualData& data, const Attribution& attribution, const HypothesisResult& r,
+                         bool group_extension) {
+  Augmentation a;
+  a.kind = r.hypothesis.kind;
+  a.effect = r.effect;
+  a.screen_statistic = floor_statistic(attribution, r);
+  a.group_extension = group_extension;
+  effect_info(a.kind).plan(data, attribution, r, a);
+  return a;
+}
+
+}  // namespace
+
 std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attribution& attribution, int count) {
   std::vector<Augmentation> out;
   const auto winner = attribution.winner();
@@ -139,13 +156,7 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   std::string winner_not_fixable;
   std::vector<EffectKind> leads;
   const auto plan_of = [&](const HypothesisResult& r, bool group_extension) {
-    Augmentation a;
-    a.kind = r.hypothesis.kind;
-    a.effect = r.effect;
-    a.screen_statistic = floor_statistic(attribution, r);
-    a.group_extension = group_extension;
-    effect_info(a.kind).plan(data, attribution, r, a);
-    return a;
+    return planned_for(data, attribution, r, group_extension);
   };
   for (const auto& r : attribution.ranked) {
     if (!r.significant || static_cast<int>(out.size()) >= count) break;
@@ -196,18 +207,36 @@ bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k) {
          !planned[k - 1].extended_channels.empty();
 }
 
-std::optional<std::size_t> simpler_account(const std::vector<Augmentation>& planned, std::size_t k) {
+std::vector<Augmentation> simpler_plans(const ResidualData& data, const Attribution& floorless,
+                                       const std::vector<Augmentation>& planned, std::size_t k) {
+  std::vector<Augmentation> out;
   const std::optional<EffectKind> simpler = effect_info(planned[k].kind).simpler;
-  if (!simpler || planned[k].channels.empty()) return std::nullopt;
+  if (!simpler || planned[k].channels.empty()) return out;
   const std::string& lead = planned[k].channels.front();
-  std::optional<std::size_t> found;
-  for (std::size_t s = 0; s < planned.size(); ++s) {
-    const Augmentation& a = planned[s];
-    if (a.kind != *simpler || !a.not_fixable.empty()) continue;
-    if (std::find(a.channels.begin(), a.channels.end(), lead) == a.channels.end()) continue;
-    if (!found || a.channels.size() < planned[*found].channels.size()) found = s;
+  for (const Augmentation& a : planned)
+    if (a.kind == *simpler && a.not_fixable.empty() &&
+        std::find(a.channels.begin(), a.channels.end(), lead) != a.channels.end())
+      out.push_back(a);
+  if (out.empty()) {
+    const int target = index_of(data.y_names, lead);
+    for (const auto& r : floorless.ranked) {
+      if (!r.significant) break;
+      if (r.hypothesis.kind != *simpler || r.hypothesis.target != target) continue;
+      if (!why_not_fixable(data, floorless, r).empty()) break;
+      Augmentation a = planned_for(data, floorless, r, true);
+      if (!a.not_fixable.empty()) break;
+      const bool extended = !a.extended_channels.empty();
+      out.push_back(std::move(a));
+      if (extended) {
+        Augmentation family_alone = planned_for(data, floorless, r, false);
+        if (family_alone.not_fixable.empty()) out.push_back(std::move(family_alone));
+      }
+      break;
+    }
   }
-  return found;
+  std::stable_sort(out.begin(), out.end(),
+                   [](const Augmentation& a, const Augmentation& b) { return a.channels.size() < b.channels.size(); });
+  return out;
 }
 
 std::optional<Augmentation> on_whole_group(const std::vector<std::string>& y_names, const SensorModel& sensor,
@@ -520,27 +549,38 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // The simpler account (FixResult::simpler): a confirmed change that can
   // imitate a simpler effect on its lead channel stands only if it predicts
   // that plan's channels significantly better than the plan does, once the
-  // plan is confirmed against the reference itself.
-  std::size_t applied_plan = chosen;
-  if (confirmed)
-    if (const auto s = simpler_account(planned, chosen)) {
-      FixResult::SimplerAccount account;
-      account.effect = planned[*s].effect;
-      account.replaces = planned[chosen].effect;
-      account.channels = channels_of(planned[*s]);
-      FoldTrial t = fold_trial(planned[*s]);
-      account.against_reference = compare(reference, mirrored_reference, t.rows, t.mirrored, account.channels);
-      if (significant(account.against_reference)) {
-        account.gain_tested = true;
-        account.confirmed_gain = compare(t.rows, t.mirrored, result.after, mirrored_after, account.channels);
-        account.applied = !significant(account.confirmed_gain);
-      }
-      if (account.applied) {
-        apply(t);
-        applied_plan = *s;
-      }
-      result.simpler = std::move(account);
+  // plan is confirmed against the reference itself. Tried on the plan with
+  // the fewest channels; its extended plan, if any, is then a wider plan.
+  // A plan that needs more rows than the candidates were judged on is not
+  // tried (a simpler effect that delays).
+  const Augmentation* extended_of_applied = is_family_alone(planned, chosen) ? &planned[chosen - 1] : nullptr;
+  bool applied_extended = !planned[chosen].extended_channels.empty();
+  std::vector<Augmentation> simpler;
+  if (confirmed) simpler = simpler_plans(data, with_null_floor(attribution, 0), planned, chosen);
+  if (!simpler.empty() && sensor_after(model.sensor, simpler.front()).max_delay() <= d) {
+    const Augmentation& plan = simpler.front();
+    FixResult::SimplerAccount account;
+    account.effect = plan.effect;
+    account.replaces = planned[chosen].effect;
+    account.description = plan.description;
+    account.channels = channels_of(plan);
+    account.a_candidate = std::any_of(planned.begin(), planned.end(), [&](const Augmentation& a) {
+      return a.kind == plan.kind && a.channels == plan.channels;
+    });
+    FoldTrial t = fold_trial(plan);
+    account.against_reference = compare(reference, mirrored_reference, t.rows, t.mirrored, account.channels);
+    if (significant(account.against_reference)) {
+      account.gain_tested = true;
+      account.confirmed_gain = compare(t.rows, t.mirrored, result.after, mirrored_after, account.channels);
+      account.applied = !significant(account.confirmed_gain);
     }
+    if (account.applied) {
+      apply(t);
+      extended_of_applied = simpler.size() > 1 ? &simpler.back() : nullptr;
+      applied_extended = !plan.extended_channels.empty();
+    }
+    result.simpler = std::move(account);
+  }
 
   // A wider plan, tested only after the test before it was significant (a fixed
   // sequence at alpha; FixResult::extensions): the plan applied so far
@@ -569,9 +609,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // its group the test did not find it on (an acquisition chain delays
   // every channel it carries, and a channel that barely moves hides it).
   if (confirmed) {
-    bool beyond_family = !planned[applied_plan].extended_channels.empty();
-    if (is_family_alone(planned, applied_plan))
-      beyond_family = try_wider(planned[applied_plan - 1], "its group's channels where the test finds the same effect");
+    bool beyond_family = applied_extended;
+    if (extended_of_applied != nullptr)
+      beyond_family = try_wider(*extended_of_applied, "its group's channels where the test finds the same effect");
     if (beyond_family)
       if (const auto whole = on_whole_group(model.layout.y_names, model.sensor, *result.augmentation))
         try_wider(*whole, "every channel of its group");

@@ -271,13 +271,19 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
 // after the same plan extended to its group.
 bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k);
 
-// The candidate fix() tries as the simpler account of a confirmed
-// planned[k] (its effect's EffectInfo::simpler): the first plan of that
-// effect whose channels hold planned[k]'s lead channel (its first), its
-// family alone before its extended plan (the fewest channels first: a
-// wider plan is then tested as after any confirmed family alone); nullopt
-// when none was planned.
-std::optional<std::size_t> simpler_account(const std::vector<Augmentation>& planned, std::size_t k);
+// The plans fix() tries as the simpler account of a confirmed planned[k]
+// (its effect's EffectInfo::simpler), fewest channels first: the plans of
+// that effect among `planned` whose channels hold planned[k]'s lead
+// channel (its first); when none was planned, those of the simpler
+// effect's best hypothesis on the lead channel in `floorless` (the
+// attribution with no floor on the excess share, with_null_floor(.., 0):
+// a hypothesis that passes the test but explains too little beyond the
+// null to be a candidate), planned as plan_candidates() plans one (its
+// family alone, and its group when that adds channels). Empty when
+// neither holds one. fix() tests the first and then, as a wider plan, the
+// last.
+std::vector<Augmentation> simpler_plans(const ResidualData& data, const Attribution& floorless,
+                                        const std::vector<Augmentation>& planned, std::size_t k);
 
 // The ranking fix() plans its candidates from: `attribution` re-floored at
 // options.min_excess_null (with_null_floor) when that is below the screen's
@@ -433,13 +439,17 @@ struct FixResult {
   // `untuned`, `model`, `loss_history`, `train_windows`, `fitted_rates`,
   // the verdict after) unless that change predicts those channels
   // significantly better: of two accounts of one channel, the one with
-  // fewer parameters stands until the data reject it. The wider plans then
-  // start from the plan applied. Both tests at the attribution's alpha; the
+  // fewer parameters stands until the data reject it. The plan may come
+  // from below the candidates' floor (simpler_plans: the decision has
+  // already found the channel's effect; the class is what is asked). The
+  // wider plans then start from the plan applied. Both tests at the attribution's alpha; the
   // first runs only after the decision confirmed, so nothing is applied
   // that the decision did not confirm. `confirmation` stays the decision's.
   struct SimplerAccount {
     std::string effect;                 // the simpler plan's effect
     std::string replaces;               // the confirmed change's effect
+    std::string description;            // the simpler plan, as planned
+    bool a_candidate = false;           // the plan was one of the candidates (else from below their floor)
     std::vector<std::string> channels;  // the simpler plan's channels of the model (the tests' channels)
     DieboldMariano against_reference;   // the reference's loss minus the simpler plan's there
     DieboldMariano confirmed_gain;      // the simpler plan's loss minus the confirmed change's there (if tested)
