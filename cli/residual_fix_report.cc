@@ -105,7 +105,8 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                                              {"p_value", a.against_reference.p_value}}},
                       {"applied", a.applied}};
       if (a.gain_tested)
-        account["confirmed_gain"] = {{"mean_loss_difference", a.confirmed_gain.mean},
+        account["confirmed_gain"] = {{"channels", a.gain_channels},
+                                     {"mean_loss_difference", a.confirmed_gain.mean},
                                      {"statistic", a.confirmed_gain.stat},
                                      {"rows", a.confirmed_gain.samples},
                                      {"p_value", a.confirmed_gain.p_value}};
@@ -170,12 +171,14 @@ bool replaced_after_decision(const rs::FixResult& f) {
 std::string simpler_sentence(const rs::FixResult::SimplerAccount& s, const std::string& reference) {
   std::string m = "Simpler account: " + s.effect + " on ";
   for (std::size_t i = 0; i < s.channels.size(); ++i) m += (i ? ", " : "") + s.channels[i];
-  if (!s.a_candidate) m += " (planned from below the candidates' floor)";
+  if (!s.a_candidate) m += " (not among the candidates)";
   m += ", against " + reference + " on their held-out rows (Diebold-Mariano, " +
        std::to_string(s.against_reference.samples) + " rows): mean loss difference " +
        num("%.3g", s.against_reference.mean) + ", p " + num("%.2g", s.against_reference.p_value);
   if (!s.gain_tested) return m + ": not confirmed, " + s.replaces + " kept";
-  m += "; " + s.replaces + " against it there: mean loss difference " + num("%.3g", s.confirmed_gain.mean) +
+  m += "; " + s.replaces + " against it on ";
+  for (std::size_t i = 0; i < s.gain_channels.size(); ++i) m += (i ? ", " : "") + s.gain_channels[i];
+  m += ": mean loss difference " + num("%.3g", s.confirmed_gain.mean) +
        ", p " + num("%.2g", s.confirmed_gain.p_value) + ": ";
   return m + (s.applied ? "no significant gain, " + s.effect + " applied in its place"
                         : "a significant gain, " + s.replaces + " kept");

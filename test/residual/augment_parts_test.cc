@@ -351,6 +351,38 @@ TEST(FixCandidates, TheSimplerAccountIsARailOnTheCurvesLeadChannel) {
   EXPECT_EQ(simpler(planned), Channels{});
 }
 
+// With no rail among the candidates, the simpler account is planned from
+// the ranking without its floor: on the lead's group and side only, the
+// lead first, though a rail of another group (a length's lower rail) or
+// side ranks above it.
+TEST(FixCandidates, ASimplerAccountBelowTheFloorKeepsTheLeadsGroupAndSide) {
+  residual::ResidualData data;
+  data.y_names = {"l4", "fc3", "fc4", "fc7"};
+  residual::Attribution floorless;
+  const auto rail = [&](int target, int side, double level) {
+    residual::HypothesisResult r;
+    r.hypothesis = {residual::EffectKind::kSaturation, target, -1, 0, side, level};
+    r.effect = "saturation";
+    r.label = "rail of " + data.y_names[static_cast<std::size_t>(target)];
+    r.p_adjusted = 1e-9;
+    r.explained = 0.3;
+    r.significant = true;
+    return r;
+  };
+  // In ranking order: l4's lower rail, fc7's lower rail, fc4's and fc3's upper rails.
+  floorless.ranked = {rail(0, -1, 224.9), rail(3, -1, 0.1), rail(2, +1, 3.04), rail(1, +1, 3.05)};
+  residual::Augmentation curve;
+  curve.kind = residual::EffectKind::kSensorCurve;
+  curve.channels = {"fc3", "fc7"};
+  const auto plans = residual::simpler_plans(data, floorless, {curve}, 0);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_EQ(plans[0].channels, (std::vector<std::string>{"fc3", "fc4"}));
+  EXPECT_EQ(plans[0].kind, residual::EffectKind::kSaturation);
+  // No significant rail on the lead: nothing.
+  floorless.ranked.pop_back();
+  EXPECT_TRUE(residual::simpler_plans(data, floorless, {curve}, 0).empty());
+}
+
 // The ranking fix() plans its candidates from (candidates_view): by
 // default (stop 48) down to an excess share of 1, below the screen's 3;
 // never above the screen's floor; unset, the screen's; without a null the

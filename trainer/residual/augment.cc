@@ -219,19 +219,32 @@ std::vector<Augmentation> simpler_plans(const ResidualData& data, const Attribut
       out.push_back(a);
   if (out.empty()) {
     const int target = index_of(data.y_names, lead);
-    for (const auto& r : floorless.ranked) {
-      if (!r.significant) break;
-      if (r.hypothesis.kind != *simpler || r.hypothesis.target != target) continue;
-      if (!why_not_fixable(data, floorless, r).empty()) break;
-      Augmentation a = planned_for(data, floorless, r, true);
-      if (!a.not_fixable.empty()) break;
-      const bool extended = !a.extended_channels.empty();
-      out.push_back(std::move(a));
-      if (extended) {
-        Augmentation family_alone = planned_for(data, floorless, r, false);
-        if (family_alone.not_fixable.empty()) out.push_back(std::move(family_alone));
-      }
-      break;
+    const auto best = std::find_if(floorless.ranked.begin(), floorless.ranked.end(), [&](const HypothesisResult& r) {
+      return r.significant && r.hypothesis.kind == *simpler && r.hypothesis.target == target;
+    });
+    if (best == floorless.ranked.end() || !why_not_fixable(data, floorless, *best).empty()) return out;
+    // Without the floor, the effect's family (Attribution::family_of: every
+    // channel where it is significant) can reach other groups and the other
+    // side: the plan holds the lead's group and side only, the lead first.
+    Attribution view = floorless;
+    const std::string group = channel_group(lead);
+    for (auto& r : view.ranked)
+      if (r.hypothesis.kind == *simpler &&
+          (channel_group(data.y_names[static_cast<std::size_t>(r.hypothesis.target)]) != group ||
+           r.hypothesis.side != best->hypothesis.side))
+        r.significant = false;
+    std::stable_partition(view.ranked.begin(), view.ranked.end(), [](const HypothesisResult& r) { return r.significant; });
+    const auto lead_at = std::find_if(view.ranked.begin(), view.ranked.end(), [&](const HypothesisResult& r) {
+      return r.significant && r.hypothesis.kind == *simpler && r.hypothesis.target == target;
+    });
+    std::rotate(view.ranked.begin(), lead_at, lead_at + 1);
+    Augmentation a = planned_for(data, view, view.ranked.front(), true);
+    if (!a.not_fixable.empty()) return out;
+    const bool extended = !a.extended_channels.empty();
+    out.push_back(std::move(a));
+    if (extended) {
+      Augmentation family_alone = planned_for(data, view, view.ranked.front(), false);
+      if (family_alone.not_fixable.empty()) out.push_back(std::move(family_alone));
     }
   }
   std::stable_sort(out.begin(), out.end(),
@@ -548,16 +561,20 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
 
   // The simpler account (FixResult::simpler): a confirmed change that can
   // imitate a simpler effect on its lead channel stands only if it predicts
-  // that plan's channels significantly better than the plan does, once the
-  // plan is confirmed against the reference itself. Tried on the plan with
-  // the fewest channels; its extended plan, if any, is then a wider plan.
-  // A plan that needs more rows than the candidates were judged on is not
-  // tried (a simpler effect that delays).
+  // the channels either claims significantly better than the simpler plan
+  // does, once that plan is confirmed against the reference itself. Tried
+  // on the plan with the fewest channels; its extended plan, if any, is
+  // then a wider plan. Plans that need more rows than the candidates were
+  // judged on are not tried (a simpler effect that delays).
   const Augmentation* extended_of_applied = is_family_alone(planned, chosen) ? &planned[chosen - 1] : nullptr;
   bool applied_extended = !planned[chosen].extended_channels.empty();
   std::vector<Augmentation> simpler;
   if (confirmed) simpler = simpler_plans(data, with_null_floor(attribution, 0), planned, chosen);
-  if (!simpler.empty() && sensor_after(model.sensor, simpler.front()).max_delay() <= d) {
+  const auto judged_rows_suffice = [&](const std::vector<Augmentation>& plans) {
+    return std::all_of(plans.begin(), plans.end(),
+                       [&](const Augmentation& a) { return sensor_after(model.sensor, a).max_delay() <= d; });
+  };
+  if (!simpler.empty() && judged_rows_suffice(simpler)) {
     const Augmentation& plan = simpler.front();
     FixResult::SimplerAccount account;
     account.effect = plan.effect;
@@ -570,8 +587,13 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     FoldTrial t = fold_trial(plan);
     account.against_reference = compare(reference, mirrored_reference, t.rows, t.mirrored, account.channels);
     if (significant(account.against_reference)) {
+      // Where either account claims something: the confirmed change's channels and the simpler plan's.
+      account.gain_channels = result.confirmation_channels;
+      for (const auto& name : account.channels)
+        if (std::find(account.gain_channels.begin(), account.gain_channels.end(), name) == account.gain_channels.end())
+          account.gain_channels.push_back(name);
       account.gain_tested = true;
-      account.confirmed_gain = compare(t.rows, t.mirrored, result.after, mirrored_after, account.channels);
+      account.confirmed_gain = compare(t.rows, t.mirrored, result.after, mirrored_after, account.gain_channels);
       account.applied = !significant(account.confirmed_gain);
     }
     if (account.applied) {

@@ -279,8 +279,8 @@ bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k);
 // attribution with no floor on the excess share, with_null_floor(.., 0):
 // a hypothesis that passes the test but explains too little beyond the
 // null to be a candidate), planned as plan_candidates() plans one (its
-// family alone, and its group when that adds channels). Empty when
-// neither holds one. fix() tests the first and then, as a wider plan, the
+// family alone, and its group when that adds channels), on the lead's
+// group and side only, the lead first. Empty when neither holds one. fix() tests the first and then, as a wider plan, the
 // last.
 std::vector<Augmentation> simpler_plans(const ResidualData& data, const Attribution& floorless,
                                         const std::vector<Augmentation>& planned, std::size_t k);
@@ -430,16 +430,17 @@ struct FixResult {
   };
   std::vector<Extension> extensions;
   // The simpler account, tried after a confirmed change whose effect has
-  // one (EffectInfo::simpler; simpler_account() names the plan) and before
-  // the wider plans: the simpler plan, re-estimated and fine-tuned as the
+  // one (EffectInfo::simpler; simpler_plans() plans it) and before the
+  // wider plans: the simpler plan, re-estimated and fine-tuned as the
   // tested candidate was (on each fold the decision judged), judged on the
   // held-out rows of its channels against the reference (it must be
   // confirmed itself), then, only if it is, the confirmed change against
-  // it there. It replaces the confirmed change (`augmentation`, `after`,
-  // `untuned`, `model`, `loss_history`, `train_windows`, `fitted_rates`,
-  // the verdict after) unless that change predicts those channels
-  // significantly better: of two accounts of one channel, the one with
-  // fewer parameters stands until the data reject it. The plan may come
+  // it on the channels either claims (the confirmation's and the plan's).
+  // It replaces the confirmed change (`augmentation`, `after`, `untuned`,
+  // `model`, `loss_history`, `train_windows`, `fitted_rates`, the verdict
+  // after) unless that change predicts those channels significantly
+  // better: of two accounts of one channel, the one with fewer parameters
+  // stands until the data reject it. The plan may come
   // from below the candidates' floor (simpler_plans: the decision has
   // already found the channel's effect; the class is what is asked). The
   // wider plans then start from the plan applied. Both tests at the attribution's alpha; the
@@ -449,9 +450,10 @@ struct FixResult {
     std::string effect;                 // the simpler plan's effect
     std::string replaces;               // the confirmed change's effect
     std::string description;            // the simpler plan, as planned
-    bool a_candidate = false;           // the plan was one of the candidates (else from below their floor)
+    bool a_candidate = false;           // the plan was one of the candidates (else planned from the ranking)
     std::vector<std::string> channels;  // the simpler plan's channels of the model (the tests' channels)
     DieboldMariano against_reference;   // the reference's loss minus the simpler plan's there
+    std::vector<std::string> gain_channels;  // the confirmation's channels and the plan's (if tested)
     DieboldMariano confirmed_gain;      // the simpler plan's loss minus the confirmed change's there (if tested)
     bool gain_tested = false;           // against_reference was significant, so confirmed_gain was tested
     bool applied = false;
