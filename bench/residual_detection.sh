@@ -7,7 +7,9 @@
 #   named     --fix confirmed the right effect with the right parameter (one
 #             rule per plant effect: bench/residual_named.py);
 #   cut       the held-out 1-step RMSE on the changed channels (mean ratio
-#             after/before) is at most 0.7;
+#             after/before) is at most 0.7 (the channels the decision
+#             judged, or a simpler account's, when one was applied: its
+#             own test's);
 #   <control  the augmented model's RMSE there is below fine-tuning alone's.
 # Disjoint roles: the model is trained on seed 1 (collect --preset paper;
 # its stored null is held-out rows of those logs; the 4-seed model of stop
@@ -126,6 +128,16 @@
 # delay measured with the final code (stop 51's code re-run on the same
 # logs where a wider plan was applied); 1583 then a test seed
 # (test/cli/residual_plant_delay_test.sh); 1517-1526 sensor-delay=2 re-run.
+# Stop 53 (the simpler account: a rail before a curve): 1592-1601
+# saturation=2 and saturation=3 and sensor-curve=0.7 and 0.85 of 1592-1596
+# development of its first version; 1612-1621 saturation=2, saturation=3
+# and sensor-curve=0.7 measured with it, of which saturation=3 of 1612
+# then, with saturation=3 of 1517, development of the plan from below the
+# floor, and 1595, 1596 and 1599 again of the final rule (the confirmed
+# change tested on the channels either claims); 1622-1631 saturation=2,
+# saturation=3 and sensor-curve=0.7 measured (the sets whose curve was
+# confirmed re-run with the final code); 1595 then a test seed
+# (test/cli/residual_rail_simpler_test.sh).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...
@@ -213,7 +225,11 @@ if fix.get("after") and fix.get("before") and channels:
         return {c["channel"]: c["rmse"] for c in fix[part]["channels"]}
     before, after = rmse("before"), rmse("after")
     control = rmse("control") if fix.get("control") else {}
-    tested = [c for c in (fix.get("confirmation", {}).get("channels") or channels) if c in before and c in after]
+    # The decision's channels; a simpler account applied in the confirmed
+    # change's place (fix.simpler) was confirmed on its own channels.
+    simpler = fix.get("simpler") or {}
+    judged = simpler["channels"] if simpler.get("applied") else fix.get("confirmation", {}).get("channels")
+    tested = [c for c in (judged or channels) if c in before and c in after]
     if tested:
         ratio = sum(after[c] / before[c] for c in tested) / len(tested)
         cut = ratio <= 0.7

@@ -73,6 +73,8 @@
 # path of test/cli/residual_injected_effects.sh, nothing confirmed. Stop
 # 52 (wider plans tested after the confirmation): 1582-1591 and 1602-1611
 # measured, 1 confirmed (1609, a calibration curve; stop 51's code too).
+# Stop 53 (the simpler account, which runs only after a confirmation):
+# 1612-1621 measured with its first version, 1622-1631 with the final code.
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
