@@ -9,8 +9,9 @@
 # the clearest gain, the decision confirmed it (p 0.0094) and it was
 # applied. Now the rail of the curve's lead channel, confirmed against
 # fine-tuning alone on its own rows (p 0.00075 on this machine), replaces
-# it, since the curve predicts fc4 no better (p 0.99), and its extension
-# to the group follows. On another CPU the selection may choose a rail at
+# it, since the curve does not predict the channels either claims
+# significantly better (p 0.039, at alpha 0.01), and its extension to the
+# group follows. On another CPU the selection may choose a rail at
 # once; either path passes, but a curve chosen must be followed by the
 # simpler account, reported (fix.simpler, which stop 52's code lacks) and
 # applied. Also checked: the lead's held-out RMSE cut by 30 % and below
