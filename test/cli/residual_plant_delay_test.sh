@@ -30,8 +30,10 @@ find "$work/raw" -name "*.csv" -exec cp {} "$work/logs/" \;
 "$hadynet" residual "$model" "$work/logs" --rated-range fc=0..50 --rated-range f=0..200 --fix \
   --json "$work/residual.json" >"$work/out.txt" 2>&1 || { echo "FAIL: residual"; tail -5 "$work/out.txt"; exit 1; }
 grep -E "^(decision|Extension)" "$work/out.txt"
-python3 - "$work/residual.json" <<'PY'
+python3 - "$work/residual.json" "$here/test/cli" <<'PY'
 import json, sys
+sys.path.insert(0, sys.argv[2])
+from plant_fix_checks import lead_and_loadcells
 fix = json.load(open(sys.argv[1]))["fix"]
 aug = fix.get("augmentation") or {}
 channels = aug.get("channels", [])
@@ -51,16 +53,7 @@ for e in extensions or []:
     print(f"extension to {e['what']}: {e['channels']}, p {e['p_value']:.2g}, applied {e['applied']}")
 family_alone_first = bool(extensions) and extensions[0]["what"].startswith("its group's channels")
 check(not family_alone_first or extensions[0]["applied"], "the family alone was not extended to its group")
-if fix.get("changed") and channels:
-    rmse = lambda part: {c["channel"]: c["rmse"] for c in fix[part]["channels"]}
-    before, control, after = rmse("before"), rmse("control"), rmse("after")
-    w = channels[0]  # the lead of the aligned family
-    print(f"{w}: before {before[w]:.4g}, fine-tuning alone {control[w]:.4g}, fixed {after[w]:.4g}")
-    check(after[w] <= 0.7 * before[w] and after[w] < control[w], f"{w}: not cut by 30 % below fine-tuning alone")
-    fc = [c for c in before if c.startswith("fc")]
-    total_after, total_control = sum(after[c] for c in fc), sum(control[c] for c in fc)
-    print(f"summed loadcell RMSE: fixed {total_after:.4g}, fine-tuning alone {total_control:.4g}")
-    check(total_after < total_control, "the loadcells as a whole not below fine-tuning alone")
+lead_and_loadcells(fix, check)
 for f in failures:
     print("FAIL:", f)
 sys.exit(1 if failures else 0)

@@ -1,0 +1,25 @@
+"""Checks shared by the CLI tests of `hadynet residual --fix` on plant logs
+(residual_plant_delay_test.sh, residual_rail_simpler_test.sh).
+
+lead_and_loadcells(fix, check): issue 12's bar on the fix's lead channel
+(the first of the applied plan's channels: held-out RMSE cut by 30 % and
+below fine-tuning alone) and the loadcells as a whole (the summed held-out
+RMSE of every fc* channel below fine-tuning alone's: a fix must not buy
+its lead with the rest of the group). `fix` is the JSON's "fix" object;
+`check(ok, what)` records a failure. Prints what it compares.
+"""
+
+
+def lead_and_loadcells(fix, check):
+    channels = (fix.get("augmentation") or {}).get("channels", [])
+    if not fix.get("changed") or not channels:
+        return
+    rmse = lambda part: {c["channel"]: c["rmse"] for c in fix[part]["channels"]}
+    before, control, after = rmse("before"), rmse("control"), rmse("after")
+    w = channels[0]
+    print(f"{w}: before {before[w]:.4g}, fine-tuning alone {control[w]:.4g}, fixed {after[w]:.4g}")
+    check(after[w] <= 0.7 * before[w] and after[w] < control[w], f"{w}: not cut by 30 % below fine-tuning alone")
+    fc = [c for c in before if c.startswith("fc")]
+    total_after, total_control = sum(after[c] for c in fc), sum(control[c] for c in fc)
+    print(f"summed loadcell RMSE: fixed {total_after:.4g}, fine-tuning alone {total_control:.4g}")
+    check(total_after < total_control, "the loadcells as a whole not below fine-tuning alone")
