@@ -243,8 +243,8 @@ int run_residual(int argc, char** argv) {
                               "fine-tuning alone on the rest; the first significant there, else the clearest gain,\n"
                               "else the screen's first, is the one the decision tests on the held-out rows (1: the\n"
                               "screen's winner); a confirmed calibration curve gives way to a rail planned on its lead\n"
-                              "channel when the rail is confirmed itself and the curve does not predict the rail's\n"
-                              "channels significantly better (the simpler account); a family alone confirmed there is\n"
+                              "channel when the rail is confirmed itself and the curve does not predict the channels\n"
+                              "either claims significantly better (the simpler account); a family alone confirmed is\n"
                               "then extended to its group when the extended plan predicts the channels it adds\n"
                               "significantly better on the held-out rows, and a delay seen beyond its family likewise\n"
                               "to every channel of its group", "5");

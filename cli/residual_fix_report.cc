@@ -205,7 +205,9 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
        "apart. \"Fine-tune only\" is the same fine-tuning without the augmentation.\n\n";
   m += "Verdict before: " + f.before.verdict + "\n\n";
   if (f.tried) {
-    m += "Decision: the augmented model against " + f.reference + " on the held-out rows of ";
+    const bool replaced = f.simpler && f.simpler->applied;
+    m += "Decision: the " + (replaced ? "chosen candidate (" + f.simpler->replaces + ")" : std::string("augmented model")) +
+         " against " + f.reference + " on the held-out rows of ";
     for (std::size_t i = 0; i < f.confirmation_channels.size(); ++i) m += (i ? ", " : "") + f.confirmation_channels[i];
     m += " (one-sided Diebold-Mariano test of the standardised squared error, Newey-West variance over " +
          std::to_string(f.confirmation.bandwidth) + " lags, " + std::to_string(f.confirmation.samples) +
