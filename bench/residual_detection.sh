@@ -137,7 +137,8 @@
 # change tested on the channels either claims); 1622-1631 saturation=2,
 # saturation=3 and sensor-curve=0.7 measured (the sets whose curve was
 # confirmed re-run with the final code); 1595 then a test seed
-# (test/cli/residual_rail_simpler_test.sh).
+# (test/cli/residual_rail_simpler_test.sh); 1517-1526 saturation=2 and
+# saturation=3 re-run with the final code.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...
