@@ -280,8 +280,8 @@ bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k);
 // a hypothesis that passes the test but explains too little beyond the
 // null to be a candidate), planned as plan_candidates() plans one (its
 // family alone, and its group when that adds channels), on the lead's
-// group and side only, the lead first. Empty when neither holds one. fix() tests the first and then, as a wider plan, the
-// last.
+// group and side only, the lead first. Empty when neither holds one.
+// fix() tests the first and then, as a wider plan, the last.
 std::vector<Augmentation> simpler_plans(const ResidualData& data, const Attribution& floorless,
                                         const std::vector<Augmentation>& planned, std::size_t k);
 
@@ -440,21 +440,22 @@ struct FixResult {
   // `model`, `loss_history`, `train_windows`, `fitted_rates`, the verdict
   // after) unless that change predicts those channels significantly
   // better: of two accounts of one channel, the one with fewer parameters
-  // stands until the data reject it. The plan may come
-  // from below the candidates' floor (simpler_plans: the decision has
-  // already found the channel's effect; the class is what is asked). The
-  // wider plans then start from the plan applied. Both tests at the attribution's alpha; the
-  // first runs only after the decision confirmed, so nothing is applied
-  // that the decision did not confirm. `confirmation` stays the decision's.
+  // stands until the data reject it. The plan may come from below the
+  // candidates' floor (simpler_plans: the decision has already found the
+  // channel's effect; its class is what is asked). The wider plans then
+  // start from the plan applied. Both tests at the attribution's alpha;
+  // the first runs only after the decision confirmed, so nothing is
+  // applied that the decision did not confirm. `confirmation` stays the
+  // decision's.
   struct SimplerAccount {
     std::string effect;                 // the simpler plan's effect
     std::string replaces;               // the confirmed change's effect
     std::string description;            // the simpler plan, as planned
     bool a_candidate = false;           // the plan was one of the candidates (else planned from the ranking)
-    std::vector<std::string> channels;  // the simpler plan's channels of the model (the tests' channels)
-    DieboldMariano against_reference;   // the reference's loss minus the simpler plan's there
+    std::vector<std::string> channels;  // the simpler plan's channels of the model
+    DieboldMariano against_reference;   // the reference's loss minus the simpler plan's on `channels`
     std::vector<std::string> gain_channels;  // the confirmation's channels and the plan's (if tested)
-    DieboldMariano confirmed_gain;      // the simpler plan's loss minus the confirmed change's there (if tested)
+    DieboldMariano confirmed_gain;      // the simpler plan's loss minus the confirmed change's on gain_channels
     bool gain_tested = false;           // against_reference was significant, so confirmed_gain was tested
     bool applied = false;
   };

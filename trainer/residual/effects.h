@@ -153,7 +153,7 @@ struct EffectInfo {
   const char* support_phrase = nullptr;
   // --fix: a simpler effect of the library, fewer parameters per channel,
   // that a confirmed change of this effect can imitate on its lead channel
-  // (a calibration curve compressive at its top, flattening at a rail), and
+  // (a calibration curve compressive at its top imitates a rail), and
   // that fix() then tries in its place (FixResult::simpler); nullopt: none.
   std::optional<EffectKind> simpler = std::nullopt;
 };
