@@ -569,7 +569,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   const Augmentation* extended_of_applied = is_family_alone(planned, chosen) ? &planned[chosen - 1] : nullptr;
   bool applied_extended = !planned[chosen].extended_channels.empty();
   std::vector<Augmentation> simpler;
-  if (confirmed) simpler = simpler_plans(data, with_null_floor(attribution, 0), planned, chosen);
+  if (confirmed && effect_info(planned[chosen].kind).simpler)  // the ranking re-floored only when it can be asked
+    simpler = simpler_plans(data, with_null_floor(attribution, 0), planned, chosen);
   const auto judged_rows_suffice = [&](const std::vector<Augmentation>& plans) {
     return std::all_of(plans.begin(), plans.end(),
                        [&](const Augmentation& a) { return sensor_after(model.sensor, a).max_delay() <= d; });
