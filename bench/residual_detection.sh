@@ -3,7 +3,8 @@
 # effect of the library at two strengths, each on fresh log sets (the four
 # grasps of docs/residual.md, 300 rows, the effect switched on and declared
 # nowhere), through `hadynet residual MODEL LOGS --fix` with the plant's
-# datasheet ranges (--rated-range fc=0..50 --rated-range f=0..200). Per run:
+# datasheet ranges (--rated-range fc=0..50 --rated-range f=0..200). Per run
+# (bench/residual_run_line.py, shared with bench/residual_oracle.sh):
 #   named     --fix confirmed the right effect with the right parameter (one
 #             rule per plant effect: bench/residual_named.py);
 #   cut       the held-out 1-step RMSE on the changed channels (mean ratio
@@ -205,60 +206,9 @@ for ((k = 0; k < n; ++k)); do
       --json "$d/residual.json" >"$d/out.txt" 2>&1 || { echo "$c seed $seed: residual failed" >>"$runs"; continue; }
     done_runs=$((done_runs + 1))
     eta=$(( ($(date +%s) - start) * (total - done_runs) / done_runs ))
-    python3 - "$c" "$seed" "$d/residual.json" "[$done_runs/$total, ETA ${eta}s]" <<'PY' | tee -a "$runs"
-import json, os, sys
-sys.path.insert(0, os.path.join(os.getcwd(), "bench"))
-from residual_named import names
-case, seed, path, progress = sys.argv[1:5]
-effect, strength = case.split("=")
-strength = float(strength)
-fix = json.load(open(path))["fix"]
-aug = fix.get("augmentation") or {}
-named_effect = aug.get("effect", "-")
-confirmed = bool(fix.get("changed"))
-channels = aug.get("channels", [])
-param_ok = names(effect, strength, fix)
-named = confirmed and param_ok
-cut = below_control = False
-ratio = float("nan")
-if fix.get("after") and fix.get("before") and channels:
-    def rmse(part):
-        return {c["channel"]: c["rmse"] for c in fix[part]["channels"]}
-    before, after = rmse("before"), rmse("after")
-    control = rmse("control") if fix.get("control") else {}
-    # The decision's channels; a simpler account applied in the confirmed
-    # change's place (fix.simpler) was confirmed on its own channels.
-    simpler = fix.get("simpler") or {}
-    judged = simpler["channels"] if simpler.get("applied") else fix.get("confirmation", {}).get("channels")
-    tested = [c for c in (judged or channels) if c in before and c in after]
-    if tested:
-        ratio = sum(after[c] / before[c] for c in tested) / len(tested)
-        cut = ratio <= 0.7
-        below_control = bool(control) and sum(after[c] for c in tested) < sum(control[c] for c in tested)
-label = (aug.get("description", fix.get("status", "-")))[:60]
-print(f"{case} seed {seed}: named {'yes' if named else 'no '} cut {'yes' if cut else 'no '} "
-      f"(after/before {ratio:.2f}) <control {'yes' if below_control else 'no '} | "
-      f"{'confirmed' if confirmed else 'not confirmed'}: {named_effect}: {label}   {progress}")
-PY
+    python3 bench/residual_run_line.py line "$c" "$seed" "$d/residual.json" "[$done_runs/$total, ETA ${eta}s]" |
+      tee -a "$runs"
   done
 done
 
-python3 - "$runs" "${cases[@]}" <<'PY' | tee "$out/summary.txt"
-import re, sys
-path, cases = sys.argv[1], sys.argv[2:]
-rows = {c: [0, 0, 0, 0] for c in cases}
-for line in open(path):
-    m = re.match(r"(\S+) seed \d+: named (yes|no) +cut (yes|no) .*<control (yes|no)", line)
-    if not m:
-        continue
-    r = rows[m.group(1)]
-    r[0] += 1
-    r[1] += m.group(2) == "yes"
-    r[2] += m.group(2) == "yes" and m.group(3) == "yes"
-    r[3] += m.group(2) == "yes" and m.group(3) == "yes" and m.group(4) == "yes"
-print("| effect=strength | runs | named and confirmed (right parameter) | + held-out RMSE cut >= 30 % | + below the fine-tune-only control |")
-print("|---|---|---|---|---|")
-for c in cases:
-    r = rows[c]
-    print(f"| {c} | {r[0]} | {r[1]} | {r[2]} | {r[3]} |")
-PY
+python3 bench/residual_run_line.py table "$runs" "${cases[@]}" | tee "$out/summary.txt"

@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# The plant's own effect as the fix (issue 12's detection bar; not a test):
+# what the decision of `hadynet residual --fix` does when the one candidate
+# is the effect the plant applied, with the plant's exact parameter, so that
+# neither the screen nor the fix's estimate can be what misses. Runs on the
+# logs of bench/residual_detection.sh's runs, scored by the same rule
+# (bench/residual_run_line.py), and answers whether a miss there is the
+# method's or the data's: a bar the plant's own effect does not pass is out
+# of reach of any fix judged by that decision.
+#
+# The oracle is a patch (bench/residual_oracle.patch), never in the
+# project's code: it reads HADYNET_ORACLE=KIND:VALUE:PREFIX and makes the
+# plant's own effect on every y channel named PREFIX* the only candidate:
+#   curve:E:PREFIX   every such channel reads 50 (L / 50)^E of its level L
+#                    (the plant's sensor-curve=E; knots 0, 0.02 .. 50);
+#   drift:R:PREFIX   a bias growing at R per unit of accumulated load and s
+#                    (the plant's drift=R without its random walk).
+# Nothing is re-estimated (refine() keeps it); the fine-tuning, the control
+# and the decision are the tool's, with its defaults.
+#
+# Usage: bench/residual_oracle.sh [--model M] --oracle KIND:VALUE:PREFIX RUN_DIR...
+#   RUN_DIR: OUT/EFFECT=STRENGTH/seedS of bench/residual_detection.sh (its logs/);
+#   writes RUN_DIR/residual_oracle.json and RUN_DIR/out_oracle.txt, prints the
+#   bench's line per run and the table.
+#   defaults: models/hand-4seeds.safetensors
+# Environment: HADYNET_ORACLE_BIN, a hadynet built with the patch (default:
+# the patch applied to a worktree of HEAD at build/residual-oracle/src and
+# built there, its release preset, about 10 min on 2 cores the first time).
+# Data roles (stop 54): the logs are the measurement sets of stop 53
+# (sensor-curve=0.7, seeds 1612-1631) and of stop 54 (drift=0.02, seeds
+# 1632-1641); the oracle has no option or threshold, so nothing was chosen
+# on them.
+set -euo pipefail
+usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
+model=models/hand-4seeds.safetensors
+oracle=
+dirs=()
+while (($#)); do
+  case "$1" in
+    -h | --help) usage; exit 0 ;;
+    --model) model=$2; shift 2 ;;
+    --oracle) oracle=$2; shift 2 ;;
+    -*) echo "residual_oracle: unknown option $1" >&2; exit 2 ;;
+    *) dirs+=("$1"); shift ;;
+  esac
+done
+[[ "$oracle" =~ ^(curve|drift):[0-9.eE+-]+:[A-Za-z_0-9]+$ ]] ||
+  { echo "residual_oracle: --oracle KIND:VALUE:PREFIX (curve:0.7:fc, drift:0.02:fc) needed" >&2; exit 2; }
+((${#dirs[@]})) || { echo "residual_oracle: no RUN_DIR given" >&2; exit 2; }
+root="$(cd "$(dirname "$0")/.." && pwd)"
+hadynet="${HADYNET_ORACLE_BIN:-}"
+if [[ -z "$hadynet" ]]; then
+  src="$root/build/residual-oracle/src"
+  if [[ ! -d "$src" ]]; then
+    git -C "$root" worktree add --detach "$src" HEAD >/dev/null
+    git -C "$src" apply "$root/bench/residual_oracle.patch"
+  fi
+  (cd "$src" && cmake --preset release >/dev/null && ninja -C build/release hadynet >/dev/null)
+  hadynet="$src/build/release/cli/hadynet"
+fi
+[[ -x "$hadynet" ]] || { echo "residual_oracle: $hadynet not found" >&2; exit 2; }
+cd "$root"
+runs=$(mktemp) && trap 'rm -f "$runs"' EXIT
+cases=()
+total=${#dirs[@]} done_runs=0 start=$(date +%s)
+for d in "${dirs[@]}"; do
+  [[ -d "$d/logs" ]] || { echo "residual_oracle: $d/logs not found (a run of bench/residual_detection.sh?)" >&2; exit 2; }
+  case=$(basename "$(dirname "$d")") seed=${d##*seed}
+  [[ " ${cases[*]} " == *" $case "* ]] || cases+=("$case")
+  HADYNET_ORACLE="$oracle" "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 \
+    --fix --json "$d/residual_oracle.json" >"$d/out_oracle.txt" 2>&1 ||
+    { echo "$case seed $seed: residual failed (see $d/out_oracle.txt)" | tee -a "$runs"; continue; }
+  done_runs=$((done_runs + 1))
+  eta=$(( ($(date +%s) - start) * (total - done_runs) / done_runs ))
+  python3 bench/residual_run_line.py line "$case" "$seed" "$d/residual_oracle.json" "[$done_runs/$total, ETA ${eta}s]" |
+    tee -a "$runs"
+done
+python3 bench/residual_run_line.py table "$runs" "${cases[@]}"
