@@ -4,17 +4,19 @@
 # is the effect the plant applied, with the plant's exact parameter, so that
 # neither the screen nor the fix's estimate can be what misses. Runs on the
 # logs of bench/residual_detection.sh's runs, scored by the same rule
-# (bench/residual_run_line.py), and answers whether a miss there is the
-# method's or the data's: a bar the plant's own effect does not pass is out
-# of reach of any fix judged by that decision.
+# (bench/residual_run_line.py). It tells a miss of the method (the plant's
+# own effect passes where the tool's fix does not) from one of the data
+# (the plant's own effect does not pass either). The plant's effect is no
+# upper bound: another plan may pass where it does not.
 #
 # The oracle is a patch (bench/residual_oracle.patch), never in the
 # project's code: it reads HADYNET_ORACLE=KIND:VALUE:PREFIX and makes the
 # plant's own effect on every y channel named PREFIX* the only candidate:
 #   curve:E:PREFIX   every such channel reads 50 (L / 50)^E of its level L
 #                    (the plant's sensor-curve=E; knots 0, 0.02 .. 50);
-#   drift:R:PREFIX   a bias growing at R per unit of accumulated load and s
-#                    (the plant's drift=R without its random walk).
+#   drift:R:PREFIX   a bias growing at R per N s of the channel's true
+#                    level, the reading less the bias (the plant's drift=R;
+#                    its random walk has no effect in the library).
 # Nothing is re-estimated (refine() keeps it); the fine-tuning, the control
 # and the decision are the tool's, with its defaults.
 #
@@ -38,8 +40,8 @@ dirs=()
 while (($#)); do
   case "$1" in
     -h | --help) usage; exit 0 ;;
-    --model) model=$2; shift 2 ;;
-    --oracle) oracle=$2; shift 2 ;;
+    --model) model=${2:?--model needs a path}; shift 2 ;;
+    --oracle) oracle=${2:?--oracle needs KIND:VALUE:PREFIX}; shift 2 ;;
     -*) echo "residual_oracle: unknown option $1" >&2; exit 2 ;;
     *) dirs+=("$1"); shift ;;
   esac
@@ -47,14 +49,29 @@ done
 [[ "$oracle" =~ ^(curve|drift):[0-9.eE+-]+:[A-Za-z_0-9]+$ ]] ||
   { echo "residual_oracle: --oracle KIND:VALUE:PREFIX (curve:0.7:fc, drift:0.02:fc) needed" >&2; exit 2; }
 ((${#dirs[@]})) || { echo "residual_oracle: no RUN_DIR given" >&2; exit 2; }
+# Paths are the caller's: resolved before anything changes directory.
+model=$(realpath "$model")
+for i in "${!dirs[@]}"; do
+  dirs[i]=$(realpath "${dirs[i]}")
+  [[ -d "${dirs[i]}/logs" && "${dirs[i]}" =~ /[a-z-]+=[0-9.]+/seed[0-9]+$ ]] ||
+    { echo "residual_oracle: ${dirs[i]} is not OUT/EFFECT=STRENGTH/seedS with logs/ (bench/residual_detection.sh)" >&2
+      exit 2; }
+done
 root="$(cd "$(dirname "$0")/.." && pwd)"
-hadynet="${HADYNET_ORACLE_BIN:-}"
+hadynet="${HADYNET_ORACLE_BIN:+$(realpath "$HADYNET_ORACLE_BIN")}"
 if [[ -z "$hadynet" ]]; then
+  # A worktree of HEAD with the patch, made again whenever HEAD has moved
+  # or the patch is not applied as it stands.
   src="$root/build/residual-oracle/src"
-  if [[ ! -d "$src" ]]; then
-    git -C "$root" worktree add --detach "$src" HEAD >/dev/null
+  head=$(git -C "$root" rev-parse HEAD)
+  if [[ ! -d "$src" || "$(git -C "$src" rev-parse HEAD)" != "$head" ]] ||
+    ! git -C "$src" apply --reverse --check "$root/bench/residual_oracle.patch" 2>/dev/null; then
+    [[ -d "$src" ]] && git -C "$root" worktree remove --force "$src"
+    git -C "$root" worktree prune
+    git -C "$root" worktree add --detach "$src" "$head" >/dev/null
     git -C "$src" apply "$root/bench/residual_oracle.patch"
   fi
+  echo "residual_oracle: building the patched hadynet in $src (about 10 min the first time)" >&2
   (cd "$src" && cmake --preset release >/dev/null && ninja -C build/release hadynet >/dev/null)
   hadynet="$src/build/release/cli/hadynet"
 fi
@@ -64,7 +81,6 @@ runs=$(mktemp) && trap 'rm -f "$runs"' EXIT
 cases=()
 total=${#dirs[@]} done_runs=0 start=$(date +%s)
 for d in "${dirs[@]}"; do
-  [[ -d "$d/logs" ]] || { echo "residual_oracle: $d/logs not found (a run of bench/residual_detection.sh?)" >&2; exit 2; }
   case=$(basename "$(dirname "$d")") seed=${d##*seed}
   [[ " ${cases[*]} " == *" $case "* ]] || cases+=("$case")
   HADYNET_ORACLE="$oracle" "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 \

@@ -185,7 +185,7 @@ datalog::RobotProfile profile_from_json(const json& j, const std::vector<std::st
 
 // The sensor model (sensor_model.h) as metadata "sensor":
 //   {"delays": [{"channel", "steps"}], "crosstalk": [{"target", "source", "gain"}],
-//    "drifts": [{"channel", "driver": "load"|"time", "rate"}], "period_s": s,
+//    "drifts": [{"channel", "driver": "level"|"time", "rate"}], "period_s": s,
 //    "curves": [{"channel", "level": [knots], "reading": [knots]}] (optional, none if absent),
 //    "clips": [{"channel", "side", "rail"}]}
 json sensor_json(const SensorModel& s) {
@@ -196,7 +196,7 @@ json sensor_json(const SensorModel& s) {
   for (const auto& x : s.crosstalk) j["crosstalk"].push_back({{"target", x.target}, {"source", x.source}, {"gain", x.gain}});
   j["drifts"] = json::array();
   for (const auto& d : s.drifts)
-    j["drifts"].push_back({{"channel", d.channel}, {"driver", d.load ? "load" : "time"}, {"rate", d.rate}});
+    j["drifts"].push_back({{"channel", d.channel}, {"driver", d.load ? "level" : "time"}, {"rate", d.rate}});
   j["period_s"] = s.period_s;
   if (!s.curves.empty()) {
     j["curves"] = json::array();
@@ -226,8 +226,13 @@ SensorModel sensor_from_json(const json& j, const std::string& origin) {
                            json_number(x, "gain", "sensor crosstalk", origin, -1.0, 1.0)});
   for (const json& d : json_array(j, "drifts", origin)) {
     const std::string driver = json_get<std::string>(d, "driver", "sensor drift", origin);
-    if (driver != "load" && driver != "time") fail(origin, "sensor drift driver '" + driver + "' is not load or time");
-    s.drifts.push_back({json_get<std::string>(d, "channel", "sensor drift", origin), driver == "load",
+    // "load" (builds before stop 54): a bias that grew with the reading, its
+    // own bias included; read as "level" it would predict another bias.
+    if (driver == "load")
+      fail(origin, "sensor drift driver 'load' (a bias growing with the reading, written by a build before the "
+                   "level driver): run its --fix again");
+    if (driver != "level" && driver != "time") fail(origin, "sensor drift driver '" + driver + "' is not level or time");
+    s.drifts.push_back({json_get<std::string>(d, "channel", "sensor drift", origin), driver == "level",
                         json_number(d, "rate", "sensor drift", origin)});
   }
   s.period_s = json_number(j, "period_s", "sensor", origin, 0.0);

@@ -75,7 +75,7 @@ std::vector<std::string> SensorModel::describe() const {
   for (const auto& d : delays) out.push_back(d.channel + " reported " + std::to_string(d.steps) + " steps late");
   for (const auto& x : crosstalk) out.push_back(x.target + " += " + num(x.gain) + " * " + x.source);
   for (const auto& d : drifts)
-    out.push_back(d.channel + " += " + num(d.rate) + (d.load ? " * sum |" + d.channel + "| dt" : std::string(" * t")));
+    out.push_back(d.channel + " += " + num(d.rate) + (d.load ? " * sum |" + d.channel + " level| dt" : std::string(" * t")));
   for (const auto& c : curves) {
     std::string knots;
     for (std::size_t k = 0; k < c.level.size(); ++k)
@@ -129,10 +129,10 @@ std::vector<double> drift_driver(const datalog::LogTable& table, const std::stri
   const std::size_t c = column(table, file, drift.channel);
   const double dt = log_dt(table, file);
   std::vector<double> d(table.rows());
-  double load = 0;
+  double level = 0;  // the accumulated level (SensorDrift: the reading less its bias)
   for (std::size_t r = 0; r < d.size(); ++r) {
-    load += std::abs(table.at(r, c)) * dt;
-    d[r] = drift.load ? load : static_cast<double>(r) * dt;
+    level = (level + std::abs(table.at(r, c)) * dt) / (1 + drift.rate * dt);
+    d[r] = drift.load ? level : static_cast<double>(r) * dt;
   }
   return d;
 }

@@ -46,9 +46,20 @@ struct SensorCrosstalk {
   bool operator==(const SensorCrosstalk&) const = default;
 };
 
+// A sensor bias b = rate D growing with a driver D (SensorModel):
+//   load: D is the channel's accumulated level in the model frame, the
+//     reading y less its bias, over time: D_r = D_r-1 + dt (|y_r| - b_r),
+//     solved as D_r = (D_r-1 + dt |y_r|) / (1 + rate dt) (the level's
+//     magnitude where the level is >= 0, a loadcell's force). A bias that
+//     grows with the true load (creep) is driven by the level, not by the
+//     reading: a driver of the reading (before stop 54) counts the bias
+//     itself and, at 0.02 per N s, read the plant's bias 1.4-1.7 times too
+//     high by the end of a 60 s log (docs/residual.md, "The plant's own
+//     effect as the fix");
+//   time: D_r = r dt.
 struct SensorDrift {
   std::string channel;  // a y channel
-  bool load = true;     // D = accumulated load; false: time
+  bool load = true;     // D = accumulated level; false: time
   double rate = 0;      // channel units per (channel unit s), or per s
 
   bool operator==(const SensorDrift&) const = default;
@@ -126,7 +137,8 @@ bool frame_transforms(const SensorModel& sensor, const std::string& channel);
 // std::runtime_error naming `file` if it is not a positive number.
 double log_dt(const datalog::LogTable& table, const std::string& file);
 
-// D_c of every row (see SensorDrift) from the measured column.
+// D_c of every row (see SensorDrift) from the measured column (a load
+// driver with the drift's rate).
 std::vector<double> drift_driver(const datalog::LogTable& table, const std::string& file, const SensorDrift& drift);
 
 // The parts of the frame transform, each on a copy; a missing column is a
@@ -136,7 +148,8 @@ std::vector<double> drift_driver(const datalog::LogTable& table, const std::stri
 //   crosstalk_removed: target -= gain * source, every row (a source with a
 //                 curve in `curves` read through it: the model frame's
 //                 source, which the sensor model adds back).
-//   drift_removed: y_c -= rate * D_c (D_c from the measured column), every row.
+//   drift_removed: y_c -= rate * D_c (D_c from the measured column, see
+//                 SensorDrift), every row.
 //   curves_inverted: y_c = g_c^-1(y_c), every row.
 datalog::LogTable time_aligned(const datalog::LogTable& table, const std::string& file,
                                const std::vector<SensorDelay>& delays);

@@ -62,8 +62,9 @@ constexpr bool parse_numeric(std::string_view text, Numeric& out) noexcept {
 // header fails the build, not the robot). 3 added kPeriodUs and kBoardGroup,
 // 4 kShapeId, 5 DerivedKind::kLag and kUDerivedLag, 6 the sensors'
 // calibration curves (kCurve*), 7 no transposed copy of W_ih's command
-// columns in the q15 tensors (model_tensors.h: a payload 8 KiB shorter).
-inline constexpr int kModelContractVersion = 7;
+// columns in the q15 tensors (model_tensors.h: a payload 8 KiB shorter), 8
+// a load drift driven by the level, the reading less its bias (sensor_stage.h).
+inline constexpr int kModelContractVersion = 8;
 
 // Loss class of each observed channel for the grasp stabiliser.
 enum class LossClass : std::uint8_t {
@@ -195,7 +196,9 @@ concept GeneratedModel = requires {
   // logs as they are; arrays hold max(count, 1) entries). The measured y is
   //   y_c = clip( g_c(y'_c) + sum k y'_s + rate D_c ),  y' the network's channel,
   // g_c the channel's calibration curve (the identity without one),
-  // D_c = sum |y_c| kSensorPeriod (load) or t kSensorPeriod (time) since reset.
+  // D_c the accumulated level since reset, the reading less its bias,
+  // D_c <- (D_c + |y_c| kSensorPeriod) / (1 + rate kSensorPeriod) each frame
+  // (load), or t kSensorPeriod (time).
   { M::kCurveCount } -> std::convertible_to<int>;  // at most one curve per channel
   { M::kCurveKnots } -> std::convertible_to<int>;  // knots of every curve (>= 2; 2 without a curve)
   M::kCurveChannel;       // int[]

@@ -10,8 +10,9 @@
 //       kept here), or u_base of kUDerivedLag frames earlier (input dead
 //       time; the newest kMaxLag bases are kept here), overwriting the
 //       frame's values;
-//     drift: D_c += |y_c| kSensorPeriod (load) or kSensorPeriod (time), then
-//       y1_c = y_c - rate D_c;
+//     drift: D_c = (D_c + |y_c| kSensorPeriod) / (1 + rate kSensorPeriod)
+//       (load: the accumulated level, the reading less its bias) or
+//       D_c += kSensorPeriod (time), then y1_c = y_c - rate D_c;
 //     cross-talk: y2_c = y1_c - gain g_s^-1(y1_s) (the source after the
 //       drift step, through its curve if it has one: the model frame's
 //       source, which to_measured adds back);
@@ -94,7 +95,10 @@ class SensorStage {
     for (int k = 0; k < M::kDriftCount; ++k) {
       const int c = M::kDriftChannel[k];
       const float magnitude = y[c] < 0.0f ? -y[c] : y[c];
-      driver_[k] += M::kDriftIsLoad[k] ? magnitude * M::kSensorPeriod : M::kSensorPeriod;
+      if (M::kDriftIsLoad[k])
+        driver_[k] = (driver_[k] + magnitude * M::kSensorPeriod) / (1.0f + t_->drift_rate[k] * M::kSensorPeriod);
+      else
+        driver_[k] += M::kSensorPeriod;
       // The time driver is t dt with t counted from 0 at the first frame.
       drifted[c] -= t_->drift_rate[k] * drift_driver(k);
     }

@@ -166,11 +166,20 @@ datalog::LogTable drift_log() {
 
 TEST(SensorFrame, DriftDriverAndRemoval) {
   const datalog::LogTable in = drift_log();
-  // Load: sum_{s<=t} |fc0(s)| dt = 0.5, 1.5, 3.0, 3.0; time: t dt.
-  EXPECT_EQ(drift_driver(in, "d.csv", {"fc0", true, 0.1}), (std::vector<double>{0.5, 1.5, 3.0, 3.0}));
+  // Load: the level accumulated, the reading less its bias b = rate D:
+  // D_r = D_r-1 + dt (|fc0_r| - rate D_r), |fc0| = 1, 2, 3, 0, dt 0.5, rate
+  // 0.1 (stop 53's driver, the reading alone, gave 0.5, 1.5, 3.0, 3.0).
+  const std::vector<double> load = drift_driver(in, "d.csv", {"fc0", true, 0.1});
+  const double magnitude[] = {1, 2, 3, 0};
+  ASSERT_EQ(load.size(), 4u);
+  for (std::size_t r = 0; r < 4; ++r)
+    EXPECT_NEAR(load[r], (r ? load[r - 1] : 0.0) + 0.5 * (magnitude[r] - 0.1 * load[r]), 1e-12) << r;
+  EXPECT_NEAR(load[0], 0.5 / 1.05, 1e-12);
+  EXPECT_NEAR(load[3], (((0.5 / 1.05 + 1.0) / 1.05 + 1.5) / 1.05) / 1.05, 1e-12);
+  // Time: t dt.
   EXPECT_EQ(drift_driver(in, "d.csv", {"fc0", false, 0.1}), (std::vector<double>{0.0, 0.5, 1.0, 1.5}));
   const auto out = drift_removed(in, "d.csv", {{"fc0", true, 0.1}, {"fc1", false, 2.0}});
-  const double want0[] = {1 - 0.05, -2 - 0.15, 3 - 0.3, 0 - 0.3};
+  const double want0[] = {1 - 0.1 * load[0], -2 - 0.1 * load[1], 3 - 0.1 * load[2], 0 - 0.1 * load[3]};
   const double want1[] = {5, 4, 3, 2};
   for (std::size_t r = 0; r < 4; ++r) {
     EXPECT_NEAR(out.at(r, 0), want0[r], 1e-12);
@@ -213,8 +222,9 @@ TEST(SensorFrame, AlignmentCrosstalkAndTheWholeFrame) {
   s.delays = {{"fc0", 1}};
   const auto frame = to_model_frame(s, in, "d.csv");
   ASSERT_EQ(frame.rows(), 3u);
-  EXPECT_NEAR(frame.at(0, 0), -2 - 0.15 - 1.0, 1e-12);  // row 1's fc0, shifted to row 0
-  EXPECT_NEAR(frame.at(2, 0), 0 - 0.3 - 1.0, 1e-12);
+  const std::vector<double> load = drift_driver(in, "d.csv", s.drifts.front());
+  EXPECT_NEAR(frame.at(0, 0), -2 - 0.1 * load[1] - 1.0, 1e-12);  // row 1's fc0, shifted to row 0
+  EXPECT_NEAR(frame.at(2, 0), 0 - 0.1 * load[3] - 1.0, 1e-12);
   EXPECT_EQ(frame.at(2, 1), 5);
   // Every part checked against the channels.
   EXPECT_NO_THROW(s.check({"fc0", "fc1"}));

@@ -248,7 +248,9 @@ TEST_F(ModelFileRejects, SensorModelOnAnUnknownChannelOrWithBadNumbers) {
       {"\"side\":-1", "\"side\":0", "output clip side"},
       {"\"channel\":\"", "\"channel\":\"no_", "not a y channel"},
       {"\"rail\"", "\"rial\"", "rail"},
-      {"\"driver\":\"load\"", "\"driver\":\"heat\"", "driver 'heat'"},
+      {"\"driver\":\"level\"", "\"driver\":\"heat\"", "driver 'heat'"},
+      // A bias that grew with the reading (builds before the level driver): refused, not re-read.
+      {"\"driver\":\"level\"", "\"driver\":\"load\"", "driver 'load' (a bias growing with the reading"},
       {"\"steps\":2", "\"steps\":0", "sensor delay 'steps' must be a whole number in 1 .. 4096, got 0"},
       {"\"crosstalk\":[", "\"crosstalk\":{\"a\":1},\"x\":[", "'crosstalk' is not an array"},
       {"\"clips\":", "\"hysteresis\":[],\"clips\":", "unknown part 'hysteresis'"},

@@ -146,7 +146,8 @@ struct CrosstalkRemoval : ModelChange {
 };
 
 // drift-load, drift-time: a bias state b_c(t) = rate * D_c(t) per family
-// channel (D: accumulated load sum |y_c| dt, or time), removed from the data
+// channel (D: the accumulated level, the reading less its bias, or time;
+// SensorDrift), removed from the data
 // (in y and x) and added to the prediction; the rates are re-estimated before
 // fine-tuning (refine: the attribution's fit is low, because the model
 // carries part of a bias over from x_t).

@@ -4,7 +4,7 @@
 //     --headroom 1.5 --control-horizon 8 --control-epochs 3 --control-alphas 1,0.5,0.25,0.125
 //     --control-truncation 8 --beta 3 --w2 1 --w3 1 --loss-units physical --control-commands all
 //
-// Contract   firmware/core/model_contract.h, version 7 (hadynet::firmware::GeneratedModel)
+// Contract   firmware/core/model_contract.h, version 8 (hadynet::firmware::GeneratedModel)
 // Model      tiny.safetensors, FNV-1a 64 0x0123456789abcdef
 // Trained    data_hash ?, git ?, ?
 // Dims       x 9, u 2, y 6, pb 2, hidden 5, states 3, N_train 10
@@ -31,10 +31,10 @@ struct Model {
   using Bias = float;
 
   // ---- identity
-  static constexpr int kContractVersion = 7;
+  static constexpr int kContractVersion = 8;
   static constexpr const char* kGeneratorVersion = "hadynet-codegen 0.1.0";
   static constexpr std::uint64_t kModelHash = 0x0123456789abcdefULL;  // FNV-1a 64 of the model file
-  static constexpr std::uint64_t kShapeId = 0x81042253bf0fd27dULL;  // model images must match it
+  static constexpr std::uint64_t kShapeId = 0xa21178d036249bb8ULL;  // model images must match it
   static constexpr hadynet::firmware::Numeric kNumeric = hadynet::firmware::Numeric::kF32;
 
   // ---- dimensions
