@@ -140,6 +140,13 @@
 # confirmed re-run with the final code); 1595 then a test seed
 # (test/cli/residual_rail_simpler_test.sh); 1517-1526 saturation=2 and
 # saturation=3 re-run with the final code.
+# Stop 54 (the plant's own effect, bench/residual_oracle.sh; a drift driven
+# by the level): 1632-1641 drift=0.02 measured with stop 53's code, then
+# the oracle's logs; 1642-1651 sensor-curve=0.7 and drift=0.02 at 600 rows
+# started and abandoned (a few sets recorded, none used); 1652-1661 every
+# effect at its larger strength measured with stop 53's code, the drift
+# sets re-run with stop 54's; 1662-1671 drift=0.02 and drift=0.01
+# measured with stop 54's code.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

@@ -75,6 +75,7 @@
 # measured, 1 confirmed (1609, a calibration curve; stop 51's code too).
 # Stop 53 (the simpler account, which runs only after a confirmation):
 # 1612-1621 measured with its first version, 1622-1631 with the final code.
+# Stop 54 (a drift driven by the level): 1672-1681 measured, none confirmed.
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
