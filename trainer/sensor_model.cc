@@ -48,6 +48,8 @@ void SensorModel::check(const std::vector<std::string>& y_names) const {
   for (const auto& d : drifts) {
     need_channel(d.channel, "drift");
     if (!std::isfinite(d.rate)) throw std::invalid_argument("sensor model: drift rate on " + d.channel + " not finite");
+    if (d.load && d.rate < 0)  // SensorDrift: the level's driver would grow exponentially
+      throw std::invalid_argument("sensor model: load drift rate on " + d.channel + " is negative");
   }
   for (std::size_t i = 0; i < curves.size(); ++i) {
     const SensorCurve& c = curves[i];

@@ -11,8 +11,9 @@
 //           function of its channel's level (identity without one);
 //   k_cs    cross-talk: the target picks up `gain` times the source;
 //   b_c     a drift/bias state, rate * D_c(t), D_c the load the sensor has
-//           carried since the log's start (sum_{s<=t} |y_c(s)| dt) or the
-//           time since then (t dt), from the measured column;
+//           carried since the log's start (its level, the reading less the
+//           bias, accumulated: SensorDrift) or the time since then (t dt),
+//           from the measured column;
 //   clip_c  a rail the sensor saturates at (side +1: min(., rail); -1: max).
 //
 // to_model_frame() moves a log into the model's frame (the inverse: the
@@ -55,7 +56,8 @@ struct SensorCrosstalk {
 //     reading: a driver of the reading (before stop 54) counts the bias
 //     itself and, at 0.02 per N s, read the plant's bias 1.4-1.7 times too
 //     high by the end of a 60 s log (docs/residual.md, "The plant's own
-//     effect as the fix");
+//     effect as the fix"). Its rate is >= 0 (check()): with a negative
+//     rate 1 / (1 + rate dt) > 1 and D grows exponentially;
 //   time: D_r = r dt.
 struct SensorDrift {
   std::string channel;  // a y channel

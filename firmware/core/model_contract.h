@@ -213,7 +213,7 @@ concept GeneratedModel = requires {
   M::kCrosstalkGain;      // float[] target units per source unit
   { M::kDriftCount } -> std::convertible_to<int>;
   M::kDriftChannel;       // int[]
-  M::kDriftIsLoad;        // bool[] true: D = accumulated load; false: time
+  M::kDriftIsLoad;        // bool[] true: D = accumulated level (the reading less its bias); false: time
   M::kDriftRate;          // float[] units per (unit s), or per s
   { M::kSensorPeriod } -> std::convertible_to<float>;  // s per frame for D
   { M::kClipCount } -> std::convertible_to<int>;

@@ -163,7 +163,7 @@ class SensorStage {
   }
 
  private:
-  // D_k as of the newest frame: load sum, or (frames - 1) periods for time.
+  // D_k as of the newest frame: the accumulated level (load), or (frames - 1) periods for time.
   float drift_driver(int k) const noexcept {
     return M::kDriftIsLoad[k] ? driver_[k] : driver_[k] - M::kSensorPeriod;
   }

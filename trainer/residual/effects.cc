@@ -641,7 +641,9 @@ void BiasState::refine(Augmentation& a, const SensorModel& before, const Trainin
   if (drifts.empty()) return;
   for (SensorDrift& drift : drifts) {
     fitted.push_back(drift.rate);
-    const double fitted_rate = drift.rate;
+    // A load drift's rate is >= 0 (SensorDrift: with a negative rate the
+    // level's driver grows exponentially): a negative fit leaves only 0.
+    const double fitted_rate = drift.load ? std::max(drift.rate, 0.0) : drift.rate;
     double best_rate = fitted_rate, best_rmse = std::numeric_limits<double>::infinity();
     for (int step = 0; step <= 50; ++step) {
       drift.rate = fitted_rate * 0.1 * step;
@@ -1199,7 +1201,7 @@ const std::vector<EffectInfo>& effect_library() {
        "the accumulated load sum_{s<=t} |y_c(s)| dt from the log's start: a bias that grows with the load "
        "the sensor has carried",
        "rate: bias per accumulated load (target units per (target unit s))",
-       "a drift/bias state in the sensor model: a per-channel bias integrating |y_c| dt at a re-estimated "
+       "a drift/bias state in the sensor model: a per-channel bias integrating the level (|y_c| - b_c) dt at a re-estimated "
        "rate, subtracted from the measured y_c before the network sees it and added to its prediction",
        SourceKind::kNone, drift::enumerate_load, drift::load_features, first_coefficient, finite,
        drift::describe_load, drift::plan, nullptr},

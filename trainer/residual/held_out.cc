@@ -75,7 +75,8 @@ Eigen::MatrixXd measured_predictions(const HadynetModel& model, const LogSequenc
     for (int t = d + 2; t < rows_raw; ++t) {
       if (std::isnan(out(c, t))) continue;
       const double known = drift.rate * driver[static_cast<std::size_t>(t - 1)];
-      const double increment = drift.load ? std::abs(out(c, t) + known) * dt : dt;
+      // The level driver's step (SensorDrift): dt times the level's magnitude, the prediction's.
+      const double increment = drift.load ? std::abs(out(c, t)) * dt : dt;
       out(c, t) += known + drift.rate * increment;
     }
   }
