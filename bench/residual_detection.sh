@@ -142,7 +142,8 @@
 # saturation=3 re-run with the final code.
 # Stop 54 (the plant's own effect, bench/residual_oracle.sh; a drift driven
 # by the level): 1632-1641 drift=0.02 measured with stop 53's code, then
-# the oracle's logs; 1642-1651 sensor-curve=0.7 and drift=0.02 at 600 rows
+# the oracle's logs, where the driver of the level was chosen (development
+# for it); 1642-1651 sensor-curve=0.7 and drift=0.02 at 600 rows
 # started and abandoned (a few sets recorded, none used); 1652-1661 every
 # effect at its larger strength measured with stop 53's code, the drift
 # sets re-run with stop 54's; 1662-1671 drift=0.02 and drift=0.01

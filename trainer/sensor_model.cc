@@ -133,8 +133,12 @@ std::vector<double> drift_driver(const datalog::LogTable& table, const std::stri
   std::vector<double> d(table.rows());
   double level = 0;  // the accumulated level (SensorDrift: the reading less its bias)
   for (std::size_t r = 0; r < d.size(); ++r) {
+    if (!drift.load) {
+      d[r] = static_cast<double>(r) * dt;
+      continue;
+    }
     level = (level + std::abs(table.at(r, c)) * dt) / (1 + drift.rate * dt);
-    d[r] = drift.load ? level : static_cast<double>(r) * dt;
+    d[r] = level;
   }
   return d;
 }
