@@ -47,7 +47,7 @@ TEST(FixMargins, EveryMeasuredValuePassesItsBound) {
   for (const Below& b : {kSensorDelay.winner_vs_before, kSensorDelay.winner_vs_control, kSensorDelay.aligned_vs_before,
                          kSensorDelay.aligned_median, kFriction.winner_vs_before, kFriction.winner_vs_control,
                          kFriction.family_vs_before, kCrosstalk.winner_vs_before, kCrosstalk.winner_vs_control,
-                         kDrift.winner_vs_before, kDrift.winner_vs_control, kDrift.family_vs_before,
+                         kDrift.winner_vs_before, kDrift.winner_vs_control, kDrift.family_vs_before, kDrift.group_vs_control,
                          kDefaultDriftLongLogs.winner_vs_before, kDefaultDriftLongLogs.decision_p,
                          kSaturation.winner_vs_before, kSaturation.winner_vs_control, kSaturation.rail_error_N,
                          kAux.winner_vs_before, kAux.winner_vs_control, kSpringDelay.winner_vs_before,

@@ -498,14 +498,34 @@ TEST(ResidualFix, DriftGetsABiasStateWithTheRightRateAndCutsTheError) {
   const Augmentation& a = *r.fix.augmentation;
   const std::vector<trainer::SensorDrift>& drifts = std::get<BiasState>(a.change).drifts;
   ASSERT_FALSE(drifts.empty());
-  // The re-estimated rate of the winner is the plant's.
+  // The plant drifts every loadcell at one rate: after the confirmation the
+  // drift on every loadcell at one re-estimated rate is judged on all nine
+  // against the plan applied before it, and applied.
+  ASSERT_FALSE(r.fix.extensions.empty());
+  const FixResult::Extension& whole = r.fix.extensions.back();
+  EXPECT_TRUE(whole.applied) << whole.what << ": p " << whole.test.p_value;
+  EXPECT_EQ(whole.channels.size(), 9u);
+  ASSERT_EQ(drifts.size(), 9u);
+  for (const auto& d : drifts) {
+    EXPECT_EQ(channel_group(d.channel), "fc") << d.channel;
+    EXPECT_EQ(d.rate, drifts.front().rate) << d.channel;
+  }
+  // The re-estimated rate is the plant's.
   EXPECT_GT(drifts.front().rate, fm::kDrift.rate_vs_plant.lo * 0.02);
   EXPECT_LT(drifts.front().rate, fm::kDrift.rate_vs_plant.hi * 0.02);
   EXPECT_TRUE(r.fix.model.sensor.drifts == drifts);
   EXPECT_TRUE(r.fix.model.layout == build_model().layout);
   const std::string& c = a.channels.front();
   expect_cut(r.fix, c, fm::kDrift.winner_vs_before, fm::kDrift.winner_vs_control);
-  for (const auto& ch : a.channels) expect_cut(r.fix, ch, fm::kDrift.family_vs_before);
+  for (const auto& ch : a.found_on) expect_cut(r.fix, ch, fm::kDrift.family_vs_before);
+  ASSERT_TRUE(r.fix.control.has_value());
+  double after = 0, control = 0;
+  for (const auto& d : drifts) {
+    EXPECT_LT(rmse_of(r.fix.after, d.channel), rmse_of(*r.fix.control, d.channel)) << d.channel;
+    after += rmse_of(r.fix.after, d.channel);
+    control += rmse_of(*r.fix.control, d.channel);
+  }
+  EXPECT_LT(after, fm::kDrift.group_vs_control.limit * control);
   expect_deployable(r.fix.model);
 }
 

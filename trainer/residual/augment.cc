@@ -254,23 +254,40 @@ std::vector<Augmentation> simpler_plans(const ResidualData& data, const Attribut
 
 std::optional<Augmentation> on_whole_group(const std::vector<std::string>& y_names, const SensorModel& sensor,
                                            const Augmentation& a) {
-  if (a.kind != EffectKind::kSensorDelay || !std::holds_alternative<TimeAlignment>(a.change) || a.channels.empty())
+  if (a.channels.empty()) return std::nullopt;
+  const auto* bias = std::get_if<BiasState>(&a.change);
+  const bool delay = a.kind == EffectKind::kSensorDelay && std::holds_alternative<TimeAlignment>(a.change);
+  const bool drift = (a.kind == EffectKind::kDriftLoad || a.kind == EffectKind::kDriftTime) && bias != nullptr &&
+                     !bias->drifts.empty();
+  if (!delay && !drift) return std::nullopt;
+  // A drift's common rate is re-estimated on a grid of its channels' largest
+  // rate (BiasState::refine): a load drift needs a positive one.
+  if (drift && bias->drifts.front().load &&
+      std::none_of(bias->drifts.begin(), bias->drifts.end(), [](const SensorDrift& x) { return x.rate > 0; }))
     return std::nullopt;
   const std::string group = channel_group(a.channels.front());
-  const auto delayed = [&](const std::string& name) {
-    return std::any_of(sensor.delays.begin(), sensor.delays.end(),
-                       [&](const SensorDelay& x) { return x.channel == name && x.steps > 0; });
+  const auto in_sensor = [&](const std::string& name) {
+    if (delay)
+      return std::any_of(sensor.delays.begin(), sensor.delays.end(),
+                         [&](const SensorDelay& x) { return x.channel == name && x.steps > 0; });
+    return std::any_of(sensor.drifts.begin(), sensor.drifts.end(),
+                       [&](const SensorDrift& x) { return x.channel == name; });
   };
   Augmentation whole = a;
   std::string added;
   for (const auto& name : y_names) {
-    if (channel_group(name) != group || delayed(name)) continue;
+    if (channel_group(name) != group || in_sensor(name)) continue;
     if (std::find(a.channels.begin(), a.channels.end(), name) != a.channels.end()) continue;
     whole.channels.push_back(name);
+    if (drift) std::get<BiasState>(whole.change).drifts.push_back({name, bias->drifts.front().load, 0.0});
     added += (added.empty() ? "" : ", ") + name;
   }
   if (added.empty()) return std::nullopt;
   whole.description += " (" + added + ": every channel of the group)";
+  if (drift) {
+    std::get<BiasState>(whole.change).common_rate = true;
+    whole.description += ", one rate for the group";
+  }
   return whole;
 }
 
@@ -567,6 +584,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // then a wider plan. Plans that need more rows than the candidates were
   // judged on are not tried (a simpler effect that delays).
   const Augmentation* extended_of_applied = is_family_alone(planned, chosen) ? &planned[chosen - 1] : nullptr;
+  const Augmentation* applied_plan = &planned[chosen];  // the applied change before its re-estimation (refined)
   bool applied_extended = !planned[chosen].extended_channels.empty();
   std::vector<Augmentation> simpler;
   if (confirmed && effect_info(planned[chosen].kind).simpler)  // the ranking re-floored only when it can be asked
@@ -599,6 +617,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     }
     if (account.applied) {
       apply(t);
+      applied_plan = &plan;
       extended_of_applied = simpler.size() > 1 ? &simpler.back() : nullptr;
       applied_extended = !plan.extended_channels.empty();
     }
@@ -609,13 +628,18 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // sequence at alpha; FixResult::extensions): the plan applied so far
   // against `wider` on the held-out rows of the channels `wider` adds;
   // applied when significant. Returns whether it was applied.
+  // A drift's whole group (one common rate) changes the rates of the
+  // channels it had too, so it is judged on all its channels.
   const auto try_wider = [&](const Augmentation& wider, const std::string& what) {
     const Augmentation& current = *result.augmentation;
+    const auto* bias = std::get_if<BiasState>(&wider.change);
+    const bool all_its_channels = bias != nullptr && bias->common_rate;
     FixResult::Extension e;
     e.what = what;
     for (const auto& name : wider.channels)
       if (index_of(model.layout.y_names, name) >= 0 &&
-          std::find(current.channels.begin(), current.channels.end(), name) == current.channels.end())
+          (all_its_channels ||
+           std::find(current.channels.begin(), current.channels.end(), name) == current.channels.end()))
         e.channels.push_back(name);
     if (e.channels.empty()) return false;
     FoldTrial t = fold_trial(wider);
@@ -631,13 +655,24 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // confirmation".) Then a delay seen beyond its family, on the channels of
   // its group the test did not find it on (an acquisition chain delays
   // every channel it carries, and a channel that barely moves hides it).
+  //
+  // A confirmed drift: on every channel of its group at one rate, whatever
+  // the test found (sensors of one kind age together, and the 1-step
+  // residual shows little of a drift: docs/residual.md, "A drift across its
+  // group"). Its plan is the applied one before re-estimation, so that each
+  // fold re-estimates the rate on its own training rows.
   if (confirmed) {
     bool beyond_family = applied_extended;
-    if (extended_of_applied != nullptr)
+    if (extended_of_applied != nullptr) {
       beyond_family = try_wider(*extended_of_applied, "its group's channels where the test finds the same effect");
-    if (beyond_family)
-      if (const auto whole = on_whole_group(model.layout.y_names, model.sensor, *result.augmentation))
+      if (beyond_family) applied_plan = extended_of_applied;
+    }
+    const bool drift = std::holds_alternative<BiasState>(applied_plan->change);
+    if (beyond_family || drift) {
+      const Augmentation& plan = drift ? *applied_plan : *result.augmentation;
+      if (const auto whole = on_whole_group(model.layout.y_names, model.sensor, plan))
         try_wider(*whole, "every channel of its group");
+    }
   }
 
   // The residual analysis of the augmented model (in its own frame), against

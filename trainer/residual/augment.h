@@ -154,6 +154,9 @@ struct CrosstalkRemoval : ModelChange {
 struct BiasState : ModelChange {
   std::vector<SensorDrift> drifts;  // one per channel
   double period_s = 0;              // the logs' control period (s)
+  // One rate for every drift (on_whole_group's plan: one kind of sensor),
+  // re-estimated on their summed 1-step MSE (refine) rather than per channel.
+  bool common_rate = false;
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;
   void refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
               std::vector<double>& fitted);
@@ -228,7 +231,7 @@ struct Augmentation {
   // The screen's floor statistic of the hypothesis that led to it
   // (floor_statistic: excess_share with a null, else explained_std).
   double screen_statistic = 0;
-  // The group extension of a sensor delay, a calibration curve or a rail
+  // The group extension of a sensor delay, a calibration curve, a rail or a drift
   // (effects.cc, passing_in_group): whether the plan may extend the family
   // to the other channels of its group where the test finds the effect (set
   // before planning), and the channels it added.
@@ -412,7 +415,8 @@ struct FixResult {
   // alone (a candidate planned without its group, Augmentation::
   // group_extension false, right after its extended plan) against that
   // extended plan; then a time alignment seen beyond its family (chosen
-  // extended, or so extended) against its whole group (on_whole_group).
+  // extended, or so extended), or any confirmed drift, against its whole
+  // group (on_whole_group).
   // Each wider plan is re-estimated and fine-tuned as the tested candidate
   // was (on each fold the decision judged) and judged against the plan
   // applied so far on the held-out rows of the channels it adds;
@@ -425,7 +429,7 @@ struct FixResult {
   // candidate's change on those channels).
   struct Extension {
     std::string what;                   // the wider plan's channels, in words
-    std::vector<std::string> channels;  // the channels it adds
+    std::vector<std::string> channels;  // the channels it is judged on: those it adds (a drift's group: all)
     DieboldMariano test;                // the applied plan's loss minus the wider one's there
     bool applied = false;
   };
@@ -463,22 +467,29 @@ struct FixResult {
   std::optional<SimplerAccount> simpler;
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
-  std::vector<double> fitted_rates;     // drift: the attribution's rate per channel, before refine(); else empty
+  // drift: the attribution's rate per channel, before refine() (0 for a
+  // channel on_whole_group added); else empty
+  std::vector<double> fitted_rates;
   // Confirmed: what the data's 1-step residuals do not tell apart from the
   // confirmed change (look_alike()); "" otherwise.
   std::string look_alike;
   long train_windows = 0;
 };
 
-// A sensor delay's time alignment `a` on every y channel of its group (the
-// group of its first channel, its family's lead; `y_names`: the model's)
-// that `sensor` (the model's sensor model) does not delay yet, whether the
-// test found the delay there or not: an acquisition chain delays every
-// channel it carries, and a channel that barely moves hides its delay from
-// the test. The added channels join `channels` only: `found_on` and
-// `extended_channels` keep where the test found the delay. nullopt when `a`
-// is not a time alignment or nothing is added. fix() tests it after a delay
-// seen beyond its family (FixResult::extensions).
+// A sensor delay's time alignment or a drift's bias state `a` on every y
+// channel of its group (the group of its first channel, its family's lead;
+// `y_names`: the model's) that `sensor` (the model's sensor model) does not
+// delay, or give a drift, yet, whether the test found the effect there or
+// not: an acquisition chain delays every channel it carries, and a channel
+// that barely moves hides its delay from the test; sensors of one kind age
+// together, and the 1-step residual shows little of a drift. A drift's plan
+// then has one rate for the whole group (BiasState::common_rate), so it
+// changes the rates of `a`'s channels too; nothing for a load drift without
+// a positive rate in `a`. The added channels join `channels` only:
+// `found_on` and `extended_channels` keep where the test found the effect.
+// nullopt when `a` is neither or nothing is added. fix() tests it after a
+// delay seen beyond its family, on the channels it adds, and after any
+// confirmed drift, on all its channels (FixResult::extensions).
 std::optional<Augmentation> on_whole_group(const std::vector<std::string>& y_names, const SensorModel& sensor,
                                            const Augmentation& a);
 

@@ -94,7 +94,7 @@ std::vector<std::string> family_groups(const ResidualData& data, const Attributi
 // (Augmentation::group_extension). The floors keep the model's own misfit
 // from being named as a new effect; once a sensor effect is established,
 // the test only says where else in the group it is (the group extension of
-// a sensor delay, a calibration curve and a rail).
+// a sensor delay, a calibration curve, a rail and a drift).
 template <typename Also>
 std::vector<const HypothesisResult*> passing_in_group(const ResidualData& data, const Attribution& attribution,
                                                       const Augmentation& a, EffectKind kind,
@@ -604,7 +604,15 @@ std::string describe_time(const Hypothesis& h, const ResidualData& data, double 
   return "drift on " + y_name(data, h.target) + " with time: rate " + fmt("%.3g", p) + " per s";
 }
 
-// Both drifts: one bias state per family channel at its fitted rate (refined by refine()).
+// Both drifts: one bias state per family channel at its fitted rate
+// (refined by refine()), extended to the other channels of the winner's
+// group where the same drift passes the test (Holm-adjusted p < alpha)
+// without the practical floors, with a rate of the winner's sign (a load
+// drift's rate is > 0: SensorDrift). As for a sensor delay or a curve, once
+// a drift is established the test only says where else in the group it is.
+// The 1-step residual shows little of a drift (the network carries most of
+// the bias over from its inputs), so the test finds it on few channels;
+// fix() then tries the drift on the whole group (on_whole_group).
 void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
   const auto& h = w.hypothesis;
   auto& change = a.change.emplace<BiasState>();
@@ -612,12 +620,27 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   for (const auto& log : data.logs)
     if (log.dt_s != change.period_s)
       throw std::runtime_error(log.seq.file + ": dt_s differs from the other logs' (a drift needs one period)");
+  const bool load = h.kind == EffectKind::kDriftLoad;
   for (const auto& r : attribution.family_of(w)) {
     a.channels.push_back(y_name(data, r.hypothesis.target));
-    change.drifts.push_back({a.channels.back(), h.kind == EffectKind::kDriftLoad, r.parameter});
+    change.drifts.push_back({a.channels.back(), load, r.parameter});
   }
-  a.description = std::string("a bias state growing with ") +
-                  (h.kind == EffectKind::kDriftLoad ? "the accumulated load" : "time") + " on " + join(a.channels) +
+  const auto same_sign = [&](const HypothesisResult& r) {
+    return load ? r.parameter > 0 : (r.parameter > 0) == (w.parameter > 0);
+  };
+  for (const HypothesisResult* r :
+       passing_in_group(data, attribution, a, h.kind, channel_group(y_name(data, h.target)), same_sign)) {
+    const std::string& name = y_name(data, r->hypothesis.target);
+    if (std::find(a.channels.begin(), a.channels.end(), name) != a.channels.end()) continue;
+    a.channels.push_back(name);
+    a.extended_channels.push_back(name);
+    change.drifts.push_back({name, load, r->parameter});
+  }
+  a.description = std::string("a bias state growing with ") + (load ? "the accumulated load" : "time") + " on " +
+                  join(a.channels) +
+                  (a.extended_channels.empty()
+                       ? ""
+                       : " (" + join(a.extended_channels) + ": the same drift in the same group)") +
                   ", removed from the data and added to the prediction";
   a.found_on = a.channels;
 }
@@ -635,12 +658,43 @@ void BiasState::add_to_sensor(SensorModel& s, const Augmentation&) const {
 // the fitted rate in steps of 0.1x, that minimises the unchanged network's
 // 1-step RMSE of that channel in the measured frame on the training rows
 // (the bias removed from the inputs, added to the prediction). Channels in
-// family order, each with the others' rates so far.
+// family order, each with the others' rates so far. With common_rate, one
+// rate for all: 0 or the largest fitted rate (of the first's sign) times
+// 2^(k/4), k = -8..16 (1/4x..16x: the fit reads 0.1-0.4 of the plant's rate
+// on the bench's logs), minimising the channels' summed 1-step MSE (one
+// group, one unit).
 void BiasState::refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
                        std::vector<double>& fitted) {
   if (drifts.empty()) return;
+  for (const SensorDrift& drift : drifts) fitted.push_back(drift.rate);
+  char text[64];
+  if (common_rate) {
+    const double sign = drifts.front().load || drifts.front().rate >= 0 ? 1.0 : -1.0;
+    double base = 0;
+    for (const SensorDrift& drift : drifts) base = std::max(base, sign * drift.rate);
+    std::vector<double> grid{0.0};
+    if (base > 0)
+      for (int k = -8; k <= 16; ++k) grid.push_back(sign * base * std::exp2(k / 4.0));
+    double best_rate = 0, best_mse = std::numeric_limits<double>::infinity();
+    for (const double rate : grid) {
+      for (SensorDrift& drift : drifts) drift.rate = rate;
+      const Eigen::VectorXd rmse = training_rmse.all(sensor_after(before, a));
+      double mse = 0;
+      for (const SensorDrift& drift : drifts) {
+        const auto it = std::find(training_rmse.y_names.begin(), training_rmse.y_names.end(), drift.channel);
+        if (it == training_rmse.y_names.end())
+          throw std::logic_error("--fix: refine probes " + drift.channel + ", not a y channel");
+        const double r = rmse(it - training_rmse.y_names.begin());
+        mse += r * r;
+      }
+      if (mse < best_mse) best_mse = mse, best_rate = rate;
+    }
+    for (SensorDrift& drift : drifts) drift.rate = best_rate;
+    std::snprintf(text, sizeof text, "%.4g", best_rate);
+    a.description += std::string("; common rate re-estimated: ") + text;
+    return;
+  }
   for (SensorDrift& drift : drifts) {
-    fitted.push_back(drift.rate);
     // A load drift's rate is >= 0 (SensorDrift: with a negative rate the
     // level's driver grows exponentially): a negative fit leaves only 0.
     const double fitted_rate = drift.load ? std::max(drift.rate, 0.0) : drift.rate;
@@ -652,7 +706,6 @@ void BiasState::refine(Augmentation& a, const SensorModel& before, const Trainin
     }
     drift.rate = best_rate;
   }
-  char text[64];
   std::string rates;
   for (const SensorDrift& drift : drifts) {
     std::snprintf(text, sizeof text, "%s%s %.4g", rates.empty() ? "" : ", ", drift.channel.c_str(), drift.rate);
