@@ -148,6 +148,10 @@
 # effect at its larger strength measured with stop 53's code, the drift
 # sets re-run with stop 54's; 1662-1671 drift=0.02 and drift=0.01
 # measured with stop 54's code.
+# Stop 55 (a drift across its group, at one rate): 1662-1671's drift=0.02
+# logs re-run as its development (the whole group, the common rate and its
+# grid chosen there); 1682-1691 every effect at its larger strength and
+# drift=0.01 measured with its final code.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

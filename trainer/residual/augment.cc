@@ -656,18 +656,18 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // its group the test did not find it on (an acquisition chain delays
   // every channel it carries, and a channel that barely moves hides it).
   //
-  // A confirmed drift: on every channel of its group at one rate, whatever
-  // the test found (sensors of one kind age together, and the 1-step
-  // residual shows little of a drift: docs/residual.md, "A drift across its
-  // group"). Its plan is the applied one before re-estimation, so that each
-  // fold re-estimates the rate on its own training rows.
+  // A confirmed drift: straight to every channel of its group at one rate,
+  // whatever the test found (sensors of one kind age together, and the
+  // 1-step residual shows little of a drift: docs/residual.md, "A drift
+  // across its group"); that plan holds its extended plan's channels, so
+  // the one test replaces both. Its plan is the applied one before
+  // re-estimation, so that each fold re-estimates the rate on its own
+  // training rows.
   if (confirmed) {
-    bool beyond_family = applied_extended;
-    if (extended_of_applied != nullptr) {
-      beyond_family = try_wider(*extended_of_applied, "its group's channels where the test finds the same effect");
-      if (beyond_family) applied_plan = extended_of_applied;
-    }
     const bool drift = std::holds_alternative<BiasState>(applied_plan->change);
+    bool beyond_family = applied_extended;
+    if (extended_of_applied != nullptr && !drift)
+      beyond_family = try_wider(*extended_of_applied, "its group's channels where the test finds the same effect");
     if (beyond_family || drift) {
       const Augmentation& plan = drift ? *applied_plan : *result.augmentation;
       if (const auto whole = on_whole_group(model.layout.y_names, model.sensor, plan))

@@ -415,8 +415,9 @@ struct FixResult {
   // alone (a candidate planned without its group, Augmentation::
   // group_extension false, right after its extended plan) against that
   // extended plan; then a time alignment seen beyond its family (chosen
-  // extended, or so extended), or any confirmed drift, against its whole
-  // group (on_whole_group).
+  // extended, or so extended) against its whole group (on_whole_group). A
+  // confirmed drift goes straight to its whole group, which holds its
+  // extended plan's channels.
   // Each wider plan is re-estimated and fine-tuned as the tested candidate
   // was (on each fold the decision judged) and judged against the plan
   // applied so far on the held-out rows of the channels it adds;
