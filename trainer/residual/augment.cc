@@ -260,12 +260,13 @@ std::optional<Augmentation> on_whole_group(const std::vector<std::string>& y_nam
   const bool drift = (a.kind == EffectKind::kDriftLoad || a.kind == EffectKind::kDriftTime) && bias != nullptr &&
                      !bias->drifts.empty();
   if (!delay && !drift) return std::nullopt;
-  // A drift's common rate is re-estimated on a grid of its channels' largest
-  // rate (BiasState::refine): a load drift needs a positive one.
-  if (drift && bias->drifts.front().load &&
-      std::none_of(bias->drifts.begin(), bias->drifts.end(), [](const SensorDrift& x) { return x.rate > 0; }))
-    return std::nullopt;
   const std::string group = channel_group(a.channels.front());
+  // A drift's common rate is re-estimated on a grid of its group's largest
+  // rate (BiasState::refine): a load drift needs a positive one there.
+  const auto positive_in_group = [&](const SensorDrift& x) { return x.rate > 0 && channel_group(x.channel) == group; };
+  if (drift && bias->drifts.front().load &&
+      std::none_of(bias->drifts.begin(), bias->drifts.end(), positive_in_group))
+    return std::nullopt;
   const auto in_sensor = [&](const std::string& name) {
     if (delay)
       return std::any_of(sensor.delays.begin(), sensor.delays.end(),

@@ -154,8 +154,9 @@ struct CrosstalkRemoval : ModelChange {
 struct BiasState : ModelChange {
   std::vector<SensorDrift> drifts;  // one per channel
   double period_s = 0;              // the logs' control period (s)
-  // One rate for every drift (on_whole_group's plan: one kind of sensor),
-  // re-estimated on their summed 1-step MSE (refine) rather than per channel.
+  // One rate for the drifts of the first drift's group (on_whole_group's
+  // plan: one kind of sensor), re-estimated on their summed 1-step MSE
+  // (refine) rather than per channel; another group's keep their own.
   bool common_rate = false;
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;
   void refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
@@ -420,14 +421,17 @@ struct FixResult {
   // extended plan's channels.
   // Each wider plan is re-estimated and fine-tuned as the tested candidate
   // was (on each fold the decision judged) and judged against the plan
-  // applied so far on the held-out rows of the channels it adds;
+  // applied so far on the held-out rows of the channels it adds (a drift's
+  // whole group, which re-rates the channels it had: of all its channels);
   // significant, it is applied: `augmentation`, `after`, `untuned`,
   // `model`, `loss_history`, `train_windows`, `fitted_rates` and the
   // verdict after are then its. A fixed sequence (each test only after the
   // one before was significant), each at the attribution's alpha. `confirmation`
   // stays the tested candidate's test on its channels: the applied wider
   // plan is not tested against the reference again (it holds the tested
-  // candidate's change on those channels).
+  // candidate's change on those channels; a drift's whole group holds its
+  // channels at the group's re-estimated rate, judged better there than the
+  // change the confirmation tested).
   struct Extension {
     std::string what;                   // the wider plan's channels, in words
     std::vector<std::string> channels;  // the channels it is judged on: those it adds (a drift's group: all)
@@ -484,13 +488,15 @@ struct FixResult {
 // not: an acquisition chain delays every channel it carries, and a channel
 // that barely moves hides its delay from the test; sensors of one kind age
 // together, and the 1-step residual shows little of a drift. A drift's plan
-// then has one rate for the whole group (BiasState::common_rate), so it
-// changes the rates of `a`'s channels too; nothing for a load drift without
-// a positive rate in `a`. The added channels join `channels` only:
-// `found_on` and `extended_channels` keep where the test found the effect.
-// nullopt when `a` is neither or nothing is added. fix() tests it after a
-// delay seen beyond its family, on the channels it adds, and after any
-// confirmed drift, on all its channels (FixResult::extensions).
+// then has one rate for the group's channels (BiasState::common_rate), so
+// it changes the rates of `a`'s channels there too; nothing for a load
+// drift without a positive rate in the group. The added channels join
+// `channels` only: `found_on` and `extended_channels` keep where the test
+// found the effect. nullopt when `a` is neither or nothing is added (the
+// test found it on every channel of the group: a drift's rates then stay
+// per channel). fix() tests it after a delay seen beyond its family, on the
+// channels it adds, and after any confirmed drift, on all its channels
+// (FixResult::extensions).
 std::optional<Augmentation> on_whole_group(const std::vector<std::string>& y_names, const SensorModel& sensor,
                                            const Augmentation& a);
 

@@ -658,29 +658,40 @@ void BiasState::add_to_sensor(SensorModel& s, const Augmentation&) const {
 // the fitted rate in steps of 0.1x, that minimises the unchanged network's
 // 1-step RMSE of that channel in the measured frame on the training rows
 // (the bias removed from the inputs, added to the prediction). Channels in
-// family order, each with the others' rates so far. With common_rate, one
-// rate for all: 0 or the largest fitted rate (of the first's sign) times
-// 2^(k/4), k = -8..16 (1/4x..16x: the fit reads 0.1-0.4 of the plant's rate
-// on the bench's logs), minimising the channels' summed 1-step MSE (one
-// group, one unit).
+// family order, each with the others' rates so far. With common_rate, the
+// channels of the first drift's group first, at one rate: 0 or their
+// largest fitted rate (of the first's sign) times 2^(k/4), k = -8..16
+// (1/4x..16x: the fit reads 0.1-0.4 of the plant's rate on the bench's
+// logs), minimising their summed 1-step MSE (one group, one unit); a
+// family channel of another group, or a time drift of the other sign,
+// keeps its own rate, re-estimated after.
 void BiasState::refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
                        std::vector<double>& fitted) {
   if (drifts.empty()) return;
   for (const SensorDrift& drift : drifts) fitted.push_back(drift.rate);
+  const std::string group = channel_group(drifts.front().channel);
+  // A time drift of the other sign keeps its own rate (a load drift's is >= 0).
+  const double sign = drifts.front().load || drifts.front().rate >= 0 ? 1.0 : -1.0;
+  const auto shared = [&](const SensorDrift& drift) {
+    return common_rate && channel_group(drift.channel) == group && (drift.load || sign * drift.rate >= 0);
+  };
   char text[64];
+  std::string rates;
   if (common_rate) {
-    const double sign = drifts.front().load || drifts.front().rate >= 0 ? 1.0 : -1.0;
     double base = 0;
-    for (const SensorDrift& drift : drifts) base = std::max(base, sign * drift.rate);
+    for (const SensorDrift& drift : drifts)
+      if (shared(drift)) base = std::max(base, sign * drift.rate);
     std::vector<double> grid{0.0};
     if (base > 0)
       for (int k = -8; k <= 16; ++k) grid.push_back(sign * base * std::exp2(k / 4.0));
     double best_rate = 0, best_mse = std::numeric_limits<double>::infinity();
     for (const double rate : grid) {
-      for (SensorDrift& drift : drifts) drift.rate = rate;
+      for (SensorDrift& drift : drifts)
+        if (shared(drift)) drift.rate = rate;
       const Eigen::VectorXd rmse = training_rmse.all(sensor_after(before, a));
       double mse = 0;
       for (const SensorDrift& drift : drifts) {
+        if (!shared(drift)) continue;
         const auto it = std::find(training_rmse.y_names.begin(), training_rmse.y_names.end(), drift.channel);
         if (it == training_rmse.y_names.end())
           throw std::logic_error("--fix: refine probes " + drift.channel + ", not a y channel");
@@ -689,12 +700,13 @@ void BiasState::refine(Augmentation& a, const SensorModel& before, const Trainin
       }
       if (mse < best_mse) best_mse = mse, best_rate = rate;
     }
-    for (SensorDrift& drift : drifts) drift.rate = best_rate;
-    std::snprintf(text, sizeof text, "%.4g", best_rate);
-    a.description += std::string("; common rate re-estimated: ") + text;
-    return;
+    for (SensorDrift& drift : drifts)
+      if (shared(drift)) drift.rate = best_rate;
+    std::snprintf(text, sizeof text, "%s %.4g", group.c_str(), best_rate);
+    rates = text;
   }
   for (SensorDrift& drift : drifts) {
+    if (shared(drift)) continue;
     // A load drift's rate is >= 0 (SensorDrift: with a negative rate the
     // level's driver grows exponentially): a negative fit leaves only 0.
     const double fitted_rate = drift.load ? std::max(drift.rate, 0.0) : drift.rate;
@@ -705,13 +717,11 @@ void BiasState::refine(Augmentation& a, const SensorModel& before, const Trainin
       if (rmse < best_rmse) best_rmse = rmse, best_rate = drift.rate;
     }
     drift.rate = best_rate;
-  }
-  std::string rates;
-  for (const SensorDrift& drift : drifts) {
     std::snprintf(text, sizeof text, "%s%s %.4g", rates.empty() ? "" : ", ", drift.channel.c_str(), drift.rate);
     rates += text;
   }
-  a.description += "; rates re-estimated: " + rates;
+  a.description += std::string(common_rate ? "; rates re-estimated (one for the group): " : "; rates re-estimated: ") +
+                   rates;
 }
 
 namespace {
@@ -1255,12 +1265,14 @@ const std::vector<EffectInfo>& effect_library() {
        "the sensor has carried",
        "rate: bias per accumulated load (target units per (target unit s))",
        "a drift/bias state in the sensor model: a per-channel bias integrating the level (|y_c| - b_c) dt at a re-estimated "
-       "rate, subtracted from the measured y_c before the network sees it and added to its prediction",
+       "rate, subtracted from the measured y_c before the network sees it and added to its prediction (on the channels "
+       "of the group where the test finds it; once confirmed, tried on the whole group at one rate)",
        SourceKind::kNone, drift::enumerate_load, drift::load_features, first_coefficient, finite,
        drift::describe_load, drift::plan, nullptr},
       {EffectKind::kDriftTime, "drift-time", "time since the log's start: a bias growing with time",
        "rate: bias per second (target units per s)",
-       "a drift/bias state in the sensor model, growing with time at a re-estimated rate", SourceKind::kNone,
+       "a drift/bias state in the sensor model, growing with time at a re-estimated rate (extended as drift-load)",
+       SourceKind::kNone,
        drift::enumerate_time, drift::time_features, first_coefficient, finite, drift::describe_time, drift::plan, nullptr},
       {EffectKind::kSaturation, "saturation",
        "min(y_hat_c, R) - y_hat_c (upper rail R = the largest measured value over the logs; lower: max(y_hat_c, "
