@@ -151,7 +151,9 @@
 # Stop 55 (a drift across its group, at one rate): 1662-1671's drift=0.02
 # logs re-run as its development (the whole group, the common rate and its
 # grid chosen there); 1682-1691 every effect at its larger strength and
-# drift=0.01 measured with its final code.
+# drift=0.01 measured with its first version (the final code differs only
+# where a drift is confirmed: those six sets, 1682, 1691 and development
+# 1664, 1665, 1669 and 1670, re-run with it give the same passes).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

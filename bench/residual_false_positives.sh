@@ -76,7 +76,9 @@
 # Stop 53 (the simpler account, which runs only after a confirmation):
 # 1612-1621 measured with its first version, 1622-1631 with the final code.
 # Stop 54 (a drift driven by the level): 1672-1681 measured, none confirmed.
-# Stop 55 (a drift across its group): 1692-1711 measured.
+# Stop 55 (a drift across its group): 1692-1711 measured, none confirmed;
+# the multi-step RMSE of 1672-1681 read as development evidence for a
+# drift screen (not built).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

@@ -131,12 +131,12 @@ std::vector<double> drift_driver(const datalog::LogTable& table, const std::stri
   const std::size_t c = column(table, file, drift.channel);
   const double dt = log_dt(table, file);
   std::vector<double> d(table.rows());
+  if (!drift.load) {
+    for (std::size_t r = 0; r < d.size(); ++r) d[r] = static_cast<double>(r) * dt;
+    return d;
+  }
   double level = 0;  // the accumulated level (SensorDrift: the reading less its bias)
   for (std::size_t r = 0; r < d.size(); ++r) {
-    if (!drift.load) {
-      d[r] = static_cast<double>(r) * dt;
-      continue;
-    }
     level = (level + std::abs(table.at(r, c)) * dt) / (1 + drift.rate * dt);
     d[r] = level;
   }

@@ -90,10 +90,14 @@ std::string why_not_fixable(const ResidualData& data, const Attribution& attribu
   return info.not_planned ? info.not_planned(data, attribution, r) : "";
 }
 
-double TrainingRmse::operator()(const SensorModel& sensor, const std::string& channel) const {
+Eigen::Index TrainingRmse::row(const std::string& channel) const {
   const auto it = std::find(y_names.begin(), y_names.end(), channel);
   if (it == y_names.end()) throw std::logic_error("--fix: refine probes " + channel + ", not a y channel");
-  return all(sensor)(it - y_names.begin());
+  return it - y_names.begin();
+}
+
+double TrainingRmse::operator()(const SensorModel& sensor, const std::string& channel) const {
+  return all(sensor)(row(channel));
 }
 
 bool gains_significantly(const CandidateTrial& c, double alpha) {

@@ -100,6 +100,8 @@ struct TrainingRmse {
   std::function<Eigen::VectorXd(const SensorModel& sensor)> all;
   std::vector<std::string> y_names;
   double operator()(const SensorModel& sensor, const std::string& channel) const;
+  // The element of all()'s result that is `channel` (std::logic_error if none).
+  Eigen::Index row(const std::string& channel) const;
 };
 
 // What an alternative of Augmentation::change does to a model. std::visit

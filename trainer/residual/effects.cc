@@ -684,20 +684,16 @@ void BiasState::refine(Augmentation& a, const SensorModel& before, const Trainin
     std::vector<double> grid{0.0};
     if (base > 0)
       for (int k = -8; k <= 16; ++k) grid.push_back(sign * base * std::exp2(k / 4.0));
+    std::vector<Eigen::Index> rows;  // the shared channels in all()'s result
+    for (const SensorDrift& drift : drifts)
+      if (shared(drift)) rows.push_back(training_rmse.row(drift.channel));
     double best_rate = 0, best_mse = std::numeric_limits<double>::infinity();
     for (const double rate : grid) {
       for (SensorDrift& drift : drifts)
         if (shared(drift)) drift.rate = rate;
       const Eigen::VectorXd rmse = training_rmse.all(sensor_after(before, a));
       double mse = 0;
-      for (const SensorDrift& drift : drifts) {
-        if (!shared(drift)) continue;
-        const auto it = std::find(training_rmse.y_names.begin(), training_rmse.y_names.end(), drift.channel);
-        if (it == training_rmse.y_names.end())
-          throw std::logic_error("--fix: refine probes " + drift.channel + ", not a y channel");
-        const double r = rmse(it - training_rmse.y_names.begin());
-        mse += r * r;
-      }
+      for (const Eigen::Index row : rows) mse += rmse(row) * rmse(row);
       if (mse < best_mse) best_mse = mse, best_rate = rate;
     }
     for (SensorDrift& drift : drifts)
