@@ -121,6 +121,7 @@ void print_fix(const rs::FixResult& fixed) {
   std::printf("\nfix: %s%s\n", fixed.status.c_str(),
               fixed.augmentation ? (": " + fixed.augmentation->description).c_str() : "");
   if (!fixed.look_alike.empty()) std::printf("note: %s\n", fixed.look_alike.c_str());
+  for (const auto& p : fixed.drift_probes) std::printf("%s\n", drift_probe_sentence(p).c_str());
   const rs::HeldOutError& e = fixed.tried ? fixed.after : fixed.before;
   std::printf("held-out 1-step RMSE (%ld rows)   %-10s %11s %11s %11s   LB p before/after\n", fixed.before.samples,
               "channel", "before", "fine-tune", "after");
@@ -159,6 +160,7 @@ void print_fix(const rs::FixResult& fixed) {
       for (const auto& c : fixed.candidates) {
         std::printf("  %c %-74.74s", c.chosen ? '*' : ' ', (c.effect + ": " + c.description).c_str());
         if (c.below_screen_floor) std::printf(" below the screen's floor (%.2g);", c.screen_statistic);
+        if (c.from_drift_probe) std::printf(" the drift probe's;");
         if (c.selected_by_training_rows)
           std::printf(" training rows: DM %.2f, p %.2g\n", c.selection.stat, c.selection.p_value);
         else std::printf(" not judged\n");
@@ -247,7 +249,11 @@ int run_residual(int argc, char** argv) {
                               "either claims significantly better (the simpler account); a family alone confirmed is\n"
                               "then extended to its group when the extended plan predicts the channels it adds\n"
                               "significantly better on the held-out rows, and a delay seen beyond its family likewise\n"
-                              "to every channel of its group", "5");
+                              "to every channel of its group; when the screen proposes no drift and a place is left,\n"
+                              "the drift probe asks each channel group whether a load drift at one rate, fitted on the\n"
+                              "first 75 % of the training rows, makes the unchanged network predict the rest better\n"
+                              "(one-sided Diebold-Mariano, Holm over the groups), and the best group that does is one\n"
+                              "more candidate", "5");
   opt.value("fix-min-excess-null", "S",
             "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"
             "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"

@@ -119,6 +119,7 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                             {"channels", c.channels},
                             {"screen_statistic", c.screen_statistic},
                             {"below_screen_floor", c.below_screen_floor},
+                            {"from_drift_probe", c.from_drift_probe},
                             {"selected_by_training_rows", c.selected_by_training_rows},
                             {"selection_statistic", c.selection.stat},
                             {"selection_p_value", c.selection.p_value},
@@ -126,6 +127,20 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                             {"chosen", c.chosen}});
     j["candidates"] = candidates;
   }
+  // The drift probes (FixResult::drift_probes), whether or not a fix was tried.
+  j["drift_probes"] = json::array();
+  for (const auto& p : f.drift_probes)
+    j["drift_probes"].push_back({{"group", p.group},
+                                 {"channels", p.channels},
+                                 {"start_rate", p.start_rate},
+                                 {"rate", p.rate},
+                                 {"test", "Diebold-Mariano, one-sided, the unchanged network without minus with"},
+                                 {"mean_loss_difference", p.gain.mean},
+                                 {"statistic", p.gain.stat},
+                                 {"rows", p.gain.samples},
+                                 {"p_value", p.gain.p_value},
+                                 {"p_adjusted", p.p_adjusted},
+                                 {"candidate", p.candidate}});
   return j;
 }
 
@@ -193,6 +208,18 @@ std::string extension_sentence(const rs::FixResult::Extension& e) {
   return m;
 }
 
+std::string drift_probe_sentence(const rs::DriftProbe& p) {
+  std::string m = "Drift probe of " + p.group + " (" + std::to_string(p.channels.size()) +
+                  " channels, one load drift at one rate): ";
+  if (!(p.start_rate > 0)) return m + "not probed, the channels carry no level";
+  m += "rate " + num("%.3g", p.rate) + " per (unit s) on the selection's training rows";
+  if (!(p.rate > 0)) return m + ": no drift";
+  return m + ", the unchanged network's gain on the selection's judged rows (Diebold-Mariano, " +
+         std::to_string(p.gain.samples) + " rows): mean loss difference " + num("%.3g", p.gain.mean) + ", p " +
+         num("%.2g", p.gain.p_value) + " (Holm " + num("%.2g", p.p_adjusted) + "): " +
+         (p.candidate ? "a candidate" : "not a candidate");
+}
+
 std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const std::string& out,
                          const std::string& png) {
   std::string m = "\n## Fix (--fix)\n\n**" + f.status + "**";
@@ -204,6 +231,7 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
        " held-out rows, causal 1-step predictions of the measured values), the decision's mirrored fold "
        "apart. \"Fine-tune only\" is the same fine-tuning without the augmentation.\n\n";
   m += "Verdict before: " + f.before.verdict + "\n\n";
+  for (const auto& p : f.drift_probes) m += drift_probe_sentence(p) + ".\n\n";
   if (f.tried) {
     const bool replaced = f.simpler && f.simpler->applied;
     m += "Decision: the " + (replaced ? "chosen candidate (" + f.simpler->replaces + ")" : std::string("augmented model")) +

@@ -22,6 +22,10 @@ std::string fix_markdown(const trainer::residual::FixResult& f, const trainer::r
 // applied. For stdout and REPORT.md.
 std::string extension_sentence(const trainer::residual::FixResult::Extension& e);
 
+// One sentence on a drift probe (FixResult::drift_probes): its rate, its
+// test and whether it became a candidate.
+std::string drift_probe_sentence(const trainer::residual::DriftProbe& p);
+
 // One sentence on the simpler account tried after the confirmation
 // (FixResult::simpler): its channels, its test against the reference, the
 // confirmed change's gain over it when tested, and whether it was applied.

@@ -7,11 +7,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 
 #include "trainer/derived_inputs.h"
 #include "trainer/log_dataset.h"
 #include "trainer/output_clip.h"
 #include "trainer/residual/augment.h"
+#include "trainer/residual/drift_probe.h"
 #include "trainer/sensor_model.h"
 
 namespace hadynet::test {
@@ -435,6 +437,107 @@ TEST(FixCandidates, ByDefaultTheyReachDownToAShareOfOne) {
   residual::Attribution absolute = screen;
   absolute.null.reset();
   EXPECT_EQ(significant(residual::candidates_view(absolute, residual::FixOptions{})), significant(absolute));
+}
+
+// The drift probe (drift_probe.h) as pure code, its rows faked: the grid's
+// start in closed form, one probe per channel group that the sensor model
+// does not already drift, Holm's correction over the groups, and which group
+// becomes the candidate. A group's loss with its drift is its loss without
+// less a fixed gain plus a wobble (the Diebold-Mariano test needs
+// variance); tolerance 1e-12 on the closed forms.
+TEST(DriftProbe, OneLoadDriftPerGroupAtOneRateTheBestGroupACandidate) {
+  residual::ResidualData data;
+  data.y_names = {"a0", "a1", "b0", "c0"};
+  data.y_scale = Eigen::VectorXd(4);
+  data.y_scale << 1.0, 3.0, 2.0, 1.0;
+  for (int k = 0; k < 2; ++k) {
+    residual::ResidualLog log;
+    log.dt_s = 0.5;
+    log.seq.y = Eigen::MatrixXd::Zero(4, 3);
+    log.seq.y.row(0) << 1, -2, 3;      // sum |y| = 6
+    log.seq.y.row(1) << 2, 2, 2 + k;   // 6, 7
+    log.seq.y.row(2) << 0.5, 0.5, 0;   // 1
+    data.logs.push_back(std::move(log));
+  }
+  // a: load dt averaged over a0, a1 and the two logs, (6 + 6 + 6 + 7) / 4 * 0.5;
+  // the std averaged over a0, a1, 2: a quarter of it over that load.
+  EXPECT_NEAR(residual::start_rate(data, {"a0", "a1"}), 0.25 * 2.0 / (25.0 / 4 * 0.5), 1e-12);
+  EXPECT_NEAR(residual::start_rate(data, {"b0"}), 0.25 * 2.0 / 0.5, 1e-12);
+  EXPECT_EQ(residual::start_rate(data, {"c0"}), 0.0);  // no level: not probed
+  EXPECT_THROW(residual::start_rate(data, {"z0"}), std::logic_error);
+
+  const residual::Augmentation plan = residual::group_drift_plan({"a0", "a1"}, 0.5, 0.01);
+  EXPECT_EQ(plan.kind, residual::EffectKind::kDriftLoad);
+  EXPECT_EQ(plan.found_on, (std::vector<std::string>{"a0", "a1"}));
+  const auto& bias = std::get<residual::BiasState>(plan.change);
+  EXPECT_TRUE(bias.common_rate);
+  EXPECT_EQ(bias.period_s, 0.5);
+  EXPECT_EQ(bias.drifts, (std::vector<SensorDrift>{{"a0", true, 0.01}, {"a1", true, 0.01}}));
+
+  HadynetModel model;
+  model.layout.y_names = data.y_names;
+  // The fake rows: group a's rate re-estimated at twice its start, b's at
+  // zero; the loss with a drift lowered by `gain` per row.
+  std::map<std::string, double> gain{{"a0", 0.5}, {"b0", 0.5}};
+  residual::DriftProbeRows rows;
+  rows.refined = [](residual::Augmentation a) {
+    for (auto& d : std::get<residual::BiasState>(a.change).drifts) d.rate = d.channel[0] == 'a' ? 2 * d.rate : 0.0;
+    return a;
+  };
+  rows.loss = [&](const SensorModel& sensor, const std::vector<std::string>& channels) {
+    Eigen::VectorXd loss(60);
+    for (int i = 0; i < 60; ++i)
+      loss(i) = 4.0 + std::sin(0.7 * i) - (sensor.drifts.empty() ? 0.0 : gain[channels.front()] + std::cos(1.3 * i));
+    return residual::Segments{loss};
+  };
+  std::vector<residual::DriftProbe> probes = residual::probe_drifts(model, data, rows, 0.01);
+  ASSERT_EQ(probes.size(), 3u);  // a, b and c, in the order they first appear
+  EXPECT_EQ(probes[0].group, "a");
+  EXPECT_EQ(probes[0].channels, (std::vector<std::string>{"a0", "a1"}));
+  EXPECT_NEAR(probes[0].rate, 2 * probes[0].start_rate, 1e-12);
+  EXPECT_GT(probes[0].gain.mean, 0.4);
+  EXPECT_TRUE(probes[0].candidate);
+  EXPECT_LE(probes[0].gain.p_value, probes[0].p_adjusted);
+  // Holm over the groups tested: b's rate is 0 and c carries no level, so a alone.
+  EXPECT_NEAR(probes[0].p_adjusted, probes[0].gain.p_value, 1e-12);
+  EXPECT_EQ(probes[1].rate, 0.0);  // no drift at its best rate: no test, no candidate
+  EXPECT_EQ(probes[1].p_adjusted, 1.0);
+  EXPECT_FALSE(probes[1].candidate);
+  // Two groups tested: Holm doubles the smaller p (b's gain made larger than a's).
+  rows.refined = [](residual::Augmentation a) {
+    for (auto& d : std::get<residual::BiasState>(a.change).drifts) d.rate *= 2;
+    return a;
+  };
+  gain["b0"] = 0.8;
+  const std::vector<residual::DriftProbe> both = residual::probe_drifts(model, data, rows, 0.01);
+  ASSERT_EQ(both.size(), 3u);
+  const double p_a = both[0].gain.p_value, p_b = both[1].gain.p_value;
+  ASSERT_LT(p_b, p_a);
+  EXPECT_NEAR(both[1].p_adjusted, std::min(1.0, 2 * p_b), 1e-12);
+  EXPECT_NEAR(both[0].p_adjusted, std::min(1.0, std::max(2 * p_b, p_a)), 1e-12);
+  rows.refined = [](residual::Augmentation a) {
+    for (auto& d : std::get<residual::BiasState>(a.change).drifts) d.rate = d.channel[0] == 'a' ? 2 * d.rate : 0.0;
+    return a;
+  };
+  gain["b0"] = 0.5;
+  EXPECT_EQ(probes[2].start_rate, 0.0);
+  EXPECT_FALSE(probes[2].candidate);
+  ASSERT_NE(residual::best_drift_probe(probes), nullptr);
+  EXPECT_EQ(residual::best_drift_probe(probes)->group, "a");
+  // A loss that rises with the drift is no candidate.
+  gain["a0"] = -0.5;
+  EXPECT_EQ(residual::best_drift_probe(residual::probe_drifts(model, data, rows, 0.01)), nullptr);
+  // A channel the sensor model already drifts is left out of its group; a
+  // group it drifts whole is not probed.
+  gain["a0"] = 0.5;
+  model.sensor.drifts = {{"a0", true, 0.02}, {"b0", true, 0.02}};
+  probes = residual::probe_drifts(model, data, rows, 0.01);
+  ASSERT_EQ(probes.size(), 2u);
+  EXPECT_EQ(probes[0].channels, (std::vector<std::string>{"a1"}));
+  EXPECT_EQ(probes[1].group, "c");
+  // Logs of different periods: nothing probed (a drift needs one period).
+  data.logs[1].dt_s = 0.25;
+  EXPECT_TRUE(residual::probe_drifts(model, data, rows, 0.01).empty());
 }
 
 // The rows fix() fine-tunes on and judges (decision_rows): the first fold and

@@ -7,6 +7,7 @@
 
 #include "trainer/model_frame.h"
 #include "trainer/residual/analysis.h"
+#include "trainer/residual/drift_probe.h"
 
 namespace hadynet::trainer::residual {
 
@@ -392,16 +393,6 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.before = held_out_error(model, eval_logs(model, before_pbs));
   result.before.verdict = verdict_text(attribution);
 
-  if (planned.empty()) {
-    result.status = "no significant effect";
-    return result;
-  }
-  if (!planned.front().not_fixable.empty()) {
-    result.augmentation = planned.front();
-    result.status = "not supported: " + planned.front().effect + ": " + planned.front().not_fixable;
-    return result;
-  }
-
   // What an augmentation re-estimates before fine-tuning (drift: the rates;
   // curve: the slopes), probing the unchanged network with a sensor model on
   // the rows of `rows`: the rows its fine-tuning will see.
@@ -423,6 +414,62 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     if (fitted != nullptr) *fitted = std::move(rates);
     return a;
   };
+
+  // The drift probe (drift_probe.h): the regression screen rarely lists a
+  // slow drift, and lists it on a family of one or two channels, so every
+  // channel group is asked with the unchanged network whether a load drift
+  // at one re-estimated rate predicts the selection's judged rows better.
+  // The best group that does takes the place of the screen's load drifts of
+  // that group (the first's place: its family, and the family alone), or,
+  // when the screen proposes none, is one more candidate after the screen's
+  // where a place is left (FixOptions::candidates), or the only one when the
+  // screen has none that can be added.
+  std::optional<std::size_t> probed;  // its index in `planned`
+  const bool none_addable = planned.empty() || !planned.front().not_fixable.empty();
+  const bool place_left = none_addable || static_cast<int>(planned.size()) < options.candidates;
+  const auto load_drift_of = [&](const Augmentation& a, const std::string& group) {
+    return a.not_fixable.empty() && a.kind == EffectKind::kDriftLoad && !a.channels.empty() &&
+           channel_group(a.channels.front()) == group;
+  };
+  const bool any_load_drift = std::any_of(planned.begin(), planned.end(), [](const Augmentation& a) {
+    return a.not_fixable.empty() && a.kind == EffectKind::kDriftLoad;
+  });
+  if (can_select && (place_left || any_load_drift)) {
+    DriftProbeRows rows;
+    rows.refined = [&](const Augmentation& plan) { return refined(plan, selection_train, nullptr); };
+    rows.loss = [&](const SensorModel& sensor, const std::vector<std::string>& channels) {
+      probe.sensor = sensor;
+      return standardised_loss(model, held_out_error(probe, eval_rows(probe, before_pbs, selection_judged)), channels);
+    };
+    result.drift_probes = probe_drifts(model, data, rows, attribution.options.alpha);
+    if (const DriftProbe* best = best_drift_probe(result.drift_probes)) {
+      Augmentation group = group_drift_plan(best->channels, data.logs.front().dt_s, best->start_rate);
+      const auto first = std::find_if(planned.begin(), planned.end(),
+                                      [&](const Augmentation& a) { return load_drift_of(a, best->group); });
+      if (first != planned.end()) {
+        const auto at = first - planned.begin();
+        planned.erase(std::remove_if(planned.begin(), planned.end(),
+                                     [&](const Augmentation& a) { return load_drift_of(a, best->group); }),
+                      planned.end());
+        planned.insert(planned.begin() + at, std::move(group));
+        probed = static_cast<std::size_t>(at);
+      } else if (place_left) {
+        if (none_addable) planned.clear();  // a winner that cannot be added gives way
+        planned.push_back(std::move(group));
+        probed = planned.size() - 1;
+      }
+    }
+  }
+  if (planned.empty()) {
+    result.status = "no significant effect";
+    return result;
+  }
+  if (!planned.front().not_fixable.empty()) {
+    result.augmentation = planned.front();
+    result.status = "not supported: " + planned.front().effect + ": " + planned.front().not_fixable;
+    return result;
+  }
+
 
   // A model fine-tuned on the rows of `rows` (the control: no augmentation).
   struct Tuned {
@@ -465,7 +512,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     c.description = planned[k].description;
     c.channels = channels_of(planned[k]);
     c.screen_statistic = planned[k].screen_statistic;
-    c.below_screen_floor = attribution.null && c.screen_statistic < attribution.options.min_excess_null;
+    c.from_drift_probe = probed && *probed == k;
+    c.below_screen_floor =
+        !c.from_drift_probe && attribution.null && c.screen_statistic < attribution.options.min_excess_null;
     result.candidates.push_back(std::move(c));
   }
   if (planned.size() > 1 && can_select) {

@@ -62,7 +62,9 @@ struct FixOptions {
   // clearest gain (chosen_candidate), goes to the decision.
   // 1: the screen's winner alone. 5 was chosen on development seeds 771-775
   // (docs/residual.md, "Detection on fresh logs"), when every candidate was
-  // another effect; since stop 51 a family alone takes one of them.
+  // another effect; since stop 51 a family alone takes one of them. The
+  // drift probe (drift_probe.h) takes a place left when the screen proposes
+  // no drift (or the only place, when no screened candidate can be added).
   int candidates = 5;
   // With a calibrated null: the floor of excess_share (in units of the
   // channel's clean residual level) of the candidates fix() may try
@@ -338,6 +340,23 @@ struct CandidateTrial {
   // AttributionOptions::min_excess_null): the screen's verdict does not name
   // it; only fix()'s candidates' floor (FixOptions::min_excess_null) let it in.
   bool below_screen_floor = false;
+  // Proposed by the drift probe (drift_probe.h), not by the screen: its
+  // screen_statistic is 0 and the probe's test is FixResult::drift_probes'.
+  bool from_drift_probe = false;
+};
+
+// One channel group's drift probe (drift_probe.h, probe_drifts): a load
+// drift on every channel of the group at one rate, re-estimated on the
+// selection's training rows, and the unchanged network's gain from it on the
+// selection's judged rows.
+struct DriftProbe {
+  std::string group;                  // channel_group() of its channels
+  std::vector<std::string> channels;  // the model's y channels of the group
+  double start_rate = 0;              // the grid's start (start_rate), per (channel unit s)
+  double rate = 0;                    // re-estimated on the selection's training rows
+  DieboldMariano gain;                // loss without the drift minus with it, on the selection's judged rows
+  double p_adjusted = 1;              // Holm over the groups tested (a positive rate); 1: not tested
+  bool candidate = false;             // p_adjusted < alpha, with gain.mean > 0 and rate > 0
 };
 
 // Which of the judged candidates the decision tests: the first, in the
@@ -413,7 +432,11 @@ struct FixResult {
   // FixOptions::min_excess_null, at most the screen's floor); none without a
   // null (the screen's absolute floors).
   std::optional<double> candidates_floor;
-  std::vector<CandidateTrial> candidates;          // the screen's candidates, in its order
+  std::vector<CandidateTrial> candidates;          // the screen's candidates, in its order (then the probe's)
+  // The drift probes (drift_probe.h), run when the screen proposes no drift
+  // and the logs are long enough for the selection's rows; the best
+  // candidate group is the last of `candidates`. Empty: not run.
+  std::vector<DriftProbe> drift_probes;
   // Wider plans tested after the confirmation, in order: a confirmed family
   // alone (a candidate planned without its group, Augmentation::
   // group_extension false, right after its extended plan) against that
