@@ -260,6 +260,10 @@ int run_residual(int argc, char** argv) {
             "decision on held-out rows against fine-tuning alone guards what is applied (docs/residual.md,\n"
             "\"Candidates down to 1 by default\"); never above --min-excess-null",
             num("%g", rs::kDefaultFixMinExcessNull));
+  opt.value("drift-probe-alpha", "A",
+            "with --fix: the drift probe's family-wise level (Holm over the channel groups whose fitted rate\n"
+            "is positive; see --candidates); 0: no probe",
+            num("%g", rs::kDefaultDriftProbeAlpha));
   opt.value("fix-folds", "1|2",
             "with --fix: 2 also judges a mirrored fold (the candidate and its reference fine-tuned on each\n"
             "log's last rows, judged on the rows before them), pooled with the first fold in the decision's\n"
@@ -313,12 +317,13 @@ int run_residual(int argc, char** argv) {
   const auto rounds = opt.get_int("rounds", 1, 20);
   const auto candidates = opt.get_int("candidates", 1, 20);
   const auto folds = opt.get_int("fix-folds", 1, 2);
+  const auto drift_probe_alpha = opt.get_double("drift-probe-alpha", 0.0, 0.5);
   std::optional<double> fix_min_excess;  // given; else FixOptions' default (fix() keeps it at most the screen's)
   if (opt.has("fix-min-excess-null")) {
     fix_min_excess = opt.get_double("fix-min-excess-null", 0.0, 1e6);
     if (!fix_min_excess) return 2;
   }
-  if (!fix_epochs || !fix_lr || !fix_seed || !rounds || !candidates || !folds) return 2;
+  if (!fix_epochs || !fix_lr || !fix_seed || !rounds || !candidates || !folds || !drift_probe_alpha) return 2;
   if (opt.has("fix-min-excess-null") && !opt.has("fix")) {
     std::fprintf(stderr, "hadynet residual: --fix-min-excess-null needs --fix\n");
     return 2;
@@ -330,6 +335,10 @@ int run_residual(int argc, char** argv) {
   }
   if (opt.has("fix-min-excess-null") && no_reference) {
     std::fprintf(stderr, "hadynet residual: --fix-min-excess-null needs a null (not --reference none)\n");
+    return 2;
+  }
+  if (opt.has("drift-probe-alpha") && !opt.has("fix")) {
+    std::fprintf(stderr, "hadynet residual: --drift-probe-alpha needs --fix\n");
     return 2;
   }
   if (opt.has("rounds") && !opt.has("fix")) {
@@ -399,6 +408,7 @@ int run_residual(int argc, char** argv) {
     fo.seed = static_cast<std::uint64_t>(*fix_seed);
     fo.control = !opt.has("no-control");
     fo.candidates = static_cast<int>(*candidates);
+    fo.drift_probe_alpha = *drift_probe_alpha;
     fo.folds = static_cast<int>(*folds);
     if (fix_min_excess) fo.min_excess_null = fix_min_excess;
     fo.reference = &reference;

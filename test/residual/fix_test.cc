@@ -48,7 +48,8 @@ struct FixRun {
 // floors on it, with its logs' trained PBs (as `hadynet residual` on the
 // model's stored held-out logs); without: absolute floors.
 FixRun run_fix(const std::vector<LogInput>& logs, const std::string& label,
-               const trainer::HadynetModel& model = build_model(), const std::vector<LogInput>* null = nullptr) {
+               const trainer::HadynetModel& model = build_model(), const std::vector<LogInput>* null = nullptr,
+               int candidates = 1) {
   FixRun r;
   FixOptions fo;
   // The screen's winner alone: these tests check each effect's fix (and
@@ -58,7 +59,7 @@ FixRun run_fix(const std::vector<LogInput>& logs, const std::string& label,
   // wins the selection on the cross-talk and drift logs and on seed 12's clean
   // logs (docs/residual.md, "Several candidates"); the choice itself is
   // FixCandidates' test, the default's rates the benches' (bench/residual_detection.sh).
-  fo.candidates = 1;
+  fo.candidates = candidates;
   if (null != nullptr) {
     AnalysisOptions ao;
     ao.reference_pb_choice = "state";
@@ -527,6 +528,52 @@ TEST(ResidualFix, DriftGetsABiasStateWithTheRightRateAndCutsTheError) {
     control += rmse_of(*r.fix.control, d.channel);
   }
   EXPECT_LT(after, fm::kDrift.group_vs_control.limit * control);
+  expect_deployable(r.fix.model);
+}
+
+TEST(ResidualFix, TheDriftProbeProposesTheGroupTheScreenDoesNotList) {
+  // Plant drift=0.02 on fresh logs (seed 1713, a development seed of the
+  // probe, stop 56), with the stored null and the default five candidates:
+  // the screen lists calibration curves and cross-talks, no drift; the drift
+  // probe (drift_probe.h) finds a load drift of the loadcells' group, which
+  // the selection then chooses and the decision confirms.
+  const FixRun r = run_fix(plant_logs("drift=0.02", 300, 1713), "drift probe", build_model(), &stored_null(), 5);
+  for (const auto& c : r.attribution.ranked) {
+    if (!c.significant) continue;
+    EXPECT_NE(c.hypothesis.kind, EffectKind::kDriftLoad) << c.label << ": the screen lists a drift";
+  }
+  ASSERT_FALSE(r.fix.drift_probes.empty());
+  for (const DriftProbe& p : r.fix.drift_probes) {
+    std::printf("  probe %s: rate %.4g, p %.2g (Holm %.2g)%s\n", p.group.c_str(), p.rate, p.gain.p_value,
+                p.p_adjusted, p.candidate ? ", a candidate" : "");
+    EXPECT_EQ(p.candidate, p.group == "fc") << p.group;
+  }
+  const auto chosen = std::find_if(r.fix.candidates.begin(), r.fix.candidates.end(),
+                                   [](const CandidateTrial& c) { return c.chosen; });
+  ASSERT_NE(chosen, r.fix.candidates.end());
+  EXPECT_TRUE(chosen->from_drift_probe) << chosen->description;
+  ASSERT_TRUE(fixed_as(r, EffectKind::kDriftLoad));
+  EXPECT_LT(r.fix.confirmation.p_value, fm::kDriftProbe.decision_p.limit);
+  const std::vector<trainer::SensorDrift>& drifts = std::get<BiasState>(r.fix.augmentation->change).drifts;
+  ASSERT_EQ(drifts.size(), 9u);
+  for (const auto& d : drifts) {
+    EXPECT_EQ(channel_group(d.channel), "fc") << d.channel;
+    EXPECT_EQ(d.rate, drifts.front().rate) << d.channel;
+  }
+  EXPECT_TRUE(r.fix.extensions.empty()) << "the probe's plan holds the whole group already";
+  std::printf("  rate %.4g (%.3g x the plant's)\n", drifts.front().rate, drifts.front().rate / 0.02);
+  EXPECT_GT(drifts.front().rate, fm::kDriftProbe.rate_vs_plant.lo * 0.02);
+  EXPECT_LT(drifts.front().rate, fm::kDriftProbe.rate_vs_plant.hi * 0.02);
+  ASSERT_TRUE(r.fix.control.has_value());
+  double after = 0, control = 0, before = 0;
+  for (const auto& d : drifts) {
+    after += rmse_of(r.fix.after, d.channel);
+    control += rmse_of(*r.fix.control, d.channel);
+    before += rmse_of(r.fix.before, d.channel);
+  }
+  std::printf("  summed loadcell RMSE: before %.4g, fine-tuning alone %.4g, after %.4g\n", before, control, after);
+  EXPECT_LT(after, fm::kDriftProbe.group_vs_before.limit * before);
+  EXPECT_LT(after, fm::kDriftProbe.group_vs_control.limit * control);
   expect_deployable(r.fix.model);
 }
 

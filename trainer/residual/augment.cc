@@ -434,14 +434,14 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   const bool any_load_drift = std::any_of(planned.begin(), planned.end(), [](const Augmentation& a) {
     return a.not_fixable.empty() && a.kind == EffectKind::kDriftLoad;
   });
-  if (can_select && (place_left || any_load_drift)) {
+  if (options.drift_probe_alpha > 0 && can_select && (place_left || any_load_drift)) {
     DriftProbeRows rows;
     rows.refined = [&](const Augmentation& plan) { return refined(plan, selection_train, nullptr); };
     rows.loss = [&](const SensorModel& sensor, const std::vector<std::string>& channels) {
       probe.sensor = sensor;
       return standardised_loss(model, held_out_error(probe, eval_rows(probe, before_pbs, selection_judged)), channels);
     };
-    result.drift_probes = probe_drifts(model, data, rows, attribution.options.alpha);
+    result.drift_probes = probe_drifts(model, data, rows, options.drift_probe_alpha);
     if (const DriftProbe* best = best_drift_probe(result.drift_probes)) {
       Augmentation group = group_drift_plan(best->channels, data.logs.front().dt_s, best->start_rate);
       const auto first = std::find_if(planned.begin(), planned.end(),
