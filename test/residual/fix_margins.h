@@ -275,6 +275,11 @@ inline std::vector<std::string> margins_table() {
            worst(kDrift.family_vs_before) + "; all nine loadcells at one rate, each / fine-tuning alone " +
            worst(kDrift.each_vs_control) + ", their summed RMSE " + text(kDrift.group_vs_control) + " of its",
        kDrift.why},
+      {"drift probe (seed 1713)", "summed loadcells " + text(kDriftProbe.group_vs_before),
+       "summed loadcells " + text(kDriftProbe.group_vs_control),
+       "the probe's candidate chosen and confirmed (decision p " + text(kDriftProbe.decision_p) +
+           "); all nine loadcells at one rate, re-estimated rate / the plant's " + text(kDriftProbe.rate_vs_plant),
+       kDriftProbe.why},
       {"default drift, 1 000 steps", text(kDefaultDriftLongLogs.winner_vs_before), none,
        "re-estimated rate / the plant's " + text(kDefaultDriftLongLogs.rate_vs_plant) +
            "; decision p against fine-tuning alone " + text(kDefaultDriftLongLogs.decision_p),

@@ -48,13 +48,15 @@ TEST(FixMargins, EveryMeasuredValuePassesItsBound) {
                          kSensorDelay.aligned_median, kFriction.winner_vs_before, kFriction.winner_vs_control,
                          kFriction.family_vs_before, kCrosstalk.winner_vs_before, kCrosstalk.winner_vs_control,
                          kDrift.winner_vs_before, kDrift.winner_vs_control, kDrift.family_vs_before,
-                         kDrift.each_vs_control, kDrift.group_vs_control,
+                         kDrift.each_vs_control, kDrift.group_vs_control, kDriftProbe.group_vs_before,
+                         kDriftProbe.group_vs_control, kDriftProbe.decision_p,
                          kDefaultDriftLongLogs.winner_vs_before, kDefaultDriftLongLogs.decision_p,
                          kSaturation.winner_vs_before, kSaturation.winner_vs_control, kSaturation.rail_error_N,
                          kAux.winner_vs_before, kAux.winner_vs_control, kSpringDelay.winner_vs_before,
                          kSpringDelay.winner_vs_control})
     EXPECT_LT(b.measured, b.limit);
-  for (const Between& b : {kCrosstalk.gain, kDrift.rate_vs_plant, kDefaultDriftLongLogs.rate_vs_plant}) {
+  for (const Between& b : {kCrosstalk.gain, kDrift.rate_vs_plant, kDriftProbe.rate_vs_plant,
+                           kDefaultDriftLongLogs.rate_vs_plant}) {
     EXPECT_GT(b.measured, b.lo);
     EXPECT_LT(b.measured, b.hi);
   }
