@@ -154,6 +154,15 @@
 # drift=0.01 measured with its first version (the final code differs only
 # where a drift is confirmed: those six sets, 1682, 1691 and development
 # 1664, 1665, 1669 and 1670, re-run with it give the same passes).
+# Stop 56 (the drift probe, trainer/residual/drift_probe.h): 1712-1716's
+# drift=0.02 logs development (the probe first as one more candidate, then
+# in the place of the screen's load drifts, then its level 0.05; 1713's
+# logs are also the probe's test, ResidualFix.TheDriftProbe...); 1722-1731
+# every effect at its larger strength run with the probe's level at 0.01,
+# stopped after 21 runs (their drift sets' probe p were seen before the
+# level was set, so they are development); 1752-1761 every effect at its
+# larger strength and drift=0.01 measured with the final code. Next unused:
+# 1797 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

@@ -79,6 +79,9 @@
 # Stop 55 (a drift across its group): 1692-1711 measured, none confirmed;
 # the multi-step RMSE of 1672-1681 read as development evidence for a
 # drift screen (not built).
+# Stop 56 (the drift probe): 1732-1751 run with the probe's level at 0.01
+# (none confirmed), then development of its level 0.05 (the smallest probe
+# p there, 0.021, read); 1762-1781 measured with the final code.
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

@@ -37,7 +37,8 @@
 # decision on two folds; the 4-seed model), 1422-1431 (stop 48: --fix's
 # candidates down to 1 by default; the 4-seed model; also at the screen's
 # floor on the same logs), 1487-1496 (stop 49: the same defaults on
-# 600-row logs, RESIDUAL_ROWS=600).
+# 600-row logs, RESIDUAL_ROWS=600), 1782-1791 (stop 56: the drift probe;
+# the 4-seed model).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve]

@@ -249,11 +249,11 @@ int run_residual(int argc, char** argv) {
                               "either claims significantly better (the simpler account); a family alone confirmed is\n"
                               "then extended to its group when the extended plan predicts the channels it adds\n"
                               "significantly better on the held-out rows, and a delay seen beyond its family likewise\n"
-                              "to every channel of its group; when the screen proposes no drift and a place is left,\n"
+                              "to every channel of its group; when a place is left or the screen proposes a load drift,\n"
                               "the drift probe asks each channel group whether a load drift at one rate, fitted on the\n"
                               "first 75 % of the training rows, makes the unchanged network predict the rest better\n"
                               "(one-sided Diebold-Mariano, Holm over the groups), and the best group that does is one\n"
-                              "more candidate", "5");
+                              "more candidate (after the screen's drift of its group, beyond K, when it lists one)", "5");
   opt.value("fix-min-excess-null", "S",
             "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"
             "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"

@@ -499,13 +499,23 @@ TEST(ResidualFix, DriftGetsABiasStateWithTheRightRateAndCutsTheError) {
   const Augmentation& a = *r.fix.augmentation;
   const std::vector<trainer::SensorDrift>& drifts = std::get<BiasState>(a.change).drifts;
   ASSERT_FALSE(drifts.empty());
-  // The plant drifts every loadcell at one rate: after the confirmation the
-  // drift on every loadcell at one re-estimated rate is judged on all nine
-  // against the plan applied before it, and applied.
-  ASSERT_FALSE(r.fix.extensions.empty());
-  const FixResult::Extension& whole = r.fix.extensions.back();
-  EXPECT_TRUE(whole.applied) << whole.what << ": p " << whole.test.p_value;
-  EXPECT_EQ(whole.channels.size(), 9u);
+  // The plant drifts every loadcell at one rate, and the plan ends on all
+  // nine at one re-estimated rate by either of two paths: the drift probe's
+  // candidate (drift_probe.h), which the selection chose over the screen's
+  // drift of fc3 and fc6; or that drift, confirmed, then judged on all
+  // nine against itself and applied (FixResult::extensions).
+  const auto chosen = std::find_if(r.fix.candidates.begin(), r.fix.candidates.end(),
+                                   [](const CandidateTrial& c) { return c.chosen; });
+  ASSERT_NE(chosen, r.fix.candidates.end());
+  std::printf("  the plan on all nine: %s\n", chosen->from_drift_probe ? "the drift probe's" : "the whole group's");
+  if (chosen->from_drift_probe) {
+    EXPECT_TRUE(r.fix.extensions.empty()) << "the probe's plan holds the whole group already";
+  } else {
+    ASSERT_FALSE(r.fix.extensions.empty());
+    const FixResult::Extension& whole = r.fix.extensions.back();
+    EXPECT_TRUE(whole.applied) << whole.what << ": p " << whole.test.p_value;
+    EXPECT_EQ(whole.channels.size(), 9u);
+  }
   ASSERT_EQ(drifts.size(), 9u);
   for (const auto& d : drifts) {
     EXPECT_EQ(channel_group(d.channel), "fc") << d.channel;
@@ -516,9 +526,14 @@ TEST(ResidualFix, DriftGetsABiasStateWithTheRightRateAndCutsTheError) {
   EXPECT_LT(drifts.front().rate, fm::kDrift.rate_vs_plant.hi * 0.02);
   EXPECT_TRUE(r.fix.model.sensor.drifts == drifts);
   EXPECT_TRUE(r.fix.model.layout == build_model().layout);
-  const std::string& c = a.channels.front();
+  // The screen's winner (fc3) and every channel the screen found the drift on.
+  const std::vector<HypothesisResult> family = r.attribution.winner_family();
+  ASSERT_FALSE(family.empty());
+  ASSERT_EQ(family.front().hypothesis.kind, EffectKind::kDriftLoad);
+  const std::string& c = r.data.y_names[static_cast<std::size_t>(family.front().hypothesis.target)];
   expect_cut(r.fix, c, fm::kDrift.winner_vs_before, fm::kDrift.winner_vs_control);
-  for (const auto& ch : a.found_on) expect_cut(r.fix, ch, fm::kDrift.family_vs_before);
+  for (const auto& h : family)
+    expect_cut(r.fix, r.data.y_names[static_cast<std::size_t>(h.hypothesis.target)], fm::kDrift.family_vs_before);
   ASSERT_TRUE(r.fix.control.has_value());
   double after = 0, control = 0;
   for (const auto& d : drifts) {

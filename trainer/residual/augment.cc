@@ -419,11 +419,12 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // slow drift, and lists it on a family of one or two channels, so every
   // channel group is asked with the unchanged network whether a load drift
   // at one re-estimated rate predicts the selection's judged rows better.
-  // The best group that does takes the place of the screen's load drifts of
-  // that group (the first's place: its family, and the family alone), or,
-  // when the screen proposes none, is one more candidate after the screen's
-  // where a place is left (FixOptions::candidates), or the only one when the
-  // screen has none that can be added.
+  // The best group that does is one more candidate: right after the
+  // screen's load drifts of that group when it lists one (a drift's third
+  // plan, beside its family and the family alone, beyond
+  // FixOptions::candidates), else after the screen's candidates where a
+  // place is left, or the only one when the screen has none that can be
+  // added. The selection then chooses among them as among any.
   std::optional<std::size_t> probed;  // its index in `planned`
   const bool none_addable = planned.empty() || !planned.front().not_fixable.empty();
   const bool place_left = none_addable || static_cast<int>(planned.size()) < options.candidates;
@@ -447,10 +448,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       const auto first = std::find_if(planned.begin(), planned.end(),
                                       [&](const Augmentation& a) { return load_drift_of(a, best->group); });
       if (first != planned.end()) {
-        const auto at = first - planned.begin();
-        planned.erase(std::remove_if(planned.begin(), planned.end(),
-                                     [&](const Augmentation& a) { return load_drift_of(a, best->group); }),
-                      planned.end());
+        const auto last = std::find_if(planned.rbegin(), planned.rend(),
+                                       [&](const Augmentation& a) { return load_drift_of(a, best->group); });
+        const auto at = planned.rend() - last;  // right after the screen's last load drift of the group
         planned.insert(planned.begin() + at, std::move(group));
         probed = static_cast<std::size_t>(at);
       } else if (place_left) {
@@ -469,7 +469,6 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     result.status = "not supported: " + planned.front().effect + ": " + planned.front().not_fixable;
     return result;
   }
-
 
   // A model fine-tuned on the rows of `rows` (the control: no augmentation).
   struct Tuned {

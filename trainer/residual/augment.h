@@ -75,7 +75,8 @@ struct FixOptions {
   // (docs/residual.md, "Detection on fresh logs"), when every candidate was
   // another effect; since stop 51 a family alone takes one of them. The
   // drift probe (drift_probe.h) takes a place left when the screen proposes
-  // no drift (or the only place, when no screened candidate can be added).
+  // no drift (or the only place, when no screened candidate can be added),
+  // and is one beyond it when it follows the screen's load drift.
   int candidates = 5;
   // With a calibrated null: the floor of excess_share (in units of the
   // channel's clean residual level) of the candidates fix() may try
@@ -447,9 +448,12 @@ struct FixResult {
   // null (the screen's absolute floors).
   std::optional<double> candidates_floor;
   std::vector<CandidateTrial> candidates;          // the screen's candidates, in its order (then the probe's)
-  // The drift probes (drift_probe.h), run when the screen proposes no drift
-  // and the logs are long enough for the selection's rows; the best
-  // candidate group is the last of `candidates`. Empty: not run.
+  // The drift probes (drift_probe.h), run when the logs are long enough for
+  // the selection's rows and the screen proposes a load drift or leaves a
+  // candidate's place (FixOptions::drift_probe_alpha > 0); the best
+  // candidate group follows the screen's load drifts of its group among
+  // `candidates`, or is the last of them (CandidateTrial::from_drift_probe).
+  // Empty: not run.
   std::vector<DriftProbe> drift_probes;
   // Wider plans tested after the confirmation, in order: a confirmed family
   // alone (a candidate planned without its group, Augmentation::

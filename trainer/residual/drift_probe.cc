@@ -23,7 +23,7 @@ Augmentation group_drift_plan(const std::vector<std::string>& channels, double p
   Augmentation a;
   a.kind = EffectKind::kDriftLoad;
   a.effect = effect_info(a.kind).name;
-  a.group_extension = false;
+  a.group_extension = true;  // planned on its whole group (never a family alone: is_family_alone)
   auto& change = a.change.emplace<BiasState>();
   change.period_s = period_s;
   change.common_rate = true;

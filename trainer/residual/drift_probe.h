@@ -28,10 +28,11 @@
 //      judge); a group is a candidate when its adjusted p is below alpha
 //      with a positive gain.
 //
-// The probe proposes only: the best candidate group joins fix()'s candidates
-// after the screen's (one candidate per effect), is judged on the training
-// rows like them, and only the decision on the held-out rows, against
-// fine-tuning alone, confirms it (augment.h). The held-out rows play no part
+// The probe proposes only: the best candidate group joins fix()'s
+// candidates, right after the screen's load drifts of that group or after
+// the screen's candidates; it is judged on the training rows like them, and
+// only the decision on the held-out rows, against fine-tuning alone,
+// confirms it (augment.h, fix()). The held-out rows play no part
 // here. Nothing here knows the hand: groups come from the model's channel
 // names (channel_group).
 #pragma once
