@@ -438,18 +438,23 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   if (options.drift_probe_alpha > 0 && can_select && (place_left || any_load_drift)) {
     DriftProbeRows rows;
     rows.refined = [&](const Augmentation& plan) { return refined(plan, selection_train, nullptr); };
+    // The unchanged network without a drift is every group's reference: judged once.
+    std::optional<HeldOutError> unchanged;
     rows.loss = [&](const SensorModel& sensor, const std::vector<std::string>& channels) {
-      probe.sensor = sensor;
-      return standardised_loss(model, held_out_error(probe, eval_rows(probe, before_pbs, selection_judged)), channels);
+      const auto judged_rows = [&] {
+        probe.sensor = sensor;
+        return held_out_error(probe, eval_rows(probe, before_pbs, selection_judged));
+      };
+      if (sensor != model.sensor) return standardised_loss(model, judged_rows(), channels);
+      if (!unchanged) unchanged = judged_rows();
+      return standardised_loss(model, *unchanged, channels);
     };
     result.drift_probes = probe_drifts(model, data, rows, options.drift_probe_alpha);
     if (const DriftProbe* best = best_drift_probe(result.drift_probes)) {
       Augmentation group = group_drift_plan(best->channels, data.logs.front().dt_s, best->start_rate);
-      const auto first = std::find_if(planned.begin(), planned.end(),
-                                      [&](const Augmentation& a) { return load_drift_of(a, best->group); });
-      if (first != planned.end()) {
-        const auto last = std::find_if(planned.rbegin(), planned.rend(),
-                                       [&](const Augmentation& a) { return load_drift_of(a, best->group); });
+      const auto last = std::find_if(planned.rbegin(), planned.rend(),
+                                     [&](const Augmentation& a) { return load_drift_of(a, best->group); });
+      if (last != planned.rend()) {
         const auto at = planned.rend() - last;  // right after the screen's last load drift of the group
         planned.insert(planned.begin() + at, std::move(group));
         probed = static_cast<std::size_t>(at);

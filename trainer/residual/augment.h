@@ -75,8 +75,9 @@ struct FixOptions {
   // (docs/residual.md, "Detection on fresh logs"), when every candidate was
   // another effect; since stop 51 a family alone takes one of them. The
   // drift probe (drift_probe.h) takes a place left when the screen proposes
-  // no drift (or the only place, when no screened candidate can be added),
-  // and is one beyond it when it follows the screen's load drift.
+  // no load drift of its group (or the only place, when no screened
+  // candidate can be added), and is one beyond it when it follows the
+  // screen's load drift of its group.
   int candidates = 5;
   // With a calibrated null: the floor of excess_share (in units of the
   // channel's clean residual level) of the candidates fix() may try

@@ -2,22 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 
 #include "trainer/log_dataset.h"
 
 namespace hadynet::trainer::residual {
-
-namespace {
-
-std::string join(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
-  return out;
-}
-
-}  // namespace
 
 Augmentation group_drift_plan(const std::vector<std::string>& channels, double period_s, double rate) {
   Augmentation a;

@@ -180,6 +180,8 @@ double main_parameter(const Hypothesis& h, const Eigen::VectorXd& coef);
 // may lower a reading). An implausible hypothesis is tested but never
 // significant (attribution.h).
 bool plausible(const Hypothesis& h, const Eigen::VectorXd& coef);
+// Channel names as the descriptions list them: "fc1, fc3, fc4".
+std::string join(const std::vector<std::string>& names);
 // The name of the hypothesis' source channel (u, y or aux, by the effect's
 // SourceKind); "" for an effect without one.
 std::string source_name(const Hypothesis& h, const ResidualData& data);
