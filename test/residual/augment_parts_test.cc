@@ -294,6 +294,40 @@ TEST(SensorFrame, ACalibrationCurveAndItsInverse) {
 // not the screen's first, which on fresh logs is often the model's own
 // misfit (docs/residual.md, "Detection on fresh logs"); not judged or no
 // gain: the screen's first.
+// The plan's curves are fitted as one (CalibrationCurves::refine): on the
+// union of the channels' knots, by coordinate search from the identity. A
+// faked probe of the unchanged network: every channel's error is 1 except
+// a third channel's, 1 + the squared distance of fc0's readings at its knots
+// from twice the level, so the loss is least at slope 2 on every segment,
+// which the search's factor 2 reaches from the identity in one sweep.
+TEST(SensorFrame, ThePlansCurvesAreFittedAsOneOnTheUnionOfTheirKnots) {
+  residual::Augmentation a;
+  a.kind = residual::EffectKind::kSensorCurve;
+  a.channels = {"fc0", "fc1"};
+  auto& change = a.change.emplace<residual::CalibrationCurves>();
+  change.curves = {{"fc0", {0, 1, 2}, {0, 1, 2}}, {"fc1", {0, 1.5, 3}, {0, 1.5, 3}}};
+  residual::TrainingRmse rmse;
+  rmse.y_names = {"fc0", "fc1", "l0"};
+  rmse.all = [](const SensorModel& s) {
+    Eigen::VectorXd e = Eigen::VectorXd::Ones(3);
+    if (const SensorCurve* c = s.curve_of("fc0"))
+      for (std::size_t k = 0; k < c->level.size(); ++k) e(2) += std::pow(c->reading[k] - 2 * c->level[k], 2);
+    return e;
+  };
+  std::vector<double> fitted;
+  change.refine(a, SensorModel{}, rmse, fitted);
+  ASSERT_EQ(change.curves.size(), 2u);
+  const std::vector<double> knots = {0, 1, 1.5, 2, 3};
+  for (const SensorCurve& c : change.curves) {
+    ASSERT_EQ(c.level, knots) << c.channel;
+    for (std::size_t k = 0; k < knots.size(); ++k) EXPECT_NEAR(c.reading[k], 2 * knots[k], 1e-12) << c.channel << k;
+  }
+  EXPECT_EQ(change.curves[0].channel, "fc0");
+  EXPECT_EQ(change.curves[1].channel, "fc1");
+  EXPECT_TRUE(fitted.empty());
+  EXPECT_NE(a.description.find("one curve, 5 knots"), std::string::npos) << a.description;
+}
+
 TEST(FixCandidates, TheFirstSignificantElseTheClearestGainIsTested) {
   auto trial = [](double stat, bool judged = true) {
     residual::CandidateTrial c;

@@ -100,13 +100,15 @@ struct SensorCurve {
   const char* why;
 };
 inline constexpr SensorCurve kSensorCurve{
-    .winner_vs_before = {0.5, 0.37},
-    .winner_vs_control = {0.95, 0.85},
+    .winner_vs_before = {0.5, 0.34},
+    .winner_vs_control = {0.95, 0.78},
     .family_vs_before = {0.9, 0.82},
-    .winner_reading_error = {0.25, 0.22},
+    .winner_reading_error = {0.1, 0.001},
     .why = "against the model's stored null, as `hadynet residual` by default; fine-tuning alone cuts fc3 to "
            "0.44×, and the identity curve (no fit) would leave the control's error (1.0×) and read 26 % low at "
-           "the top knot; the family channels measured 0.62-0.82× (fc5 the worst)"};
+           "the top knot; since stop 57 one curve for the six loadcells (a curve per channel read 22 % low, "
+           "and measured 0.37× before and 0.85× the control); the family channels measured 0.62-0.82× (fc5 "
+           "the worst)"};
 
 // Plant: fingertip loadcell i adds 0.35 x its neighbour's force (crosstalk).
 struct Crosstalk {

@@ -475,6 +475,9 @@ TEST(ResidualFix, ACalibrationCurveIsFittedAndCutsTheLoadcellsError) {
   EXPECT_TRUE(m.layout == build_model().layout);
   for (const auto& curve : m.sensor.curves) {
     ASSERT_EQ(channel_group(curve.channel), "fc");
+    // One curve for the group (CalibrationCurves::refine).
+    EXPECT_EQ(curve.level, m.sensor.curves.front().level) << curve.channel;
+    EXPECT_EQ(curve.reading, m.sensor.curves.front().reading) << curve.channel;
     // The fitted curve against the plant's at its highest knot: compressive
     // like the plant's, a reading above the level.
     const double top = curve.level.back(), plant = 50.0 * std::pow(std::max(top, 0.0) / 50.0, 0.85);

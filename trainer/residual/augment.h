@@ -194,9 +194,10 @@ struct OutputClips : ModelChange {
   bool carried_before_tuning() const { return true; }
 };
 
-// sensor-curve: a static calibration curve per family channel: the logs are
-// read through its inverse (in y and x), the prediction through it; the
-// curves' slopes are re-estimated before fine-tuning (refine).
+// sensor-curve: a static calibration curve of the plan's channels (one
+// curve for all of them once refine() has fitted it, before fine-tuning):
+// the logs are read through its inverse (in y and x), the prediction through
+// it.
 struct CalibrationCurves : ModelChange {
   std::vector<SensorCurve> curves;  // one per channel
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;

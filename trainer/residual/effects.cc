@@ -932,8 +932,8 @@ std::vector<double> knot_levels(const ResidualData& data, int c) {
 // misfit from being named). Family channels of other groups are left to a
 // later round: on fresh plant logs with curved loadcells they were tendons
 // and lengths, the model's misfit. Each channel's curve starts as the
-// identity on its knots (the screen's slopes are of the measured level and
-// carry the network's misfit) and refine() fits it.
+// identity on its own knots (the screen's slopes are of the measured level
+// and carry the network's misfit); refine() fits one curve for them all.
 void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
   auto& change = a.change.emplace<CalibrationCurves>();
   const std::string group = channel_group(y_name(data, w.hypothesis.target));
@@ -958,7 +958,8 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
     a.not_fixable = "no channel of the curve's group takes two distinct levels for its knots";
     return;
   }
-  a.description = "a static calibration curve of " + join(a.channels) +
+  a.description = std::string(change.curves.size() > 1 ? "one static calibration curve for " : "a static calibration curve of ") +
+                  join(a.channels) +
                   (a.extended_channels.empty()
                        ? ""
                        : " (" + join(a.extended_channels) + ": a curve in the same group)") +
@@ -992,70 +993,77 @@ void CalibrationCurves::add_to_sensor(SensorModel& s, const Augmentation&) const
   }
 }
 
-// Each curve is fitted on the training rows: its segment slopes by
-// coordinate search (each slope times 0.5, 0.7, 0.85, 0.93, 1/0.93, 1/0.85,
-// 1/0.7 or 2 within 1/4..4, kept where the loss falls; sweeps until one
-// changes nothing, at most 6), channels in plan order, each with the others'
-// curves so far. The curve stays anchored at its lowest knot. The loss is
-// the unchanged network's 1-step error of every channel in the measured frame, each
-// relative to its error before the curves: sum_c (rmse_c / rmse_c,before)^2.
-// The channel's own error alone is no criterion: a flat curve feeds the
-// network an exaggerated level and reads its prediction back compressed,
-// which turns it into persistence (a good 1-step predictor of a slow
-// loadcell); what the network predicts of every other channel from that
-// level shows the distortion. `fitted` is left as it is: the search starts
-// from the identity, not from a fitted parameter.
+// The plan's channels share one curve, fitted on the training rows. Sensors
+// of one group are of one kind (plan()), and one curve pools their rows: with
+// a curve per channel (stop 56 and before) the segments above a channel's
+// 7/8 quantile rested on a few rows each, and the fitted readings at the
+// top knot ranged 0.5-2.1 times the plant's on development seeds 1797-1801
+// (0.9-1.26 at every knot above 1 N with one curve; docs/residual.md, "One
+// curve for the group"). Its knots are the union of the channels' own
+// (knot_levels: each channel's quantiles, so the curve has knots where any
+// channel has rows), within 1e-4 of their range merged. Its segment slopes
+// by coordinate search (each slope times 0.5, 0.7, 0.85, 0.93, 1/0.93,
+// 1/0.85, 1/0.7 or 2 within 1/4..4, kept where the loss falls; sweeps until
+// one changes nothing, at most 6). The curve stays anchored at its lowest
+// knot. The loss is the unchanged network's 1-step error of every channel in
+// the measured frame, each relative to its error before the curve:
+// sum_c (rmse_c / rmse_c,before)^2. The channel's own error alone is no
+// criterion: a flat curve feeds the network an exaggerated level and reads
+// its prediction back compressed, which turns it into persistence (a good
+// 1-step predictor of a slow loadcell); what the network predicts of every
+// other channel from that level shows the distortion. `fitted` is left as
+// it is: the search starts from the identity, not from a fitted parameter.
 void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
                                std::vector<double>&) {
+  if (curves.empty()) return;
   static constexpr double kFactors[] = {0.5, 0.7, 0.85, 0.93, 1 / 0.93, 1 / 0.85, 1 / 0.7, 2.0};
   // A segment's slope stays within kMinSlope..kMaxSlope of the identity's:
   // beyond, the search fitted the noise of a loadcell at rest (slopes of
   // 1/64 on seed-1 development logs) without a better fit on fresh ones.
   using sensor_curve::kMaxSlope, sensor_curve::kMinSlope;
-  Eigen::ArrayXd rmse_before = training_rmse.all(before).array().max(1e-12);
-  for (SensorCurve& curve : curves) {
-    const auto slopes_of = [](const SensorCurve& c) {
-      std::vector<double> s;
-      for (std::size_t k = 1; k < c.level.size(); ++k)
-        s.push_back((c.reading[k] - c.reading[k - 1]) / (c.level[k] - c.level[k - 1]));
-      return s;
-    };
-    const auto set_slopes = [](SensorCurve& c, const std::vector<double>& s) {
-      for (std::size_t k = 1; k < c.level.size(); ++k)
-        c.reading[k] = c.reading[k - 1] + s[k - 1] * (c.level[k] - c.level[k - 1]);
-    };
-    std::vector<double> slopes = slopes_of(curve);
-    const auto loss = [&] { return (training_rmse.all(sensor_after(before, a)).array() / rmse_before).square().sum(); };
-    double best = loss();
-    bool changed = true;
-    for (int sweep = 0; sweep < 6 && changed; ++sweep) {
-      changed = false;
-      for (std::size_t k = 0; k < slopes.size(); ++k) {
-        const double kept = slopes[k];
-        double best_slope = kept;
-        for (double f : kFactors) {
-          slopes[k] = kept * f;
-          if (slopes[k] < kMinSlope || slopes[k] > kMaxSlope) continue;
-          set_slopes(curve, slopes);
-          const double l = loss();
-          if (l < best) best = l, best_slope = slopes[k], changed = true;
-        }
-        slopes[k] = best_slope;
-        set_slopes(curve, slopes);
+  const Eigen::ArrayXd rmse_before = training_rmse.all(before).array().max(1e-12);
+  std::vector<double> union_levels;
+  for (const SensorCurve& c : curves) union_levels.insert(union_levels.end(), c.level.begin(), c.level.end());
+  std::sort(union_levels.begin(), union_levels.end());
+  const double min_gap = 1e-4 * (union_levels.back() - union_levels.front());
+  std::vector<double> knots;
+  for (double v : union_levels)
+    if (knots.empty() || (v > knots.back() + min_gap && static_cast<float>(v) > static_cast<float>(knots.back())))
+      knots.push_back(v);
+  std::vector<double> slopes(knots.size() - 1, 1.0);  // the identity
+  const auto set_slopes = [&] {
+    for (SensorCurve& c : curves) {
+      c.level = knots;
+      c.reading.assign(knots.size(), knots.front());
+      for (std::size_t k = 1; k < knots.size(); ++k)
+        c.reading[k] = c.reading[k - 1] + slopes[k - 1] * (knots[k] - knots[k - 1]);
+    }
+  };
+  set_slopes();
+  const auto loss = [&] { return (training_rmse.all(sensor_after(before, a)).array() / rmse_before).square().sum(); };
+  double best = loss();
+  bool changed = true;
+  for (int sweep = 0; sweep < 6 && changed; ++sweep) {
+    changed = false;
+    for (std::size_t k = 0; k < slopes.size(); ++k) {
+      const double kept = slopes[k];
+      double best_slope = kept;
+      for (double f : kFactors) {
+        slopes[k] = kept * f;
+        if (slopes[k] < kMinSlope || slopes[k] > kMaxSlope) continue;
+        set_slopes();
+        const double l = loss();
+        if (l < best) best = l, best_slope = slopes[k], changed = true;
       }
+      slopes[k] = best_slope;
+      set_slopes();
     }
   }
-  std::string ratios;
-  char text[96];
-  for (const SensorCurve& c : curves) {
-    const std::size_t n = c.level.size();
-    const double bottom = (c.reading[1] - c.reading[0]) / (c.level[1] - c.level[0]);
-    const double top = (c.reading[n - 1] - c.reading[n - 2]) / (c.level[n - 1] - c.level[n - 2]);
-    std::snprintf(text, sizeof text, "%s%s slope %.3g at %.4g .. %.3g at %.4g", ratios.empty() ? "" : ", ",
-                  c.channel.c_str(), bottom, c.level[0], top, c.level[n - 1]);
-    ratios += text;
-  }
-  a.description += "; re-estimated: " + ratios;
+  const std::size_t n = knots.size();
+  char text[160];
+  std::snprintf(text, sizeof text, "; re-estimated: one curve, %zu knots, slope %.3g at %.4g .. %.3g at %.4g, reads %.4g at %.4g",
+                n, slopes.front(), knots.front(), slopes.back(), knots[n - 1], curves.front().reading.back(), knots[n - 1]);
+  a.description += text;
 }
 
 namespace {
