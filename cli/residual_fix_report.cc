@@ -103,6 +103,7 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                                              {"statistic", a.against_reference.stat},
                                              {"rows", a.against_reference.samples},
                                              {"p_value", a.against_reference.p_value}}},
+                      {"flat_end", a.flat_end},
                       {"applied", a.applied}};
       if (a.gain_tested)
         account["confirmed_gain"] = {{"channels", a.gain_channels},
@@ -195,6 +196,9 @@ std::string simpler_sentence(const rs::FixResult::SimplerAccount& s, const std::
   for (std::size_t i = 0; i < s.gain_channels.size(); ++i) m += (i ? ", " : "") + s.gain_channels[i];
   m += ": mean loss difference " + num("%.3g", s.confirmed_gain.mean) +
        ", p " + num("%.2g", s.confirmed_gain.p_value) + ": ";
+  if (s.flat_end)
+    return m + "the curve's end at the rail is as flat as its fit may be (a rail's signature), " + s.effect +
+           " applied in its place";
   return m + (s.applied ? "no significant gain, " + s.effect + " applied in its place"
                         : "a significant gain, " + s.replaces + " kept");
 }

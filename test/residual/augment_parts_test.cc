@@ -328,6 +328,25 @@ TEST(SensorFrame, ThePlansCurvesAreFittedAsOneOnTheUnionOfTheirKnots) {
   EXPECT_NE(a.description.find("one curve, 5 knots"), std::string::npos) << a.description;
 }
 
+// A curve's end as flat as its fit may be: one more step of the search
+// (x 0.93) would cross the slope bound 1/4 (CalibrationCurves::flat_at_end,
+// the simpler account's rail signature).
+TEST(SensorFrame, ACurvesEndIsFlatWhereItsFitCouldGoNoFlatter) {
+  using residual::CalibrationCurves;
+  // Slopes 0.26 on [0, 1], 1 on [1, 2], 0.26 on [2, 3]: 0.26 x 0.93 < 1/4.
+  const SensorCurve flat{"fc0", {0, 1, 2, 3}, {0, 0.26, 1.26, 1.52}};
+  EXPECT_TRUE(CalibrationCurves::flat_at_end(flat, 1));
+  EXPECT_TRUE(CalibrationCurves::flat_at_end(flat, -1));
+  // Slope 0.27 at both ends: 0.27 x 0.93 = 0.2511, a step the search could still take.
+  const SensorCurve steeper{"fc0", {0, 1, 2, 3}, {0, 0.27, 1.27, 1.54}};
+  EXPECT_FALSE(CalibrationCurves::flat_at_end(steeper, 1));
+  EXPECT_FALSE(CalibrationCurves::flat_at_end(steeper, -1));
+  // One end flat, the other not: the side decides.
+  const SensorCurve top_only{"fc0", {0, 1, 2}, {0, 1, 1.25}};
+  EXPECT_TRUE(CalibrationCurves::flat_at_end(top_only, 1));
+  EXPECT_FALSE(CalibrationCurves::flat_at_end(top_only, -1));
+}
+
 TEST(FixCandidates, TheFirstSignificantElseTheClearestGainIsTested) {
   auto trial = [](double stat, bool judged = true) {
     residual::CandidateTrial c;

@@ -207,6 +207,23 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   return out;
 }
 
+namespace {
+
+// Whether `confirmed` is a calibration curve whose lead channel's end on
+// the side of `rail`'s clip of that channel is as flat as the curve's fit
+// may be (FixResult::SimplerAccount::flat_end).
+bool flat_end_at_rail(const Augmentation& confirmed, const Augmentation& rail) {
+  const auto* curves = std::get_if<CalibrationCurves>(&confirmed.change);
+  const auto* clips = std::get_if<OutputClips>(&rail.change);
+  if (curves == nullptr || clips == nullptr || curves->curves.empty()) return false;
+  const SensorCurve& lead = curves->curves.front();
+  const auto clip = std::find_if(clips->clips.begin(), clips->clips.end(),
+                                 [&](const OutputClip& c) { return c.channel == lead.channel; });
+  return clip != clips->clips.end() && CalibrationCurves::flat_at_end(lead, clip->side);
+}
+
+}  // namespace
+
 bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k) {
   return k > 0 && k < planned.size() && !planned[k].group_extension && planned[k - 1].kind == planned[k].kind &&
          !planned[k - 1].extended_channels.empty();
@@ -671,7 +688,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
           account.gain_channels.push_back(name);
       account.gain_tested = true;
       account.confirmed_gain = compare(t.rows, t.mirrored, result.after, mirrored_after, account.gain_channels);
-      account.applied = !significant(account.confirmed_gain);
+      account.flat_end = flat_end_at_rail(*result.augmentation, plan);
+      account.applied = account.flat_end || !significant(account.confirmed_gain);
     }
     if (account.applied) {
       apply(t);

@@ -204,6 +204,12 @@ struct CalibrationCurves : ModelChange {
   void refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
               std::vector<double>& fitted);
   bool carried_before_tuning() const { return true; }  // refine() fitted it
+  // Whether the curve's end segment on `side` (+1 its top, -1 its bottom)
+  // is as flat as refine() may fit it: a further step of its search
+  // (x 0.93) would cross the slope bound 1/4. The fit asked for a flatter
+  // end, which is a rail's signature there (fix(): the simpler account),
+  // as an end slope below 1/4 is a delay's in the screen.
+  static bool flat_at_end(const SensorCurve& curve, int side);
 };
 
 // friction: a hysteresis state as an input: for every muscle m of the
@@ -512,6 +518,11 @@ struct FixResult {
     std::vector<std::string> gain_channels;  // the confirmation's channels and the plan's (if tested)
     DieboldMariano confirmed_gain;      // the simpler plan's loss minus the confirmed change's on gain_channels
     bool gain_tested = false;           // against_reference was significant, so confirmed_gain was tested
+    // The confirmed change is a calibration curve whose lead channel's end
+    // on the rail's side is as flat as its fit may be
+    // (CalibrationCurves::flat_at_end): the rail is applied once confirmed
+    // against the reference, whatever confirmed_gain says.
+    bool flat_end = false;
     bool applied = false;
   };
   std::optional<SimplerAccount> simpler;

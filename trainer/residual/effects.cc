@@ -993,6 +993,14 @@ void CalibrationCurves::add_to_sensor(SensorModel& s, const Augmentation&) const
   }
 }
 
+bool CalibrationCurves::flat_at_end(const SensorCurve& curve, int side) {
+  const std::size_t n = curve.level.size();
+  if (n < 2) return false;
+  const std::size_t k = side > 0 ? n - 1 : 1;  // the end segment: knots k-1 and k
+  const double slope = (curve.reading[k] - curve.reading[k - 1]) / (curve.level[k] - curve.level[k - 1]);
+  return slope * 0.93 < sensor_curve::kMinSlope;
+}
+
 // The plan's channels share one curve, fitted on the training rows. Sensors
 // of one group are of one kind (plan()), and one curve pools their rows: with
 // a curve per channel (stop 56 and before) the segments above a channel's
