@@ -161,8 +161,14 @@
 # every effect at its larger strength run with the probe's level at 0.01,
 # stopped after 21 runs (their drift sets' probe p were seen before the
 # level was set, so they are development); 1752-1761 every effect at its
-# larger strength and drift=0.01 measured with the final code. Next unused:
-# 1797 on.
+# larger strength and drift=0.01 measured with the final code.
+# Stop 57 (one calibration curve for the plan's channels; a curve's flat
+# end at a rail gives way to the rail): 1797-1801 sensor-curve=0.7
+# development (the shared curve chosen there; the flat end checked on
+# their fitted top slopes); 1802-1811 sensor-curve=0.7 measured with the
+# shared curve before the flat-end rule; 1752-1761's saturation=2 logs
+# re-run with it (unchanged); 1832-1841 every effect at its larger
+# strength measured with the final code. Next unused: 1862 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

@@ -82,6 +82,8 @@
 # Stop 56 (the drift probe): 1732-1751 run with the probe's level at 0.01
 # (none confirmed), then development of its level 0.05 (the smallest probe
 # p there, 0.021, read); 1762-1781 measured with the final code.
+# Stop 57 (one calibration curve for the plan's channels): 1812-1831
+# measured before the flat-end rule, 1842-1861 with the final code.
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
