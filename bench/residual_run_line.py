@@ -7,8 +7,8 @@ test), shared by bench/residual_detection.sh and bench/residual_oracle.sh.
         named     --fix confirmed the right effect with the right parameter
                   (bench/residual_named.py's rule for the plant effect);
         cut       the held-out 1-step RMSE on the changed channels (mean
-                  ratio after/before) is at most 0.7 (the channels the
-                  decision judged, or a simpler account's, when one was
+                  ratio after/before) is at most 0.7 (the changed channels
+                  the decision judged, or a simpler account's, when one was
                   applied: its own test's);
         <control  the augmented model's summed RMSE there is below
                   fine-tuning alone's.
@@ -45,7 +45,12 @@ def run_line(case, seed, path, progress):
         # change's place (fix.simpler) was confirmed on its own channels.
         simpler = fix.get("simpler") or {}
         judged = simpler["channels"] if simpler.get("applied") else fix.get("confirmation", {}).get("channels")
-        tested = [c for c in (judged or channels) if c in before and c in after]
+        # The changed channels among them: a calibration curve is judged on
+        # every channel (Augmentation::judged_on_every_channel) and cut on
+        # its curved ones; an aux channel's decision is on the targets it
+        # explains, none of which is the aux channel itself.
+        changed = [c for c in (judged or []) if c in channels]
+        tested = [c for c in (changed or judged or channels) if c in before and c in after]
         if tested:
             ratio = sum(after[c] / before[c] for c in tested) / len(tested)
             cut = ratio <= 0.7

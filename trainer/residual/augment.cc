@@ -512,6 +512,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     return t;
   };
   auto channels_of = [&](const Augmentation& a) {
+    if (a.judged_on_every_channel) return model.layout.y_names;
     std::vector<std::string> out;
     for (const auto& name : a.found_on) {
       if (index_of(model.layout.y_names, name) < 0) continue;
@@ -568,7 +569,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // part, against the reference on the held-out rows of the channels it was
   // found on (the plan's found_on, of the model's own channels: the aligned,
   // cleaned, clipped, drifting or friction channels; for an aux channel, the
-  // channels its significant hypotheses explain).
+  // channels its significant hypotheses explain; for a calibration curve
+  // every channel: Augmentation::judged_on_every_channel).
   const Augmentation tested = refined(planned[chosen], train_part, &result.fitted_rates);
   if (!result.candidates[chosen].selected_by_training_rows) result.candidates[chosen].description = tested.description;
   Tuned after = tune(&tested, train_part, &result.untuned);
@@ -787,8 +789,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   if (!confirmed) {
     const auto& a = *result.augmentation;
     result.status = "unexplained structure: adding " + a.effect + " (" + a.description + ") did not beat " +
-                    result.reference + " on the held-out rows of the channels it was found on (Diebold-Mariano p " +
-                    p + ")";
+                    result.reference + " on the held-out rows of " +
+                    (a.judged_on_every_channel ? "every channel" : "the channels it was found on") +
+                    " (Diebold-Mariano p " + p + ")";
     return result;
   }
   result.model = std::move(after.model);

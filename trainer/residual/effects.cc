@@ -965,6 +965,7 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
                        : " (" + join(a.extended_channels) + ": a curve in the same group)") +
                   " (piecewise linear, monotone): the logs read through its inverse, the prediction through it";
   a.found_on = a.channels;
+  a.judged_on_every_channel = true;
 }
 
 }  // namespace sensor_curve
