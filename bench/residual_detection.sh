@@ -168,7 +168,11 @@
 # their fitted top slopes); 1802-1811 sensor-curve=0.7 measured with the
 # shared curve before the flat-end rule; 1752-1761's saturation=2 logs
 # re-run with it (unchanged); 1832-1841 every effect at its larger
-# strength measured with the final code. Next unused: 1862 on.
+# strength measured with the flat-end rule; then a curve judged on every
+# channel (chosen on 1797-1801): 1877-1886 every effect at its larger
+# strength measured with the final code, and its curve, drift and rail
+# logs with the binary before that rule (the same logs). Next unused:
+# 1922 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

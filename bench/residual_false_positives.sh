@@ -83,7 +83,8 @@
 # (none confirmed), then development of its level 0.05 (the smallest probe
 # p there, 0.021, read); 1762-1781 measured with the final code.
 # Stop 57 (one calibration curve for the plan's channels): 1812-1831
-# measured before the flat-end rule, 1842-1861 with the final code.
+# measured before the flat-end rule, 1842-1861 with it, 1887-1906 with
+# the final code (a curve judged on every channel).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

@@ -1006,9 +1006,9 @@ bool CalibrationCurves::flat_at_end(const SensorCurve& curve, int side) {
 // of one group are of one kind (plan()), and one curve pools their rows: with
 // a curve per channel (stop 56 and before) the segments above a channel's
 // 7/8 quantile rested on a few rows each, and the fitted readings at the
-// top knot ranged 0.5-2.1 times the plant's on development seeds 1797-1801
-// (0.9-1.26 at every knot above 1 N with one curve; docs/residual.md, "One
-// curve for the group"). Its knots are the union of the channels' own
+// top knot ranged 0.67-2.10 times the plant's on development seed 1798
+// (one curve: 0.65-1.26 at every knot above 1 N on seeds 1797-1801;
+// docs/residual.md, "One curve for the group"). Its knots are the union of the channels' own
 // (knot_levels: each channel's quantiles, so the curve has knots where any
 // channel has rows), within 1e-4 of their range merged. Its segment slopes
 // by coordinate search (each slope times 0.5, 0.7, 0.85, 0.93, 1/0.93,
