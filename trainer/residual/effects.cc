@@ -905,6 +905,19 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
          fmt(" %.4g", h.centre - h.half_range) + fmt("..%.4g)", h.centre + h.half_range);
 }
 
+// The steps of a curve's coordinate search (CalibrationCurves::refine), and
+// the smallest of them that flattens a segment (CalibrationCurves::flat_at_end).
+constexpr double kFinestStepDown = 0.93;
+constexpr double kSlopeFactors[] = {0.5, 0.7, 0.85, kFinestStepDown, 1 / kFinestStepDown, 1 / 0.85, 1 / 0.7, 2.0};
+
+// Appends `level` to `knots` (increasing) unless it is within `min_gap` of
+// the last knot or equal to it once rounded to float (codegen would refuse
+// the model).
+void push_distinct_knot(std::vector<double>& knots, double level, double min_gap) {
+  if (knots.empty() || (level > knots.back() + min_gap && static_cast<float>(level) > static_cast<float>(knots.back())))
+    knots.push_back(level);
+}
+
 // The knots of a channel's curve: 9 quantiles (0, 1/8, .., 1) of its values
 // in the first half of each log (inside the fix's training rows, the first
 // 60 %); a quantile within 1e-4 of the values' range above the last knot,
@@ -915,11 +928,7 @@ std::vector<double> knot_levels(const ResidualData& data, int c) {
   std::vector<double> knots;
   if (v.empty()) return knots;
   const double min_gap = 1e-4 * (v.back() - v.front());
-  for (int k = 0; k <= 8; ++k) {
-    const double q = lower_quantile(v, k / 8.0);
-    if (knots.empty() || (q > knots.back() + min_gap && static_cast<float>(q) > static_cast<float>(knots.back())))
-      knots.push_back(q);
-  }
+  for (int k = 0; k <= 8; ++k) push_distinct_knot(knots, lower_quantile(v, k / 8.0), min_gap);
   if (knots.size() < 2) knots.clear();
   return knots;
 }
@@ -999,7 +1008,7 @@ bool CalibrationCurves::flat_at_end(const SensorCurve& curve, int side) {
   if (n < 2) return false;
   const std::size_t k = side > 0 ? n - 1 : 1;  // the end segment: knots k-1 and k
   const double slope = (curve.reading[k] - curve.reading[k - 1]) / (curve.level[k] - curve.level[k - 1]);
-  return slope * 0.93 < sensor_curve::kMinSlope;
+  return slope * sensor_curve::kFinestStepDown < sensor_curve::kMinSlope;
 }
 
 // The plan's channels share one curve, fitted on the training rows. Sensors
@@ -1025,28 +1034,23 @@ bool CalibrationCurves::flat_at_end(const SensorCurve& curve, int side) {
 void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
                                std::vector<double>&) {
   if (curves.empty()) return;
-  static constexpr double kFactors[] = {0.5, 0.7, 0.85, 0.93, 1 / 0.93, 1 / 0.85, 1 / 0.7, 2.0};
   // A segment's slope stays within kMinSlope..kMaxSlope of the identity's:
   // beyond, the search fitted the noise of a loadcell at rest (slopes of
   // 1/64 on seed-1 development logs) without a better fit on fresh ones.
-  using sensor_curve::kMaxSlope, sensor_curve::kMinSlope;
+  using sensor_curve::kMaxSlope, sensor_curve::kMinSlope, sensor_curve::kSlopeFactors;
   const Eigen::ArrayXd rmse_before = training_rmse.all(before).array().max(1e-12);
   std::vector<double> union_levels;
   for (const SensorCurve& c : curves) union_levels.insert(union_levels.end(), c.level.begin(), c.level.end());
   std::sort(union_levels.begin(), union_levels.end());
   const double min_gap = 1e-4 * (union_levels.back() - union_levels.front());
   std::vector<double> knots;
-  for (double v : union_levels)
-    if (knots.empty() || (v > knots.back() + min_gap && static_cast<float>(v) > static_cast<float>(knots.back())))
-      knots.push_back(v);
+  for (double v : union_levels) sensor_curve::push_distinct_knot(knots, v, min_gap);
+  for (SensorCurve& c : curves) c.level = knots, c.reading = knots;
   std::vector<double> slopes(knots.size() - 1, 1.0);  // the identity
   const auto set_slopes = [&] {
-    for (SensorCurve& c : curves) {
-      c.level = knots;
-      c.reading.assign(knots.size(), knots.front());
+    for (SensorCurve& c : curves)
       for (std::size_t k = 1; k < knots.size(); ++k)
         c.reading[k] = c.reading[k - 1] + slopes[k - 1] * (knots[k] - knots[k - 1]);
-    }
   };
   set_slopes();
   const auto loss = [&] { return (training_rmse.all(sensor_after(before, a)).array() / rmse_before).square().sum(); };
@@ -1057,7 +1061,7 @@ void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const
     for (std::size_t k = 0; k < slopes.size(); ++k) {
       const double kept = slopes[k];
       double best_slope = kept;
-      for (double f : kFactors) {
+      for (double f : kSlopeFactors) {
         slopes[k] = kept * f;
         if (slopes[k] < kMinSlope || slopes[k] > kMaxSlope) continue;
         set_slopes();
