@@ -416,6 +416,36 @@ TEST(FixCandidates, TheSimplerAccountIsARailOnTheCurvesLeadChannel) {
   EXPECT_EQ(simpler(planned), Channels{});
 }
 
+// The simpler account of a confirmed friction (EffectInfo::simpler: a
+// calibration curve, a static map where friction adds a state): the curves
+// planned on its lead channel, fewest channels first; none for a curve of
+// its group that leaves the lead channel out.
+TEST(FixCandidates, TheSimplerAccountOfFrictionIsACurveOnItsLeadChannel) {
+  const auto plan = [](residual::EffectKind kind, std::vector<std::string> channels) {
+    residual::Augmentation a;
+    a.kind = kind;
+    a.channels = std::move(channels);
+    return a;
+  };
+  using residual::EffectKind;
+  residual::ResidualData data;
+  data.y_names = {"fc0", "fc1", "fc2", "fc3", "fc4", "fc5", "fc6", "fc7", "fc8"};
+  const residual::Attribution floorless;
+  const residual::Augmentation friction = plan(EffectKind::kFriction, {"fc4"});
+  const auto simpler = [&](const std::vector<residual::Augmentation>& planned) {
+    std::vector<std::vector<std::string>> out;
+    for (const auto& a : residual::simpler_plans(data, floorless, planned, 0)) out.push_back(a.channels);
+    return out;
+  };
+  using Channels = std::vector<std::vector<std::string>>;
+  EXPECT_EQ(simpler({friction, plan(EffectKind::kSensorCurve, {"fc3", "fc2", "fc4", "fc7", "fc0"}),
+                     plan(EffectKind::kSensorCurve, {"fc3", "fc2", "fc4"})}),
+            (Channels{{"fc3", "fc2", "fc4"}, {"fc3", "fc2", "fc4", "fc7", "fc0"}}));
+  EXPECT_EQ(simpler({friction, plan(EffectKind::kSensorCurve, {"fc6", "fc1", "fc7"})}), Channels{});
+  // A rail of the lead is no account of friction.
+  EXPECT_EQ(simpler({friction, plan(EffectKind::kSaturation, {"fc4"})}), Channels{});
+}
+
 // With no rail among the candidates, the simpler account is planned from
 // the ranking without its floor: on the lead's group and side only, the
 // lead first, though a rail of another group (a length's lower rail) or

@@ -510,7 +510,7 @@ struct FixResult {
   // `model`, `loss_history`, `train_windows`, `fitted_rates`, the verdict
   // after) unless that change predicts those channels significantly
   // better: of two accounts of one channel, the one with fewer parameters
-  // stands until the data reject it. The plan may come from below the
+  // (or without a state) stands until the data reject it. The plan may come from below the
   // candidates' floor (simpler_plans: the decision has already found the
   // channel's effect; its class is what is asked). The wider plans then
   // start from the plan applied. Both tests at the attribution's alpha;

@@ -1276,7 +1276,7 @@ const std::vector<EffectInfo>& effect_library() {
        "the residual offset while muscle m moves in the + direction (target units; minus that in the other)",
        "a hysteresis state as an input: the derived commands sign_u_m and hyst_u_m appended to u",
        SourceKind::kCommand, friction::enumerate, friction::features, friction::offset, finite, friction::describe,
-       friction::plan, nullptr},
+       friction::plan, nullptr, nullptr, nullptr, EffectKind::kSensorCurve},
       {EffectKind::kDriftLoad, "drift-load",
        "the accumulated load sum_{s<=t} |y_c(s)| dt from the log's start: a bias that grows with the load "
        "the sensor has carried",

@@ -151,9 +151,11 @@ struct EffectInfo {
   // is not testable for too few of them (e.g. "the 1-step prediction passes
   // the rail"); nullptr: "a regressor is non-zero".
   const char* support_phrase = nullptr;
-  // --fix: a simpler effect of the library, fewer parameters per channel,
-  // that a confirmed change of this effect can imitate on its lead channel
-  // (a calibration curve compressive at its top imitates a rail), and
+  // --fix: a simpler effect of the library, fewer parameters per channel
+  // or no state where this one adds one, that a confirmed change of this
+  // effect can imitate on its lead channel (a calibration curve
+  // compressive at its top imitates a rail; the hysteresis inputs of one
+  // motor, fine-tuned, imitate its loadcell's calibration curve), and
   // that fix() then tries in its place (FixResult::simpler); nullopt: none.
   std::optional<EffectKind> simpler = std::nullopt;
 };
