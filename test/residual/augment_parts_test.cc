@@ -12,6 +12,7 @@
 #include "trainer/derived_inputs.h"
 #include "trainer/log_dataset.h"
 #include "trainer/output_clip.h"
+#include "trainer/residual/analysis.h"
 #include "trainer/residual/augment.h"
 #include "trainer/residual/drift_probe.h"
 #include "trainer/sensor_model.h"
@@ -86,6 +87,39 @@ TEST(DerivedInputs, LogSequenceComputesTheMissingColumnOnly) {
   }
   // y channels are never derived.
   EXPECT_THROW(log_sequence(t, "t.csv", feature_layout_from_names({"sign_u0"}, {"u0"}, {})), std::runtime_error);
+}
+
+// The null's clean logs in a dead-time model's world (with_model_dead_time):
+// each lagged command column is advanced by its largest lag, and every log
+// loses the largest lag's rows, so that lag<d>_<c> on the moved log is the
+// clean log's u_c: what a plant with d steps of dead time would have logged.
+TEST(DerivedInputs, TheNullsLogsShowTheModelsInputDeadTime) {
+  const auto t = table({"t", "y0", "u0", "u1"},
+                       {{0, 1, 5, 50}, {1, 2, 6, 60}, {2, 3, 7, 70}, {3, 4, 8, 80}, {4, 5, 9, 90}, {5, 6, 10, 100}});
+  HadynetModel m;
+  m.layout = feature_layout_from_names({"y0"}, {"u0", "u1"}, {});
+  const std::vector<residual::LogInput> clean = {{t, "clean.csv"}};
+  // No lag input: unchanged.
+  EXPECT_EQ(residual::with_model_dead_time(m, clean)[0].table.values, t.values);
+  m.layout = feature_layout_from_names({"y0"}, {"u0", "u1", "lag2_u0", "lag1_u1", "lag1_u0"}, {});
+  const auto moved = residual::with_model_dead_time(m, clean);
+  ASSERT_EQ(moved.size(), 1u);
+  EXPECT_EQ(moved[0].file, "clean.csv");
+  EXPECT_EQ(moved[0].table.columns, t.columns);
+  // u0 by 2 (its largest lag), u1 by 1; t and y0 stay; 2 rows lost.
+  EXPECT_EQ(moved[0].table.values, (std::vector<double>{0, 1, 7, 60, 1, 2, 8, 70, 2, 3, 9, 80, 3, 4, 10, 90}));
+  // From row 2 on, the lag input is the clean log's command of the same row.
+  EXPECT_EQ(*derived_input_column(moved[0].table, "lag2_u0"), (std::vector<double>{0, 0, 7, 8}));
+  // A log too short for the dead time, or without the lagged command: named.
+  const std::vector<residual::LogInput> short_log = {{table({"y0", "u0", "u1"}, {{1, 5, 50}, {2, 6, 60}}), "short.csv"}};
+  try {
+    residual::with_model_dead_time(m, short_log);
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("short.csv"), std::string::npos) << e.what();
+  }
+  const std::vector<residual::LogInput> no_u1 = {{table({"y0", "u0"}, {{1, 5}, {2, 6}, {3, 7}}), "no_u1.csv"}};
+  EXPECT_THROW(residual::with_model_dead_time(m, no_u1), std::invalid_argument);
 }
 
 HadynetModel clip_model() {

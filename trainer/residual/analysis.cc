@@ -1,8 +1,11 @@
 #include "trainer/residual/analysis.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <stdexcept>
+
+#include "trainer/derived_inputs.h"
 
 namespace hadynet::trainer::residual {
 
@@ -38,7 +41,8 @@ Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, c
     a.attribution = attribute(d, hypotheses, options.attribution);
   } else {
     const std::string& ref_pb = options.reference_pb_choice.empty() ? options.pb_choice : options.reference_pb_choice;
-    const ResidualData ref = compute_residuals(with_reference_sensor(model, options.reference_sensor), reference, ref_pb);
+    const ResidualData ref = compute_residuals(with_reference_sensor(model, options.reference_sensor),
+                                               with_model_dead_time(model, reference), ref_pb);
     a.reference_pb = pb_summary(ref, ref_pb);
     const NullCalibration null = calibrate_null(d, ref, hypotheses, options.attribution);
     a.attribution = attribute(d, hypotheses, options.attribution, &null);
@@ -51,6 +55,42 @@ HadynetModel with_reference_sensor(const HadynetModel& model, const SensorModel*
   HadynetModel m = model;
   if (reference_sensor != nullptr) m.sensor = *reference_sensor;
   return m;
+}
+
+std::vector<LogInput> with_model_dead_time(const HadynetModel& model, const std::vector<LogInput>& reference) {
+  std::map<std::string, int> lead;  // command column -> the rows it is advanced by
+  int rows_lost = 0;
+  for (const auto& name : model.layout.u_names) {
+    const std::optional<DerivedInput> d = parse_derived_input(name);
+    if (!d || d->kind != DerivedKind::kLag) continue;
+    int& steps = lead[d->base];
+    steps = std::max(steps, d->lag);
+    rows_lost = std::max(rows_lost, d->lag);
+  }
+  if (lead.empty()) return reference;
+  std::vector<LogInput> out;
+  out.reserve(reference.size());
+  for (const LogInput& log : reference) {
+    const datalog::LogTable& in = log.table;
+    const std::size_t cols = in.columns.size(), rows = in.rows();
+    if (rows <= static_cast<std::size_t>(rows_lost))
+      throw std::invalid_argument(log.file + ": a reference log of " + std::to_string(rows) +
+                                  " rows cannot show the model's input dead time of " + std::to_string(rows_lost) +
+                                  " steps");
+    std::vector<std::size_t> shift(cols, 0);  // rows each column is advanced by
+    for (const auto& [base, steps] : lead) {
+      const std::optional<std::size_t> c = in.column_index(base);
+      if (!c) throw std::invalid_argument(log.file + ": the reference log has no command column " + base);
+      shift[*c] = static_cast<std::size_t>(steps);
+    }
+    LogInput moved{in, log.file};
+    const std::size_t kept = rows - static_cast<std::size_t>(rows_lost);
+    moved.table.values.assign(kept * cols, 0.0);
+    for (std::size_t t = 0; t < kept; ++t)
+      for (std::size_t c = 0; c < cols; ++c) moved.table.at(t, c) = in.at(t + shift[c], c);
+    out.push_back(std::move(moved));
+  }
+  return out;
 }
 
 std::string floors_summary(const Analysis& a) {

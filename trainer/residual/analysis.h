@@ -67,6 +67,20 @@ Analysis analyse(const HadynetModel& model, const std::vector<LogInput>& logs, c
 // the model that computes the null's residuals (AnalysisOptions::reference_sensor).
 HadynetModel with_reference_sensor(const HadynetModel& model, const SensorModel* reference_sensor);
 
+// The reference logs as a plant with `model`'s input dead time would have
+// recorded them: the null's clean logs in the model's world, as
+// with_reference_sensor() reads them through the sensors they were
+// recorded with. A model whose u holds lag<d>_<c> inputs (an input dead
+// time, docs/residual.md "Input dead time") acts on commands d steps late,
+// so each command column c it lags is advanced by its largest d (row t
+// holds u_c(t + d)) and every log loses its last D rows (D: the largest d).
+// A log recorded without dead time then shows exactly d steps of it:
+// lag<d>_<c>(t) is the command that moved the plant at t. Without lag
+// inputs the logs are returned unchanged. Throws std::invalid_argument
+// naming the log when it lacks a lagged command column or has no more than
+// D rows.
+std::vector<LogInput> with_model_dead_time(const HadynetModel& model, const std::vector<LogInput>& reference);
+
 // What the floors of an analysis were, in words: the calibrated null (logs,
 // PBs) or the absolute floors assumed without one.
 std::string floors_summary(const Analysis& analysis);

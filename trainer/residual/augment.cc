@@ -775,7 +775,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   const std::vector<Hypothesis> hypotheses_after = enumerate_hypotheses(again, library_after);
   if (options.reference != nullptr && !options.reference->empty()) {
     ResidualData ref = compute_residuals(with_reference_sensor(after.model, options.reference_sensor),
-                                         *options.reference, options.reference_pb_choice);
+                                         with_model_dead_time(after.model, *options.reference),
+                                         options.reference_pb_choice);
     drop_predicted_aux(ref);
     const NullCalibration null = calibrate_null(again, ref, hypotheses_after, attribution.options);
     result.after.verdict = verdict_text(attribute(again, hypotheses_after, attribution.options, &null));
