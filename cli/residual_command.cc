@@ -156,7 +156,7 @@ void print_fix(const rs::FixResult& fixed) {
     if (!fixed.folds_note.empty()) std::printf("note: %s\n", fixed.folds_note.c_str());
     if (fixed.candidates.size() > 1) {
       std::printf("candidates (the screen's order; * the one tested: the first whose gain over fine-tuning alone\n"
-                  "on the training rows' last 25 %% is significant, else the clearest gain, else the screen's first):\n");
+                  "on the training rows' last 25 %% is significant, else the clearest gain; none when none gains):\n");
       for (const auto& c : fixed.candidates) {
         std::printf("  %c %-74.74s", c.chosen ? '*' : ' ', (c.effect + ": " + c.description).c_str());
         if (c.below_screen_floor) std::printf(" below the screen's floor (%.2g);", c.screen_statistic);
@@ -243,10 +243,11 @@ int run_residual(int argc, char** argv) {
                               "a delay, curve or rail extended to its group also on its family alone, right after):\n"
                               "each added, fine-tuned on the first 75 % of the training rows and compared with\n"
                               "fine-tuning alone on the rest; the first significant there, else the clearest gain,\n"
-                              "else the screen's first, is the one the decision tests on the held-out rows (1: the\n"
+                              "is the one the decision tests on the held-out rows, none when none gains (1: the\n"
                               "screen's winner); a confirmed calibration curve gives way to a rail planned on its lead\n"
                               "channel when the rail is confirmed itself and the curve does not predict the channels\n"
-                              "either claims significantly better (the simpler account); a family alone confirmed is\n"
+                              "either claims significantly better (the simpler account; a confirmed friction gives way\n"
+                              "likewise to a calibration curve of its lead channel); a family alone confirmed is\n"
                               "then extended to its group when the extended plan predicts the channels it adds\n"
                               "significantly better on the held-out rows, and a delay seen beyond its family likewise\n"
                               "to every channel of its group; when a place is left or the screen proposes a load drift,\n"

@@ -381,7 +381,7 @@ TEST(SensorFrame, ACurvesEndIsFlatWhereItsFitCouldGoNoFlatter) {
   EXPECT_FALSE(CalibrationCurves::flat_at_end(top_only, -1));
 }
 
-TEST(FixCandidates, TheFirstSignificantElseTheClearestGainIsTested) {
+TEST(FixCandidates, TheFirstSignificantElseTheClearestGainElseNoneIsTested) {
   auto trial = [](double stat, bool judged = true) {
     residual::CandidateTrial c;
     c.selection.mean = stat / 100;  // the sign of the statistic
@@ -396,13 +396,15 @@ TEST(FixCandidates, TheFirstSignificantElseTheClearestGainIsTested) {
   // None significant: the clearest gain, wherever it is.
   EXPECT_EQ(chosen({trial(1.2), trial(2.0), trial(-3.0)}), 1u);
   EXPECT_EQ(chosen({trial(-1.0), trial(0.4)}), 1u);
-  // Nothing gains: the screen's first.
-  EXPECT_EQ(chosen({trial(-1.0), trial(-4.0)}), 0u);
-  EXPECT_EQ(chosen({trial(0), trial(0)}), 0u);
+  // Nothing gains: none is tested (the training rows support none).
+  EXPECT_EQ(chosen({trial(-1.0), trial(-4.0)}), std::nullopt);
+  EXPECT_EQ(chosen({trial(0), trial(0)}), std::nullopt);
   // Candidates that were not judged (logs too short for the selection, or
-  // after the first significant one) are not chosen.
+  // after the first significant one) are not chosen; none judged: the
+  // screen's first.
   EXPECT_EQ(chosen({trial(0.0, false), trial(5.0, false)}), 0u);
   EXPECT_EQ(chosen({trial(1.0), trial(2.6), trial(9.0, false)}), 1u);
+  EXPECT_EQ(chosen({trial(-1.0), trial(9.0, false)}), std::nullopt);
   EXPECT_EQ(chosen({}), 0u);
 }
 

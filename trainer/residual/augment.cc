@@ -110,18 +110,21 @@ std::string look_alike(const Augmentation& a) {
   return info.look_alike != nullptr ? info.look_alike(a.found_on) : "";
 }
 
-std::size_t chosen_candidate(const std::vector<CandidateTrial>& candidates, double alpha) {
+std::optional<std::size_t> chosen_candidate(const std::vector<CandidateTrial>& candidates, double alpha) {
   for (std::size_t k = 0; k < candidates.size(); ++k)
     if (gains_significantly(candidates[k], alpha)) return k;
-  std::size_t chosen = 0;
+  std::optional<std::size_t> chosen;
   double best = 0;
+  bool any_judged = false;
   for (std::size_t k = 0; k < candidates.size(); ++k) {
     const DieboldMariano& s = candidates[k].selection;
-    if (candidates[k].selected_by_training_rows && s.mean > 0 && s.stat > best) {
+    any_judged = any_judged || candidates[k].selected_by_training_rows;
+    if (candidates[k].selected_by_training_rows && s.mean > 0 && (!chosen || s.stat > best)) {
       best = s.stat;
       chosen = k;
     }
   }
+  if (!any_judged) return 0;
   return chosen;
 }
 
@@ -554,7 +557,23 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       c.description = a.description;  // as judged: re-estimated on the selection's training rows
       if (gains_significantly(c, attribution.options.alpha)) break;  // chosen_candidate's choice: the rest are not needed
     }
-    chosen = chosen_candidate(result.candidates, attribution.options.alpha);
+    const std::optional<std::size_t> supported = chosen_candidate(result.candidates, attribution.options.alpha);
+    if (!supported) {
+      // The clearest of them (the largest statistic), labelled as what it is.
+      std::size_t best = 0;
+      for (std::size_t k = 1; k < result.candidates.size(); ++k)
+        if (result.candidates[k].selected_by_training_rows &&
+            result.candidates[k].selection.stat > result.candidates[best].selection.stat)
+          best = k;
+      const CandidateTrial& c = result.candidates[best];
+      char stat[32];
+      std::snprintf(stat, sizeof stat, "%.2f", c.selection.stat);
+      result.status = "unexplained structure: no candidate predicted the selection's rows better than fine-tuning "
+                      "alone, so none was tested on the held-out rows (the clearest, not confirmed: " +
+                      c.effect + " (" + c.description + "), Diebold-Mariano statistic " + stat + ")";
+      return result;
+    }
+    chosen = *supported;
   }
   result.candidates[chosen].chosen = true;
 

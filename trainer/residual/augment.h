@@ -70,7 +70,8 @@ struct FixOptions {
   // family alone, each one of the `candidates`): each is re-estimated,
   // added and fine-tuned on the first 75 % of the training rows and judged
   // on the rest against the control; the first significant there, else the
-  // clearest gain (chosen_candidate), goes to the decision.
+  // clearest gain (chosen_candidate), goes to the decision; none when none
+  // gains.
   // 1: the screen's winner alone. 5 was chosen on development seeds 771-775
   // (docs/residual.md, "Detection on fresh logs"), when every candidate was
   // another effect; since stop 51 a family alone takes one of them. The
@@ -396,8 +397,11 @@ struct DriftProbe {
 // significant at `alpha` (one-sided Diebold-Mariano); else the one with the
 // largest positive statistic (a clearer gain than the screen's first, which
 // on fresh logs is often the model's own misfit); 0 (the screen's first)
-// when none is judged or none gains.
-std::size_t chosen_candidate(const std::vector<CandidateTrial>& candidates, double alpha);
+// when none is judged. None (std::nullopt) when candidates were judged and
+// none gains there: the training rows support none of them, so the
+// decision tests none ("unexplained structure" untested; docs/residual.md,
+// "No gain, no decision").
+std::optional<std::size_t> chosen_candidate(const std::vector<CandidateTrial>& candidates, double alpha);
 
 // The raw rows [from, to) of one log that fix() fine-tunes on and judges,
 // for a log of T rows whose first `split` rows are the training part and
