@@ -171,8 +171,13 @@
 # strength measured with the flat-end rule; then a curve judged on every
 # channel (chosen on 1797-1801): 1877-1886 every effect at its larger
 # strength measured with the final code, and its curve, drift and rail
-# logs with the binary before that rule (the same logs). Next unused:
-# 1922 on.
+# logs with the binary before that rule (the same logs).
+# Stop 58 (friction's simpler account: a calibration curve): 1877-1886's
+# sensor-curve=0.7 and friction=4 logs development (re-run with it, and
+# with friction judged on every channel, not kept); 1922-1931 every
+# effect at its larger strength measured with it; 1967-1976
+# sensor-curve=0.7 and friction=4 measured with the final code. Next
+# unused: 1987 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

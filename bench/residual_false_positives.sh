@@ -85,6 +85,9 @@
 # Stop 57 (one calibration curve for the plan's channels): 1812-1831
 # measured before the flat-end rule, 1842-1861 with it, 1887-1906 with
 # the final code (a curve judged on every channel).
+# Stop 58 (friction's simpler account, the null's dead time): 1932-1951
+# measured (the final code's "no gain, no decision" can only remove a
+# decision).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

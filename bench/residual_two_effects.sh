@@ -37,7 +37,9 @@
 # 1497-1501 (stop 49: the same defaults on 600-row logs,
 # RESIDUAL_ROWS=600); 1792-1796 (stop 56); 1872-1876 and 1917-1921 (stop
 # 57: one curve for the plan's channels, then judged on every channel; the
-# 4-seed model, --candidates 5).
+# 4-seed model, --candidates 5); stop 58 (the null's dead time): 1917-1921's
+# input-delay pairs re-run as its development, 1962-1966 measured
+# (--candidates 5).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]...

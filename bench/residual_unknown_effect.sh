@@ -39,7 +39,9 @@
 # floor on the same logs), 1487-1496 (stop 49: the same defaults on
 # 600-row logs, RESIDUAL_ROWS=600), 1782-1791 (stop 56: the drift probe;
 # the 4-seed model), 1862-1871 and 1907-1916 (stop 57: one curve for the
-# plan's channels, then judged on every channel; the 4-seed model).
+# plan's channels, then judged on every channel; the 4-seed model),
+# 1952-1961 (stop 58, before "no gain, no decision": its development, seed
+# 1955) and 1977-1986 (stop 58, the final code).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve]
