@@ -154,20 +154,21 @@ void print_fix(const rs::FixResult& fixed) {
     for (const auto& wider : fixed.extensions) std::printf("%s\n", extension_sentence(wider).c_str());
     if (replaced_after_decision(fixed)) std::printf("the before/after above are the plan applied last\n");
     if (!fixed.folds_note.empty()) std::printf("note: %s\n", fixed.folds_note.c_str());
-    if (fixed.candidates.size() > 1) {
-      std::printf("candidates (the screen's order; * the one tested: the first whose gain over fine-tuning alone\n"
-                  "on the training rows' last 25 %% is significant, else the clearest gain; none when none gains):\n");
-      for (const auto& c : fixed.candidates) {
-        std::printf("  %c %-74.74s", c.chosen ? '*' : ' ', (c.effect + ": " + c.description).c_str());
-        if (c.below_screen_floor) std::printf(" below the screen's floor (%.2g);", c.screen_statistic);
-        if (c.from_drift_probe) std::printf(" the drift probe's;");
-        if (c.selected_by_training_rows)
-          std::printf(" training rows: DM %.2f, p %.2g\n", c.selection.stat, c.selection.p_value);
-        else std::printf(" not judged\n");
-      }
-    }
-    std::printf("verdict after: %s\n", fixed.after.verdict.c_str());
   }
+  // The selection's candidates, also when it tested none (no gain, no decision).
+  if (fixed.candidates.size() > 1 && (fixed.tried || fixed.status.rfind("unexplained structure", 0) == 0)) {
+    std::printf("candidates (the screen's order; * the one tested: the first whose gain over fine-tuning alone\n"
+                "on the training rows' last 25 %% is significant, else the clearest gain; none when none gains):\n");
+    for (const auto& c : fixed.candidates) {
+      std::printf("  %c %-74.74s", c.chosen ? '*' : ' ', (c.effect + ": " + c.description).c_str());
+      if (c.below_screen_floor) std::printf(" below the screen's floor (%.2g);", c.screen_statistic);
+      if (c.from_drift_probe) std::printf(" the drift probe's;");
+      if (c.selected_by_training_rows)
+        std::printf(" training rows: DM %.2f, p %.2g\n", c.selection.stat, c.selection.p_value);
+      else std::printf(" not judged\n");
+    }
+  }
+  if (fixed.tried) std::printf("verdict after: %s\n", fixed.after.verdict.c_str());
 }
 
 }  // namespace
