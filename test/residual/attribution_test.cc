@@ -249,6 +249,24 @@ TEST(Attribution, AnExtremeReachedOnceIsNoRail) {
   EXPECT_EQ(forced, 0);  // still needs 5 rows at the extreme
 }
 
+// Friction is tested on the logged commands only: after a --fix the model's
+// u also holds derived channels (a dead time's lag2_u0, friction's sign_u1
+// and hyst_u1), whose own sign and hysteresis cannot be derived from a log
+// (round 2 after a dead time failed on "no column 'sign_lag2_u4'").
+TEST(Attribution, FrictionIsTestedOnTheLoggedCommandsOnly) {
+  ResidualData d = synthetic(8, [](ResidualLog&) {});
+  d.u_names = {"u0", "u1", "lag2_u0", "sign_u1", "hyst_u1"};
+  for (auto& log : d.logs) {
+    Eigen::MatrixXd u = Eigen::MatrixXd::Zero(5, log.seq.u.cols());
+    u.topRows(2) = log.seq.u;
+    log.seq.u = u;
+  }
+  std::set<int> sources;
+  for (const auto& h : enumerate_hypotheses(d, {}))
+    if (h.kind == EffectKind::kFriction) sources.insert(h.source);
+  EXPECT_EQ(sources, (std::set<int>{0, 1}));
+}
+
 TEST(Attribution, SaturationAndDriftWin) {
   // a0 is clipped at +1.5: measured = min(y_hat, 1.5) (rail = the largest measured value).
   const Attribution sat = run(synthetic(8, [](ResidualLog& log) {

@@ -446,11 +446,17 @@ namespace {
 // ---- friction: dry friction / hysteresis driven by the motion of muscle `source` ----
 namespace friction {
 
+// The muscles are the logged commands: a derived channel (sign_, hyst_,
+// lag<d>_ of a command, added by an earlier --fix) is no muscle of its own,
+// and its sign and hysteresis could not be derived from the log (a derived
+// input is computed from a logged column). After a dead time the friction
+// of the logged command is tested, d steps ahead of the motion.
 void enumerate(const ResidualData& data, const LibraryOptions& options, int c, std::vector<Hypothesis>& out) {
   const int nu = static_cast<int>(data.u_names.size());
   const std::vector<bool> absolute =
       options.absolute_groups ? channels_in_groups(data.u_names, *options.absolute_groups) : data.u_absolute;
   for (int m = 0; m < nu; ++m) {
+    if (parse_derived_input(data.u_names[static_cast<std::size_t>(m)])) continue;
     Hypothesis h{EffectKind::kFriction, c, m, 0, 0, 0};
     h.of_change = static_cast<std::size_t>(m) < absolute.size() && absolute[static_cast<std::size_t>(m)];
     out.push_back(h);
