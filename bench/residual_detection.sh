@@ -176,8 +176,9 @@
 # sensor-curve=0.7 and friction=4 logs development (re-run with it, and
 # with friction judged on every channel, not kept); 1922-1931 every
 # effect at its larger strength measured with it; 1967-1976
-# sensor-curve=0.7 and friction=4 measured with the final code. Next
-# unused: 1987 on.
+# sensor-curve=0.7 and friction=4 measured with 6ffa678 (no later rule
+# changes a run of either). Next
+# unused: 1992 on (1987-1991: bench/residual_two_effects.sh, stop 58).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...

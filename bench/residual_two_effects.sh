@@ -39,7 +39,8 @@
 # 57: one curve for the plan's channels, then judged on every channel; the
 # 4-seed model, --candidates 5); stop 58 (the null's dead time): 1917-1921's
 # input-delay pairs re-run as its development, 1962-1966 measured
-# (--candidates 5).
+# (--candidates 5), and its input-delay pairs with the final code (friction
+# on the logged commands only) again, with 1987-1991's.
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]...
