@@ -156,7 +156,7 @@ void print_fix(const rs::FixResult& fixed) {
     if (!fixed.folds_note.empty()) std::printf("note: %s\n", fixed.folds_note.c_str());
   }
   // The selection's candidates, also when it tested none (no gain, no decision).
-  if (fixed.candidates.size() > 1 && (fixed.tried || fixed.status.rfind("unexplained structure", 0) == 0)) {
+  if (fixed.candidates.size() > 1 && (fixed.tried || fixed.none_gained)) {
     std::printf("candidates (the screen's order; * the one tested: the first whose gain over fine-tuning alone\n"
                 "on the training rows' last 25 %% is significant, else the clearest gain; none when none gains):\n");
     for (const auto& c : fixed.candidates) {

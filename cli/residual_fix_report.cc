@@ -33,6 +33,7 @@ json held_out_json(const rs::HeldOutError& e) {
 nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
   json j = {{"status", f.status},
             {"changed", f.changed},
+            {"none_gained", f.none_gained},
             {"look_alike", f.look_alike},
             {"train_fraction", o.train_fraction},
             {"epochs", o.epochs},

@@ -568,6 +568,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       const CandidateTrial& c = result.candidates[best];
       char stat[32];
       std::snprintf(stat, sizeof stat, "%.2f", c.selection.stat);
+      result.none_gained = true;
       result.status = "unexplained structure: no candidate predicted the selection's rows better than fine-tuning "
                       "alone, so none was tested on the held-out rows (the clearest, not confirmed: " +
                       c.effect + " (" + c.description + "), Diebold-Mariano statistic " + stat + ")";

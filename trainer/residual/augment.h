@@ -449,6 +449,9 @@ struct FixResult {
   std::string status;
   std::optional<Augmentation> augmentation;  // the candidate tested (kept only if confirmed)
   bool tried = false;          // the augmented model was fine-tuned and evaluated (after is valid)
+  // The selection judged candidates and none gained there, so none was
+  // tested (chosen_candidate: none; "unexplained structure", not tried).
+  bool none_gained = false;
   bool changed = false;        // confirmed: a new model was produced
   HadynetModel model;          // the augmented, fine-tuned model (the input model if !changed)
   // The chosen augmentation on the input model's network before fine-tuning
@@ -514,9 +517,9 @@ struct FixResult {
   // `model`, `loss_history`, `train_windows`, `fitted_rates`, the verdict
   // after) unless that change predicts those channels significantly
   // better: of two accounts of one channel, the one with fewer parameters
-  // (or without a state) stands until the data reject it. The plan may come from below the
-  // candidates' floor (simpler_plans: the decision has already found the
-  // channel's effect; its class is what is asked). The wider plans then
+  // (or without a state) stands until the data reject it. The plan may
+  // come from below the candidates' floor (simpler_plans: the decision has
+  // already found the channel's effect; its class is what is asked). The wider plans then
   // start from the plan applied. Both tests at the attribution's alpha;
   // the first runs only after the decision confirmed, so nothing is
   // applied that the decision did not confirm. `confirmation` stays the
