@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "trainer/derived_inputs.h"
+#include "trainer/sensor_model.h"
 
 namespace hadynet::trainer::residual {
 
@@ -58,7 +59,9 @@ HadynetModel with_reference_sensor(const HadynetModel& model, const SensorModel*
 }
 
 std::vector<LogInput> with_model_dead_time(const HadynetModel& model, const std::vector<LogInput>& reference) {
-  std::map<std::string, int> lead;  // command column -> the rows it is advanced by
+  // Each lagged command column, advanced by its largest lag: the shift
+  // time_aligned() gives a delayed sensor's column.
+  std::map<std::string, int> lead;
   int rows_lost = 0;
   for (const auto& name : model.layout.u_names) {
     const std::optional<DerivedInput> d = parse_derived_input(name);
@@ -68,27 +71,20 @@ std::vector<LogInput> with_model_dead_time(const HadynetModel& model, const std:
     rows_lost = std::max(rows_lost, d->lag);
   }
   if (lead.empty()) return reference;
+  std::vector<SensorDelay> advances;
+  for (const auto& [base, steps] : lead) advances.push_back({base, steps});
   std::vector<LogInput> out;
   out.reserve(reference.size());
   for (const LogInput& log : reference) {
-    const datalog::LogTable& in = log.table;
-    const std::size_t cols = in.columns.size(), rows = in.rows();
+    const std::size_t rows = log.table.rows();
     if (rows <= static_cast<std::size_t>(rows_lost))
       throw std::invalid_argument(log.file + ": a reference log of " + std::to_string(rows) +
                                   " rows cannot show the model's input dead time of " + std::to_string(rows_lost) +
                                   " steps");
-    std::vector<std::size_t> shift(cols, 0);  // rows each column is advanced by
-    for (const auto& [base, steps] : lead) {
-      const std::optional<std::size_t> c = in.column_index(base);
-      if (!c) throw std::invalid_argument(log.file + ": the reference log has no command column " + base);
-      shift[*c] = static_cast<std::size_t>(steps);
-    }
-    LogInput moved{in, log.file};
-    const std::size_t kept = rows - static_cast<std::size_t>(rows_lost);
-    moved.table.values.assign(kept * cols, 0.0);
-    for (std::size_t t = 0; t < kept; ++t)
-      for (std::size_t c = 0; c < cols; ++c) moved.table.at(t, c) = in.at(t + shift[c], c);
-    out.push_back(std::move(moved));
+    for (const auto& [base, steps] : lead)
+      if (!log.table.column_index(base))
+        throw std::invalid_argument(log.file + ": the reference log has no command column " + base);
+    out.push_back({time_aligned(log.table, log.file, advances), log.file});
   }
   return out;
 }

@@ -1051,7 +1051,10 @@ void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const
   const double min_gap = 1e-4 * (union_levels.back() - union_levels.front());
   std::vector<double> knots;
   for (double v : union_levels) sensor_curve::push_distinct_knot(knots, v, min_gap);
-  for (SensorCurve& c : curves) c.level = knots, c.reading = knots;
+  for (SensorCurve& c : curves) {  // reading[0] stays at the lowest knot: the curve's anchor
+    c.level = knots;
+    c.reading = knots;
+  }
   std::vector<double> slopes(knots.size() - 1, 1.0);  // the identity
   const auto set_slopes = [&] {
     for (SensorCurve& c : curves)
