@@ -178,7 +178,9 @@
 # effect at its larger strength measured with it; 1967-1976
 # sensor-curve=0.7 and friction=4 measured with 6ffa678 (no later rule
 # changes a run of either). Next
-# unused: 1992 on (1987-1991: bench/residual_two_effects.sh, stop 58).
+# unused: 2005 on, never 2001-2003 (they train the 4-seed model);
+# 1987-1991 went to bench/residual_two_effects.sh and 1992-2000 and 2004
+# to round 2's false positives after a dead time (stop 58).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...
