@@ -88,8 +88,10 @@ total=${#dirs[@]} done_runs=0 start=$(date +%s)
 for d in "${dirs[@]}"; do
   case=$(basename "$(dirname "$d")") seed=${d##*seed}
   [[ " ${cases[*]} " == *" $case "* ]] || cases+=("$case")
+  # --drift-probe-alpha 0: the drift probe would add its group's drift as a
+  # second candidate beside the oracle (stop 56); the oracle is the only one.
   HADYNET_ORACLE="$oracle" "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 \
-    --fix --json "$d/residual_oracle.json" >"$d/out_oracle.txt" 2>&1 ||
+    --drift-probe-alpha 0 --fix --json "$d/residual_oracle.json" >"$d/out_oracle.txt" 2>&1 ||
     { echo "$case seed $seed: residual failed (see $d/out_oracle.txt)" | tee -a "$runs"; continue; }
   done_runs=$((done_runs + 1))
   eta=$(( ($(date +%s) - start) * (total - done_runs) / done_runs ))
