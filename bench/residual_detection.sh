@@ -183,7 +183,7 @@
 # to round 2's false positives after a dead time (stop 58).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
-#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--case EFFECT=STRENGTH]...
+#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--case EFFECT=STRENGTH]...
 #   defaults: models/hand.safetensors, build/residual-detection, 10, 231, the tool's --candidates (5), every case
 #   (--case: only those; repeatable), the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
@@ -191,6 +191,7 @@
 #   the tool's default 1 since stop 48, the screen's floor 3 before)
 #   --rezeroed-first-init I: the k-th seed's sets are recorded under the zeroing I + k, one the model
 #   never saw, and keep the trained state names (a re-zeroed hand; bench/residual_grasps.sh)
+#   --decision-loss L: passed to `hadynet residual --fix` (squared, the default, or absolute)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
 set -euo pipefail
@@ -213,6 +214,7 @@ while (($#)); do
     --first-seed) first_seed=$2; shift 2 ;;
     --candidates) candidates=(--candidates "$2"); shift 2 ;;
     --fix-min-excess-null) candidates+=(--fix-min-excess-null "$2"); shift 2 ;;
+    --decision-loss) candidates+=(--decision-loss "$2"); shift 2 ;;
     --case) only_cases+=("$2"); shift 2 ;;
     --rezeroed-first-init) rezeroed_first_init=$2; shift 2 ;;
     *) echo "residual_detection: unknown argument $1" >&2; exit 2 ;;

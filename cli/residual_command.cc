@@ -271,6 +271,12 @@ int run_residual(int argc, char** argv) {
             "log's last rows, judged on the rows before them), pooled with the first fold in the decision's\n"
             "test (not when --train-fraction is below 4/7 or a log is too short); 1: the first fold alone\n"
             "(the written model and the before/after columns are the first fold's either way)", "2");
+  opt.value("decision-loss", "squared|absolute",
+            "with --fix: the per-row loss of its Diebold-Mariano tests (the selection, the decision, the tests\n"
+            "after it, the drift probe): the mean over the judged channels of the standardised 1-step error,\n"
+            "squared or absolute (lighter-tailed differences on contact-rich logs: docs/residual.md, \"The\n"
+            "decision's loss\")",
+            "squared");
   opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
                         "unchanged model, a weaker guard)");
   if (!opt.parse(argc, argv)) return 2;
@@ -320,6 +326,11 @@ int run_residual(int argc, char** argv) {
   const auto candidates = opt.get_int("candidates", 1, 20);
   const auto folds = opt.get_int("fix-folds", 1, 2);
   const auto drift_probe_alpha = opt.get_double("drift-probe-alpha", 0.0, 0.5);
+  const std::string decision_loss = opt.get("decision-loss");
+  if (decision_loss != "squared" && decision_loss != "absolute") {
+    std::fprintf(stderr, "hadynet residual: --decision-loss is squared or absolute, not '%s'\n", decision_loss.c_str());
+    return 2;
+  }
   std::optional<double> fix_min_excess;  // given; else FixOptions' default (fix() keeps it at most the screen's)
   if (opt.has("fix-min-excess-null")) {
     fix_min_excess = opt.get_double("fix-min-excess-null", 0.0, 1e6);
@@ -412,6 +423,7 @@ int run_residual(int argc, char** argv) {
     fo.candidates = static_cast<int>(*candidates);
     fo.drift_probe_alpha = *drift_probe_alpha;
     fo.folds = static_cast<int>(*folds);
+    fo.decision_loss = decision_loss == "squared" ? rs::DecisionLoss::kSquared : rs::DecisionLoss::kAbsolute;
     if (fix_min_excess) fo.min_excess_null = fix_min_excess;
     fo.reference = &reference;
     fo.reference_pb_choice = stored_null ? "state" : "auto";

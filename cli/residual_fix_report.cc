@@ -69,6 +69,7 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
     j["confirmation"] = {{"against", f.reference},
                          {"channels", f.confirmation_channels},
                          {"test", "Diebold-Mariano, one-sided, Newey-West variance"},
+                         {"loss", rs::decision_loss_name(o.decision_loss)},
                          {"mean_loss_difference", f.confirmation.mean},
                          {"statistic", f.confirmation.stat},
                          {"bandwidth", f.confirmation.bandwidth},
@@ -242,7 +243,9 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
     m += "Decision: the " + (replaced ? "chosen candidate (" + f.simpler->replaces + ")" : std::string("augmented model")) +
          " against " + f.reference + " on the held-out rows of ";
     for (std::size_t i = 0; i < f.confirmation_channels.size(); ++i) m += (i ? ", " : "") + f.confirmation_channels[i];
-    m += " (one-sided Diebold-Mariano test of the standardised squared error, Newey-West variance over " +
+    m += std::string(" (one-sided Diebold-Mariano test of the standardised ") +
+         rs::decision_loss_name(o.decision_loss) +
+         " error, Newey-West variance over " +
          std::to_string(f.confirmation.bandwidth) + " lags, " + std::to_string(f.confirmation.samples) +
          " rows" + (f.folds > 1 ? " of " + std::to_string(f.folds) + " folds" : std::string()) +
          "): mean loss difference " + num("%.3g", f.confirmation.mean) + ", p " +

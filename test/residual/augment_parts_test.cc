@@ -659,6 +659,42 @@ TEST(DriftProbe, OneLoadDriftPerGroupAtOneRateTheBestGroupACandidate) {
   EXPECT_TRUE(residual::probe_drifts(model, data, rows, 0.01).empty());
 }
 
+// The per-row loss of --fix's Diebold-Mariano tests (standardised_loss):
+// each channel's error over the model's standard deviation of it, squared
+// or absolute (--decision-loss), averaged over the channels asked for, one
+// segment per log. Exact: hand-computed values, tolerance 1e-12.
+TEST(DecisionLoss, TheMeanOverTheChannelsOfTheStandardisedErrorSquaredOrAbsolute) {
+  HadynetModel m;
+  m.layout.y_names = {"a", "b"};
+  m.norm.y.mean = Eigen::VectorXd::Zero(2);
+  m.norm.y.std.resize(2);
+  m.norm.y.std << 2.0, 4.0;
+  residual::HeldOutError e;
+  e.channels = {"b", "a"};  // the evaluation's order need not be the model's
+  e.residuals.resize(2);
+  e.residuals[0] = {Eigen::Vector2d(4.0, -8.0), Eigen::Vector3d(0.0, 2.0, -4.0)};  // b: two logs
+  e.residuals[1] = {Eigen::Vector2d(-2.0, 1.0), Eigen::Vector3d(4.0, 0.0, 2.0)};   // a
+  using residual::DecisionLoss;
+  const residual::Segments sq = residual::standardised_loss(m, e, {"a", "b"}, DecisionLoss::kSquared);
+  const residual::Segments ab = residual::standardised_loss(m, e, {"a", "b"}, DecisionLoss::kAbsolute);
+  ASSERT_EQ(sq.size(), 2u);
+  ASSERT_EQ(ab.size(), 2u);
+  // Log 0, row 0: a -2/2 = -1, b 4/4 = 1; row 1: a 0.5, b -2.
+  EXPECT_NEAR(sq[0](0), (1.0 + 1.0) / 2, 1e-12);
+  EXPECT_NEAR(sq[0](1), (0.25 + 4.0) / 2, 1e-12);
+  EXPECT_NEAR(ab[0](0), (1.0 + 1.0) / 2, 1e-12);
+  EXPECT_NEAR(ab[0](1), (0.5 + 2.0) / 2, 1e-12);
+  // Log 1: a 2, 0, 1; b 0, 0.5, -1.
+  const Eigen::Vector3d sq1(4.0 / 2, 0.25 / 2, 2.0 / 2), ab1(2.0 / 2, 0.5 / 2, 2.0 / 2);
+  EXPECT_LT((sq[1] - sq1).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((ab[1] - ab1).cwiseAbs().maxCoeff(), 1e-12);
+  // One channel alone is that channel's loss.
+  EXPECT_NEAR(residual::standardised_loss(m, e, {"b"}, DecisionLoss::kAbsolute)[0](1), 2.0, 1e-12);
+  EXPECT_THROW(residual::standardised_loss(m, e, {"c"}, DecisionLoss::kSquared), std::logic_error);
+  EXPECT_STREQ(residual::decision_loss_name(DecisionLoss::kSquared), "squared");
+  EXPECT_STREQ(residual::decision_loss_name(DecisionLoss::kAbsolute), "absolute");
+}
+
 // The rows fix() fine-tunes on and judges (decision_rows): the first fold and
 // the selection as before stop 47, and the mirrored fold only where its
 // judged rows end before the selection's (no row judged twice, none that

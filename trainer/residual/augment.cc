@@ -18,25 +18,6 @@ int index_of(const std::vector<std::string>& names, const std::string& name) {
   return it == names.end() ? -1 : static_cast<int>(it - names.begin());
 }
 
-// Per held-out row (one segment per log): the mean over `channels` of the
-// squared error in the model's standardised units (the training loss's).
-Segments standardised_loss(const HadynetModel& model, const HeldOutError& e, const std::vector<std::string>& channels) {
-  Segments out;
-  for (const auto& name : channels) {
-    const int c = index_of(e.channels, name);
-    const int k = index_of(model.layout.y_names, name);
-    if (c < 0 || k < 0) throw std::logic_error("--fix: channel " + name + " missing from a held-out evaluation");
-    const double scale = model.norm.y.std(k);
-    const Segments& r = e.residuals[static_cast<std::size_t>(c)];
-    if (out.empty()) out.assign(r.size(), Eigen::VectorXd());
-    for (std::size_t s = 0; s < r.size(); ++s) {
-      const Eigen::VectorXd sq = (r[s] / scale).array().square().matrix() / static_cast<double>(channels.size());
-      out[s] = out[s].size() == 0 ? sq : (out[s] + sq).eval();
-    }
-  }
-  return out;
-}
-
 // Per log i: raw rows [rows[i].from, rows[i].to).
 using RowSpan = std::vector<DecisionRows::Span>;
 
@@ -69,6 +50,30 @@ std::vector<int> held_out_starts(const std::vector<LogInput>& logs, double train
 }
 
 }  // namespace
+
+Segments standardised_loss(const HadynetModel& model, const HeldOutError& e, const std::vector<std::string>& channels,
+                           DecisionLoss loss) {
+  Segments out;
+  for (const auto& name : channels) {
+    const int c = index_of(e.channels, name);
+    const int k = index_of(model.layout.y_names, name);
+    if (c < 0 || k < 0) throw std::logic_error("--fix: channel " + name + " missing from a held-out evaluation");
+    const double scale = model.norm.y.std(k);
+    const Segments& r = e.residuals[static_cast<std::size_t>(c)];
+    if (out.empty()) out.assign(r.size(), Eigen::VectorXd());
+    for (std::size_t s = 0; s < r.size(); ++s) {
+      const Eigen::ArrayXd z = (r[s] / scale).array();
+      const Eigen::ArrayXd per_row = loss == DecisionLoss::kSquared ? z.square().eval() : z.abs().eval();
+      const Eigen::VectorXd term = per_row.matrix() / static_cast<double>(channels.size());
+      out[s] = out[s].size() == 0 ? term : (out[s] + term).eval();
+    }
+  }
+  return out;
+}
+
+const char* decision_loss_name(DecisionLoss loss) {
+  return loss == DecisionLoss::kSquared ? "squared" : "absolute";
+}
 
 DecisionRows decision_rows(int T, int split, int d) {
   DecisionRows r;
@@ -465,9 +470,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
         probe.sensor = sensor;
         return held_out_error(probe, eval_rows(probe, before_pbs, selection_judged));
       };
-      if (sensor != model.sensor) return standardised_loss(model, judged_rows(), channels);
+      if (sensor != model.sensor) return standardised_loss(model, judged_rows(), channels, options.decision_loss);
       if (!unchanged) unchanged = judged_rows();
-      return standardised_loss(model, *unchanged, channels);
+      return standardised_loss(model, *unchanged, channels, options.decision_loss);
     };
     result.drift_probes = probe_drifts(model, data, rows, options.drift_probe_alpha);
     if (const DriftProbe* best = best_drift_probe(result.drift_probes)) {
@@ -551,8 +556,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       const Tuned t = tune(&a, selection_train);
       const HeldOutError rows = judged(t.model, selection_judged);
       CandidateTrial& c = result.candidates[k];
-      c.selection = diebold_mariano(standardised_loss(model, control_rows, c.channels),
-                                    standardised_loss(model, rows, c.channels));
+      c.selection = diebold_mariano(standardised_loss(model, control_rows, c.channels, options.decision_loss),
+                                    standardised_loss(model, rows, c.channels, options.decision_loss));
       c.selected_by_training_rows = true;
       c.description = a.description;  // as judged: re-estimated on the selection's training rows
       if (gains_significantly(c, attribution.options.alpha)) break;  // chosen_candidate's choice: the rest are not needed
@@ -599,8 +604,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.train_windows = after.train_windows;
   result.after = judged(after.model, held_out_part);
   result.confirmation_channels = result.candidates[chosen].channels;
-  Segments reference_loss = standardised_loss(model, reference, result.confirmation_channels);
-  Segments after_loss = standardised_loss(model, result.after, result.confirmation_channels);
+  const DecisionLoss loss = options.decision_loss;
+  Segments reference_loss = standardised_loss(model, reference, result.confirmation_channels, loss);
+  Segments after_loss = standardised_loss(model, result.after, result.confirmation_channels, loss);
   result.first_fold = diebold_mariano(reference_loss, after_loss);
   // The mirrored fold (FixOptions::folds 2): the same candidate and its
   // reference fine-tuned on each log's last rows, [T - split, T), and judged
@@ -617,9 +623,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     mirrored_after = judged(tune(&mirrored, mirrored_train).model, mirrored_judged);
     mirrored_reference = options.control ? judged(tune(nullptr, mirrored_train).model, mirrored_judged)
                                          : held_out_error(model, eval_rows(model, before_pbs, mirrored_judged));
-    for (auto& segment : standardised_loss(model, *mirrored_reference, result.confirmation_channels))
+    for (auto& segment : standardised_loss(model, *mirrored_reference, result.confirmation_channels, loss))
       reference_loss.push_back(std::move(segment));
-    for (auto& segment : standardised_loss(model, *mirrored_after, result.confirmation_channels))
+    for (auto& segment : standardised_loss(model, *mirrored_after, result.confirmation_channels, loss))
       after_loss.push_back(std::move(segment));
     result.folds = 2;
   }
@@ -651,10 +657,10 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // of `a` (first fold, mirrored fold) minus that of `b`.
   const auto compare = [&](const HeldOutError& a, const std::optional<HeldOutError>& a_mirrored, const HeldOutError& b,
                            const std::optional<HeldOutError>& b_mirrored, const std::vector<std::string>& channels) {
-    Segments a_loss = standardised_loss(model, a, channels), b_loss = standardised_loss(model, b, channels);
+    Segments a_loss = standardised_loss(model, a, channels, loss), b_loss = standardised_loss(model, b, channels, loss);
     if (a_mirrored && b_mirrored) {
-      for (auto& segment : standardised_loss(model, *a_mirrored, channels)) a_loss.push_back(std::move(segment));
-      for (auto& segment : standardised_loss(model, *b_mirrored, channels)) b_loss.push_back(std::move(segment));
+      for (auto& segment : standardised_loss(model, *a_mirrored, channels, loss)) a_loss.push_back(std::move(segment));
+      for (auto& segment : standardised_loss(model, *b_mirrored, channels, loss)) b_loss.push_back(std::move(segment));
     }
     return diebold_mariano(a_loss, b_loss);
   };

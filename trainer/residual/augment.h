@@ -51,6 +51,22 @@ inline constexpr double kDefaultFixMinExcessNull = 1.0;
 // drift probe of the unchanged network").
 inline constexpr double kDefaultDriftProbeAlpha = 0.05;
 
+// The per-row loss of every Diebold-Mariano test of --fix (the selection,
+// the decision, the tests after a confirmation and the drift probe): the
+// mean over the judged channels of each channel's 1-step error in the
+// model's standardised units, squared (the training loss's) or absolute.
+// The tests' null is equal expected loss either way. The squared error's
+// per-row differences are heavy-tailed on contact-rich logs (docs/residual.md,
+// "The decision's loss"); the absolute error's are lighter. --decision-loss.
+enum class DecisionLoss { kSquared, kAbsolute };
+const char* decision_loss_name(DecisionLoss loss);  // "squared" or "absolute"
+// Per held-out row of `e` (one segment per log): the mean over `channels` of
+// each one's error y - y_hat divided by the model's standard deviation of
+// that channel (model.norm.y), squared or absolute. Throws std::logic_error
+// when a channel is not among e's or the model's y channels.
+Segments standardised_loss(const HadynetModel& model, const HeldOutError& e, const std::vector<std::string>& channels,
+                           DecisionLoss loss);
+
 struct FixOptions {
   double train_fraction = 0.6;  // of each log's rows, from its start: what the reported models are fine-tuned on
   int epochs = 20;              // fine-tuning epochs from the current weights (batch norm frozen)
@@ -65,6 +81,7 @@ struct FixOptions {
   // the fixed model and the before/after columns stay the first fold's).
   // 1: the first fold alone. --fix-folds.
   int folds = 2;
+  DecisionLoss decision_loss = DecisionLoss::kSquared;  // --decision-loss
   // How many of the screen's candidates may be tried (plan_candidates: the
   // best of each effect, and a plan extended to its group also on its
   // family alone, each one of the `candidates`): each is re-estimated,
