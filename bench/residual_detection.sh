@@ -181,6 +181,13 @@
 # unused: 2005 on, never 2001-2003 (they train the 4-seed model);
 # 1987-1991 went to bench/residual_two_effects.sh and 1992-2000 and 2004
 # to round 2's false positives after a dead time (stop 58).
+# Stop 59 (--decision-loss): 2005-2014 sensor-curve=0.7 measured with the
+# tool (cdd2021: stop 58's code, the squared loss) and bench/residual_oracle.sh,
+# then development of the absolute loss (a throw-away build, the same
+# logs); 2015-2024 sensor-curve=0.7 at 600 rows (RESIDUAL_ROWS=600), the
+# squared loss; 2035-2044 sensor-curve=0.7 measured with
+# --decision-loss absolute (nothing chosen on them). Next unused: 2055 on
+# (2025-2034 and 2045-2054 are clean sets: bench/residual_false_positives.sh).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--case EFFECT=STRENGTH]...

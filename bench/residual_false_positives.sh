@@ -88,6 +88,9 @@
 # Stop 58 (friction's simpler account, the null's dead time): 1932-1951
 # measured (the final code's "no gain, no decision" can only remove a
 # decision).
+# Stop 59 (--decision-loss absolute): 2025-2034 development (a throw-away
+# build with the absolute loss: 0 of 10 confirmed), 2045-2054 measured
+# with --decision-loss absolute.
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

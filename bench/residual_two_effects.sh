@@ -43,11 +43,12 @@
 # on the logged commands only) again, with 1987-1991's.
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
-#          [--pair A=X+B=Y]...
+#          [--pair A=X+B=Y]... [--decision-loss L]
 #   defaults: models/hand.safetensors, build/residual-two-effects, 5, 641, --candidates 3 (the earlier
 #   runs' setting, for comparison; the tool's default is 5), the pairs
 #   sensor-delay=2+crosstalk=0.35, sensor-delay=2+friction=4, input-delay=2+crosstalk=0.35,
 #   input-delay=2+saturation=2 (--pair: only those; repeatable)
+#   --decision-loss L: passed to `hadynet residual --fix` (squared, the default, or absolute)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
 set -euo pipefail
@@ -58,6 +59,7 @@ n=5
 first_seed=641
 candidates=3
 pairs=()
+fix_args=()
 while (($#)); do
   case "$1" in
     -h | --help) usage; exit 0 ;;
@@ -67,6 +69,7 @@ while (($#)); do
     --first-seed) first_seed=$2; shift 2 ;;
     --candidates) candidates=$2; shift 2 ;;
     --pair) pairs+=("$2"); shift 2 ;;
+    --decision-loss) fix_args+=(--decision-loss "$2"); shift 2 ;;
     *) echo "residual_two_effects: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -88,7 +91,7 @@ for ((k = 0; k < n; ++k)); do
     rm -rf "$d" && mkdir -p "$d"
     collect_residual_grasps "$hadynet" "$d/logs" "$seed" --effect "$a" --effect "$b"
     "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 --fix --rounds 2 \
-      --candidates "$candidates" --json "$d/residual.json" >"$d/out.txt" 2>&1 ||
+      --candidates "$candidates" "${fix_args[@]}" --json "$d/residual.json" >"$d/out.txt" 2>&1 ||
       { echo "$pair seed $seed: residual failed" >>"$runs"; continue; }
     done_runs=$((done_runs + 1))
     eta=$(( ($(date +%s) - start) * (total - done_runs) / done_runs ))

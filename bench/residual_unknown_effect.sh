@@ -44,9 +44,10 @@
 # 1955) and 1977-1986 (stop 58, the final code).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
-#          [--reference-seed S] [--effect-kind gain-wobble|curve]
+#          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L]
 #   defaults: models/hand.safetensors, build/residual-unknown-effect, 10, 221, the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
+#   --decision-loss L: passed to `hadynet residual --fix` (squared, the default, or absolute)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per log set with an ETA, then the counts (OUT/summary.txt).
 set -euo pipefail
@@ -57,6 +58,7 @@ out=build/residual-unknown-effect
 n=10
 first_seed=221
 kind=gain-wobble
+fix_args=()
 while (($#)); do
   case "$1" in
     -h | --help) usage; exit 0 ;;
@@ -66,6 +68,7 @@ while (($#)); do
     --seeds) n=$2; shift 2 ;;
     --first-seed) first_seed=$2; shift 2 ;;
     --effect-kind) kind=$2; shift 2 ;;
+    --decision-loss) fix_args+=(--decision-loss "$2"); shift 2 ;;
     *) echo "residual_unknown_effect: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -91,7 +94,7 @@ for ((k = 0; k < n; ++k)); do
   esac
   python3 test/cli/inject_effect.py "$effect" "$d/raw" "$d/logs"
   "$hadynet" residual "$model" "$d/logs" --rated-range fc=0..50 --rated-range f=0..200 "${reference_args[@]}" --fix \
-    --json "$d/residual.json" >"$d/out.txt" 2>"$d/err.txt" ||
+    "${fix_args[@]}" --json "$d/residual.json" >"$d/out.txt" 2>"$d/err.txt" ||
     { echo "seed $seed: residual failed: $(tail -1 "$d/err.txt")" | tee -a "$summary"; continue; }
   eta=$(( ($(date +%s) - start) * (n - k - 1) / (k + 1) ))
   python3 - "$seed" "$d/residual.json" "[$((k + 1))/$n, ETA ${eta}s]" <<'PY' | tee -a "$summary"
