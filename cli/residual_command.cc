@@ -276,7 +276,7 @@ int run_residual(int argc, char** argv) {
             "after it, the drift probe): the mean over the judged channels of the standardised 1-step error,\n"
             "squared or absolute (lighter-tailed differences on contact-rich logs: docs/residual.md, \"The\n"
             "decision's loss\")",
-            "squared");
+            rs::decision_loss_name(rs::FixOptions{}.decision_loss));
   opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
                         "unchanged model, a weaker guard)");
   if (!opt.parse(argc, argv)) return 2;
