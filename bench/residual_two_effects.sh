@@ -40,7 +40,8 @@
 # 4-seed model, --candidates 5); stop 58 (the null's dead time): 1917-1921's
 # input-delay pairs re-run as its development, 1962-1966 measured
 # (--candidates 5), and its input-delay pairs with the final code (friction
-# on the logged commands only) again, with 1987-1991's.
+# on the logged commands only) again, with 1987-1991's. Stop 59:
+# 2085-2089 with --decision-loss absolute (both named in 12 of 20).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]... [--decision-loss L]

@@ -41,7 +41,8 @@
 # the 4-seed model), 1862-1871 and 1907-1916 (stop 57: one curve for the
 # plan's channels, then judged on every channel; the 4-seed model),
 # 1952-1961 (stop 58, before "no gain, no decision": its development, seed
-# 1955) and 1977-1986 (stop 58, the final code).
+# 1955) and 1977-1986 (stop 58, the final code); 2075-2084 (stop 59,
+# --decision-loss absolute).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L]
