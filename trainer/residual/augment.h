@@ -81,7 +81,7 @@ struct FixOptions {
   // the fixed model and the before/after columns stay the first fold's).
   // 1: the first fold alone. --fix-folds.
   int folds = 2;
-  DecisionLoss decision_loss = DecisionLoss::kSquared;  // --decision-loss
+  DecisionLoss decision_loss = DecisionLoss::kAbsolute;  // --decision-loss
   // How many of the screen's candidates may be tried (plan_candidates: the
   // best of each effect, and a plan extended to its group also on its
   // family alone, each one of the `candidates`): each is re-estimated,
