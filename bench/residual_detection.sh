@@ -186,8 +186,11 @@
 # then development of the absolute loss (a throw-away build, the same
 # logs); 2015-2024 sensor-curve=0.7 at 600 rows (RESIDUAL_ROWS=600), the
 # squared loss; 2035-2044 sensor-curve=0.7 measured with
-# --decision-loss absolute (nothing chosen on them). Next unused: 2055 on
-# (2025-2034 and 2045-2054 are clean sets: bench/residual_false_positives.sh).
+# --decision-loss absolute (nothing chosen on them), and 2055-2064 every
+# other effect at its larger strength with it. Next unused: 2110 on
+# (2025-2034, 2045-2054, 2065-2074 and 2090-2109 are clean sets:
+# bench/residual_false_positives.sh; 2075-2084 the gain wobble;
+# 2085-2089 two effects).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--case EFFECT=STRENGTH]...
@@ -198,7 +201,7 @@
 #   the tool's default 1 since stop 48, the screen's floor 3 before)
 #   --rezeroed-first-init I: the k-th seed's sets are recorded under the zeroing I + k, one the model
 #   never saw, and keep the trained state names (a re-zeroed hand; bench/residual_grasps.sh)
-#   --decision-loss L: passed to `hadynet residual --fix` (squared, the default, or absolute)
+#   --decision-loss L: passed to `hadynet residual --fix` (absolute, its default since stop 59, or squared)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
 set -euo pipefail

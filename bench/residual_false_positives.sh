@@ -89,8 +89,10 @@
 # measured (the final code's "no gain, no decision" can only remove a
 # decision).
 # Stop 59 (--decision-loss absolute): 2025-2034 development (a throw-away
-# build with the absolute loss: 0 of 10 confirmed), 2045-2054 measured
-# with --decision-loss absolute.
+# build with the absolute loss: 0 of 10 confirmed), 2045-2054 and
+# 2065-2074 measured with --decision-loss absolute (1 of 20: 2065), then
+# 2090-2109 (0 of 20) recorded to decide whether it becomes the default
+# (it did). Next unused seed: 2110.
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
@@ -102,7 +104,7 @@
 #   `hadynet residual --reference`; --reference-seed none: no null, absolute floors)
 #   --rezeroed-first-init I: the n-th seed's set is recorded under the zeroing I + n - 1, one the
 #   model never saw, and keeps the trained state names (a re-zeroed hand; bench/residual_grasps.sh)
-#   --decision-loss L: passed to `hadynet residual --fix` (squared, the default, or absolute)
+#   --decision-loss L: passed to `hadynet residual --fix` (absolute, its default since stop 59, or squared)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per seed with an ETA, then the counts; OUT/summary.txt.
 set -euo pipefail

@@ -49,7 +49,7 @@
 #   runs' setting, for comparison; the tool's default is 5), the pairs
 #   sensor-delay=2+crosstalk=0.35, sensor-delay=2+friction=4, input-delay=2+crosstalk=0.35,
 #   input-delay=2+saturation=2 (--pair: only those; repeatable)
-#   --decision-loss L: passed to `hadynet residual --fix` (squared, the default, or absolute)
+#   --decision-loss L: passed to `hadynet residual --fix` (absolute, its default since stop 59, or squared)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
 set -euo pipefail

@@ -48,7 +48,7 @@
 #          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L]
 #   defaults: models/hand.safetensors, build/residual-unknown-effect, 10, 221, the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
-#   --decision-loss L: passed to `hadynet residual --fix` (squared, the default, or absolute)
+#   --decision-loss L: passed to `hadynet residual --fix` (absolute, its default since stop 59, or squared)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per log set with an ETA, then the counts (OUT/summary.txt).
 set -euo pipefail
