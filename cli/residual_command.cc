@@ -326,9 +326,10 @@ int run_residual(int argc, char** argv) {
   const auto candidates = opt.get_int("candidates", 1, 20);
   const auto folds = opt.get_int("fix-folds", 1, 2);
   const auto drift_probe_alpha = opt.get_double("drift-probe-alpha", 0.0, 0.5);
-  const std::string decision_loss = opt.get("decision-loss");
-  if (decision_loss != "squared" && decision_loss != "absolute") {
-    std::fprintf(stderr, "hadynet residual: --decision-loss is squared or absolute, not '%s'\n", decision_loss.c_str());
+  const std::optional<rs::DecisionLoss> decision_loss = rs::decision_loss_named(opt.get("decision-loss"));
+  if (!decision_loss) {
+    std::fprintf(stderr, "hadynet residual: --decision-loss is squared or absolute, not '%s'\n",
+                 opt.get("decision-loss").c_str());
     return 2;
   }
   std::optional<double> fix_min_excess;  // given; else FixOptions' default (fix() keeps it at most the screen's)
@@ -423,7 +424,7 @@ int run_residual(int argc, char** argv) {
     fo.candidates = static_cast<int>(*candidates);
     fo.drift_probe_alpha = *drift_probe_alpha;
     fo.folds = static_cast<int>(*folds);
-    fo.decision_loss = decision_loss == "squared" ? rs::DecisionLoss::kSquared : rs::DecisionLoss::kAbsolute;
+    fo.decision_loss = *decision_loss;
     if (fix_min_excess) fo.min_excess_null = fix_min_excess;
     fo.reference = &reference;
     fo.reference_pb_choice = stored_null ? "state" : "auto";

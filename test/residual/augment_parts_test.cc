@@ -693,6 +693,9 @@ TEST(DecisionLoss, TheMeanOverTheChannelsOfTheStandardisedErrorSquaredOrAbsolute
   EXPECT_THROW(residual::standardised_loss(m, e, {"c"}, DecisionLoss::kSquared), std::logic_error);
   EXPECT_STREQ(residual::decision_loss_name(DecisionLoss::kSquared), "squared");
   EXPECT_STREQ(residual::decision_loss_name(DecisionLoss::kAbsolute), "absolute");
+  EXPECT_EQ(residual::decision_loss_named("absolute"), DecisionLoss::kAbsolute);
+  EXPECT_EQ(residual::decision_loss_named("squared"), DecisionLoss::kSquared);
+  EXPECT_FALSE(residual::decision_loss_named("Squared").has_value());
 }
 
 // The rows fix() fine-tunes on and judges (decision_rows): the first fold and

@@ -75,6 +75,12 @@ const char* decision_loss_name(DecisionLoss loss) {
   return loss == DecisionLoss::kSquared ? "squared" : "absolute";
 }
 
+std::optional<DecisionLoss> decision_loss_named(const std::string& name) {
+  for (DecisionLoss loss : {DecisionLoss::kSquared, DecisionLoss::kAbsolute})
+    if (name == decision_loss_name(loss)) return loss;
+  return std::nullopt;
+}
+
 DecisionRows decision_rows(int T, int split, int d) {
   DecisionRows r;
   const int inner = static_cast<int>(std::floor(DecisionRows::kSelectionFraction * split));

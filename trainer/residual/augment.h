@@ -60,6 +60,8 @@ inline constexpr double kDefaultDriftProbeAlpha = 0.05;
 // "The decision's loss"); the absolute error's are lighter. --decision-loss.
 enum class DecisionLoss { kSquared, kAbsolute };
 const char* decision_loss_name(DecisionLoss loss);  // "squared" or "absolute"
+// The loss decision_loss_name() names `name`; none for any other text.
+std::optional<DecisionLoss> decision_loss_named(const std::string& name);
 // Per held-out row of `e` (one segment per log): the mean over `channels` of
 // each one's error y - y_hat divided by the model's standard deviation of
 // that channel (model.norm.y), squared or absolute. Throws std::logic_error
