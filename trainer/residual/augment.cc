@@ -365,6 +365,7 @@ Attribution candidates_view(const Attribution& attribution, const FixOptions& op
 FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, const ResidualData& data,
               const Attribution& attribution, const FixOptions& options) {
   if (logs.size() != data.logs.size()) throw std::invalid_argument("--fix: logs and analysis differ");
+  const DecisionLoss loss = options.decision_loss;  // every Diebold-Mariano test's per-row loss
   FixResult result;
   result.model = model;
   const Attribution view = candidates_view(attribution, options);
@@ -476,9 +477,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
         probe.sensor = sensor;
         return held_out_error(probe, eval_rows(probe, before_pbs, selection_judged));
       };
-      if (sensor != model.sensor) return standardised_loss(model, judged_rows(), channels, options.decision_loss);
+      if (sensor != model.sensor) return standardised_loss(model, judged_rows(), channels, loss);
       if (!unchanged) unchanged = judged_rows();
-      return standardised_loss(model, *unchanged, channels, options.decision_loss);
+      return standardised_loss(model, *unchanged, channels, loss);
     };
     result.drift_probes = probe_drifts(model, data, rows, options.drift_probe_alpha);
     if (const DriftProbe* best = best_drift_probe(result.drift_probes)) {
@@ -562,8 +563,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       const Tuned t = tune(&a, selection_train);
       const HeldOutError rows = judged(t.model, selection_judged);
       CandidateTrial& c = result.candidates[k];
-      c.selection = diebold_mariano(standardised_loss(model, control_rows, c.channels, options.decision_loss),
-                                    standardised_loss(model, rows, c.channels, options.decision_loss));
+      c.selection = diebold_mariano(standardised_loss(model, control_rows, c.channels, loss),
+                                    standardised_loss(model, rows, c.channels, loss));
       c.selected_by_training_rows = true;
       c.description = a.description;  // as judged: re-estimated on the selection's training rows
       if (gains_significantly(c, attribution.options.alpha)) break;  // chosen_candidate's choice: the rest are not needed
@@ -610,7 +611,6 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.train_windows = after.train_windows;
   result.after = judged(after.model, held_out_part);
   result.confirmation_channels = result.candidates[chosen].channels;
-  const DecisionLoss loss = options.decision_loss;
   Segments reference_loss = standardised_loss(model, reference, result.confirmation_channels, loss);
   Segments after_loss = standardised_loss(model, result.after, result.confirmation_channels, loss);
   result.first_fold = diebold_mariano(reference_loss, after_loss);

@@ -457,7 +457,7 @@ bool gains_significantly(const CandidateTrial& c, double alpha);
 // it beats the fine-tune-only control (or, with control off, the unchanged
 // model) on the held-out rows of the channels its effect was found on: a
 // one-sided Diebold-Mariano test (statistics.h) on the per-row standardised
-// squared error, mean over those channels, at the attribution's alpha (one
+// loss (FixOptions::decision_loss), mean over those channels, at the attribution's alpha (one
 // test: the held-out rows chose nothing), pooled over FixOptions::folds
 // (the first fold's held-out rows, and the mirrored fold's: trained on each
 // log's last rows, judged on the rows before them). Otherwise the status is

@@ -65,7 +65,8 @@ double start_rate(const ResidualData& data, const std::vector<std::string>& chan
 // What the probe needs of fix(): the plan re-estimated on the selection's
 // training rows (fix()'s refinement), and the unchanged network's per-row
 // loss on the selection's judged rows with a sensor model (the mean over
-// `channels` of the squared error in standardised units, one segment per log).
+// `channels` of the standardised error, squared or absolute as fix()'s tests:
+// FixOptions::decision_loss; one segment per log).
 struct DriftProbeRows {
   std::function<Augmentation(const Augmentation& plan)> refined;
   std::function<Segments(const SensorModel& sensor, const std::vector<std::string>& channels)> loss;
