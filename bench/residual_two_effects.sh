@@ -41,7 +41,9 @@
 # input-delay pairs re-run as its development, 1962-1966 measured
 # (--candidates 5), and its input-delay pairs with the final code (friction
 # on the logged commands only) again, with 1987-1991's. Stop 59:
-# 2085-2089 with --decision-loss absolute (both named in 12 of 20).
+# 2085-2089 with --decision-loss absolute (both named in 12 of 20),
+# then development: the squared loss and a decision-only variant re-run
+# on the same logs (docs/residual.md, "The decision's loss").
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]... [--decision-loss L]
