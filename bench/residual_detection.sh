@@ -187,10 +187,17 @@
 # logs); 2015-2024 sensor-curve=0.7 at 600 rows (RESIDUAL_ROWS=600), the
 # squared loss; 2035-2044 sensor-curve=0.7 measured with
 # --decision-loss absolute (nothing chosen on them), and 2055-2064 every
-# other effect at its larger strength with it. Next unused: 2110 on
-# (2025-2034, 2045-2054, 2065-2074 and 2090-2109 are clean sets:
-# bench/residual_false_positives.sh; 2075-2084 the gain wobble;
-# 2085-2089 two effects).
+# other effect at its larger strength with it (2025-2034, 2045-2054,
+# 2065-2074 and 2090-2109 are clean sets: bench/residual_false_positives.sh;
+# 2075-2084 the gain wobble; 2085-2089 two effects).
+# Stop 60 (the cross-talk group's pairs; back to the squared loss):
+# development: 2005-2014, 2037 and 2042 sensor-curve=0.7 (two knot rules,
+# not kept), 2055-2064 crosstalk=0.35 (the group's pairs) and drift=0.02
+# (the first knot rule). Measured with the final code, nothing chosen on
+# them: 2110-2119 (--decision-loss absolute) and 2145-2154 (squared) every
+# effect at its larger strength and crosstalk=0.2. Next unused: 2190 on
+# (2120-2139 and 2155-2174 are clean sets, 2175-2179 two effects,
+# 2180-2189 the gain wobble).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--case EFFECT=STRENGTH]...
@@ -201,7 +208,7 @@
 #   the tool's default 1 since stop 48, the screen's floor 3 before)
 #   --rezeroed-first-init I: the k-th seed's sets are recorded under the zeroing I + k, one the model
 #   never saw, and keep the trained state names (a re-zeroed hand; bench/residual_grasps.sh)
-#   --decision-loss L: passed to `hadynet residual --fix` (absolute, its default since stop 59, or squared)
+#   --decision-loss L: passed to `hadynet residual --fix` (squared, its default, or absolute: its default in stop 59)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
 set -euo pipefail

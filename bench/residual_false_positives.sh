@@ -92,7 +92,11 @@
 # build with the absolute loss: 0 of 10 confirmed), 2045-2054 and
 # 2065-2074 measured with --decision-loss absolute (1 of 20: 2065), then
 # 2090-2109 (0 of 20) recorded to decide whether it becomes the default
-# (it did). Next unused seed: 2110.
+# (it did). Stop 60: 2120-2139 measured with --decision-loss absolute (2 of
+# 20: 2121, 2126), then development (2121, 2126 and 2065 for a knot rule
+# not kept) and the choice of the squared loss as the default again;
+# 2155-2174 measured with the squared loss (0 of 20). Next unused seed:
+# 2190 (bench/residual_detection.sh lists stop 60's other seeds).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
@@ -104,7 +108,7 @@
 #   `hadynet residual --reference`; --reference-seed none: no null, absolute floors)
 #   --rezeroed-first-init I: the n-th seed's set is recorded under the zeroing I + n - 1, one the
 #   model never saw, and keeps the trained state names (a re-zeroed hand; bench/residual_grasps.sh)
-#   --decision-loss L: passed to `hadynet residual --fix` (absolute, its default since stop 59, or squared)
+#   --decision-loss L: passed to `hadynet residual --fix` (squared, its default, or absolute: its default in stop 59)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per seed with an ETA, then the counts; OUT/summary.txt.
 set -euo pipefail

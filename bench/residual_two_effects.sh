@@ -43,7 +43,9 @@
 # on the logged commands only) again, with 1987-1991's. Stop 59:
 # 2085-2089 with --decision-loss absolute (both named in 12 of 20),
 # then development: the squared loss and a decision-only variant re-run
-# on the same logs (docs/residual.md, "The decision's loss").
+# on the same logs (docs/residual.md, "The decision's loss"). Stop 60:
+# 2175-2179 (the cross-talk group's pairs, --decision-loss squared: both
+# named in 15 of 20).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]... [--decision-loss L]
@@ -51,7 +53,7 @@
 #   runs' setting, for comparison; the tool's default is 5), the pairs
 #   sensor-delay=2+crosstalk=0.35, sensor-delay=2+friction=4, input-delay=2+crosstalk=0.35,
 #   input-delay=2+saturation=2 (--pair: only those; repeatable)
-#   --decision-loss L: passed to `hadynet residual --fix` (absolute, its default since stop 59, or squared)
+#   --decision-loss L: passed to `hadynet residual --fix` (squared, its default, or absolute: its default in stop 59)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
 set -euo pipefail

@@ -42,13 +42,14 @@
 # plan's channels, then judged on every channel; the 4-seed model),
 # 1952-1961 (stop 58, before "no gain, no decision": its development, seed
 # 1955) and 1977-1986 (stop 58, the final code); 2075-2084 (stop 59,
-# --decision-loss absolute).
+# --decision-loss absolute); 2180-2189 (stop 60: the cross-talk group's
+# pairs, the squared loss; 0 of 10 confirmed).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L]
 #   defaults: models/hand.safetensors, build/residual-unknown-effect, 10, 221, the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
-#   --decision-loss L: passed to `hadynet residual --fix` (absolute, its default since stop 59, or squared)
+#   --decision-loss L: passed to `hadynet residual --fix` (squared, its default, or absolute: its default in stop 59)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per log set with an ETA, then the counts (OUT/summary.txt).
 set -euo pipefail

@@ -274,8 +274,8 @@ int run_residual(int argc, char** argv) {
   opt.value("decision-loss", "squared|absolute",
             "with --fix: the per-row loss of its Diebold-Mariano tests (the selection, the decision, the tests\n"
             "after it, the drift probe): the mean over the judged channels of the standardised 1-step error,\n"
-            "squared or absolute (lighter-tailed differences on contact-rich logs: docs/residual.md, \"The\n"
-            "decision's loss\")",
+            "squared or absolute (lighter-tailed differences on contact-rich logs, but it confirmed curves on\n"
+            "clean logs: docs/residual.md, \"The decision's loss\", \"Back to the squared loss\")",
             rs::decision_loss_name(rs::FixOptions{}.decision_loss));
   opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
                         "unchanged model, a weaker guard)");

@@ -48,8 +48,11 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
     j["augmentation"] = {{"effect", a.effect}, {"description", a.description}, {"channels", a.channels},
                          {"delay_steps", alignment != nullptr ? alignment->delay : 0}};
     if (const auto* removal = std::get_if<rs::CrosstalkRemoval>(&a.change)) {
-      j["augmentation"]["source"] = removal->pair.source;
-      j["augmentation"]["gain"] = removal->pair.gain;
+      j["augmentation"]["source"] = removal->pairs.front().source;  // the winner's pair
+      j["augmentation"]["gain"] = removal->pairs.front().gain;
+      json pairs = json::array();
+      for (const auto& x : removal->pairs) pairs.push_back({{"target", x.target}, {"source", x.source}, {"gain", x.gain}});
+      j["augmentation"]["pairs"] = pairs;
     }
     if (const auto* curves = std::get_if<rs::CalibrationCurves>(&a.change)) {
       json list = json::array();

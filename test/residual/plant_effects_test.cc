@@ -168,6 +168,43 @@ TEST(PlantEffects, CrosstalkIsNamedWithAPlantPairAndGain) {
   // Gain: 0.35 less what the model's persistence absorbs (measured 0.25-0.28); bound 0.15..0.5.
   EXPECT_GT(w.parameter, 0.15) << w.label;
   EXPECT_LT(w.parameter, 0.5) << w.label;
+
+  // The plan removes the winner's pair and, the pair being within one group,
+  // the best significant plausible pair (ranking order) of each further
+  // target of the group whose source is in the group, unless it would chain
+  // with a pair taken (its target a source or a target, its source a target
+  // of one): with no chain, removing each pair's measured source is exact.
+  const std::vector<Augmentation> two = plan_candidates(o.data, o.attribution, 2);
+  ASSERT_EQ(two.size(), 2u);
+  ASSERT_TRUE(std::holds_alternative<CrosstalkRemoval>(two[0].change)) << two[0].effect;
+  const auto& pairs = std::get<CrosstalkRemoval>(two[0].change).pairs;
+  std::vector<std::pair<std::string, std::string>> expected = {
+      {name_of(o, w.hypothesis.source), name_of(o, w.hypothesis.target)}};
+  for (const auto& r : o.attribution.ranked) {
+    if (!r.significant) break;
+    if (r.hypothesis.kind != EffectKind::kCrosstalk || !r.plausible) continue;
+    const std::string source = name_of(o, r.hypothesis.source), target = name_of(o, r.hypothesis.target);
+    if (channel_group(target) != "fc" || channel_group(source) != "fc") continue;
+    const bool chained = std::any_of(expected.begin(), expected.end(), [&](const auto& x) {
+      return x.second == target || x.first == target || x.second == source;
+    });
+    if (!chained) expected.push_back({source, target});
+  }
+  std::vector<std::pair<std::string, std::string>> planned;
+  for (const auto& x : pairs) planned.push_back({x.source, x.target});
+  EXPECT_EQ(planned, expected);
+  // On these logs the plant's chain gives more than one pair: the extension is exercised.
+  EXPECT_GT(pairs.size(), 1u);
+  ASSERT_EQ(two[0].channels.size(), pairs.size());
+  for (std::size_t k = 0; k < pairs.size(); ++k) EXPECT_EQ(two[0].channels[k], pairs[k].target);
+  EXPECT_EQ(two[0].found_on, two[0].channels);
+  EXPECT_EQ(two[0].extended_channels, std::vector<std::string>(two[0].channels.begin() + 1, two[0].channels.end()));
+  std::printf("cross-talk plan: %s\n", two[0].description.c_str());
+  // The winner's pair alone follows.
+  ASSERT_TRUE(std::holds_alternative<CrosstalkRemoval>(two[1].change)) << two[1].effect;
+  EXPECT_FALSE(two[1].group_extension);
+  ASSERT_EQ(std::get<CrosstalkRemoval>(two[1].change).pairs.size(), 1u);
+  EXPECT_EQ(std::get<CrosstalkRemoval>(two[1].change).pairs.front(), pairs.front());
 }
 
 TEST(PlantEffects, TensionLeakIsNamedAcrossGroupsWithItsGain) {
@@ -185,6 +222,13 @@ TEST(PlantEffects, TensionLeakIsNamedAcrossGroupsWithItsGain) {
   // network carries over of the pick-up is not subtracted from it); bound: within 0.5x..1.5x.
   EXPECT_GT(w.parameter, 0.1) << w.label;
   EXPECT_LT(w.parameter, 0.3) << w.label;
+  // A cross-talk between groups is one path: its pair alone is removed.
+  const std::vector<Augmentation> plan = plan_candidates(o.data, o.attribution, 1);
+  ASSERT_EQ(plan.size(), 1u);
+  ASSERT_TRUE(std::holds_alternative<CrosstalkRemoval>(plan.front().change)) << plan.front().effect;
+  ASSERT_EQ(std::get<CrosstalkRemoval>(plan.front().change).pairs.size(), 1u);
+  EXPECT_EQ(plan.front().channels, std::vector<std::string>{"fc6"});
+  EXPECT_TRUE(plan.front().extended_channels.empty());
   // Only because tensions and loadcells share a unit (N): the target's group alone does not hold f5.
   LibraryOptions same_group;
   same_group.crosstalk_sources = CrosstalkSources::kSameGroup;
