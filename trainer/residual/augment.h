@@ -58,11 +58,12 @@ inline constexpr double kDefaultDriftProbeAlpha = 0.05;
 // The tests' null is equal expected loss either way. The squared error's
 // per-row differences are heavy-tailed on contact-rich logs (docs/residual.md,
 // "The decision's loss"); the absolute error's are lighter, but they also
-// give significance to the small steady differences between two
-// fine-tunings on channels a change does not touch (clean fresh sets 2121
-// and 2126: a curve of loadcells at rest confirmed at p 8e-5 on the
-// lengths' 0.94-0.98 of fine-tuning alone's RMSE): the squared error is the
-// default (docs/residual.md, "Back to the squared loss"). --decision-loss.
+// make a small steady gain on channels a change does not touch
+// significant (clean fresh sets 2121 and 2126: a curve compressing the
+// band of loadcells at rest, confirmed at p 8e-5 on the lengths' 0.94-0.98
+// of fine-tuning alone's RMSE, with any window order): the squared error
+// is the default (docs/residual.md, "Back to the squared loss").
+// --decision-loss.
 enum class DecisionLoss { kSquared, kAbsolute };
 const char* decision_loss_name(DecisionLoss loss);  // "squared" or "absolute"
 // The loss decision_loss_name() names `name`; none for any other text.
