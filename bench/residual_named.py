@@ -3,7 +3,9 @@ benchmarks; not a test). One rule per plant effect, shared by
 bench/residual_detection.sh and bench/residual_two_effects.sh:
 
   sensor-delay  the delay in steps;
-  crosstalk     a plant pair (fc0<-fc1, fc1<-fc2, fc2<-fc3, fc3<-fc4, fc4<-fc3);
+  crosstalk     plant pairs (fc0<-fc1, fc1<-fc2, fc2<-fc3, fc3<-fc4, fc4<-fc3):
+                the winner's and, since stop 60, every further pair of the
+                group the fix removes (augmentation.pairs);
   tension-leak  f5 -> fc6 with a gain within 0.5-1.5 times the plant's;
   friction      tendon channels (f*);
   drift         a load drift on loadcells;
@@ -31,7 +33,9 @@ def names(effect, strength, fix):
     if effect == "sensor-delay":
         return named_effect == "sensor-delay" and aug.get("delay_steps") == int(strength)
     if effect == "crosstalk":
-        return named_effect == "crosstalk" and bool(channels) and (channels[0], aug.get("source")) in PLANT_CROSSTALK_PAIRS
+        pairs = [(p["target"], p["source"]) for p in aug.get("pairs", [])] or [(channels[0] if channels else None,
+                                                                                  aug.get("source"))]
+        return named_effect == "crosstalk" and bool(channels) and all(p in PLANT_CROSSTALK_PAIRS for p in pairs)
     if effect == "tension-leak":
         gain = aug.get("gain", 0.0)
         return (named_effect == "crosstalk" and channels == ["fc6"] and aug.get("source") == "f5"

@@ -241,7 +241,8 @@ int run_residual(int argc, char** argv) {
   opt.value("fix-lr", "X", "with --fix: Adam learning rate", "0.001");
   opt.value("fix-seed", "N", "with --fix: seed of the window order", "1");
   opt.value("candidates", "K", "with --fix: how many of the screen's candidates may be tried (the best of each effect;\n"
-                              "a delay, curve or rail extended to its group also on its family alone, right after):\n"
+                              "a delay, curve, rail or cross-talk extended to its group also on its family alone,\n"
+                              "right after):\n"
                               "each added, fine-tuned on the first 75 % of the training rows and compared with\n"
                               "fine-tuning alone on the rest; the first significant there, else the clearest gain,\n"
                               "is the one the decision tests on the held-out rows, none when none gains (1: the\n"

@@ -48,7 +48,8 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
     j["augmentation"] = {{"effect", a.effect}, {"description", a.description}, {"channels", a.channels},
                          {"delay_steps", alignment != nullptr ? alignment->delay : 0}};
     if (const auto* removal = std::get_if<rs::CrosstalkRemoval>(&a.change)) {
-      j["augmentation"]["source"] = removal->pairs.front().source;  // the winner's pair
+      // pairs.front(): the winner's pair, which crosstalk::plan always takes.
+      j["augmentation"]["source"] = removal->pairs.front().source;
       j["augmentation"]["gain"] = removal->pairs.front().gain;
       json pairs = json::array();
       for (const auto& x : removal->pairs) pairs.push_back({{"target", x.target}, {"source", x.source}, {"gain", x.gain}});

@@ -362,6 +362,21 @@ TEST(SensorFrame, ThePlansCurvesAreFittedAsOneOnTheUnionOfTheirKnots) {
   EXPECT_NE(a.description.find("one curve, 5 knots"), std::string::npos) << a.description;
 }
 
+// A cross-talk pair chains with a taken pair when its target is a taken
+// target (two removals of one channel) or a taken source (its removal
+// would change a source another removal subtracts as measured), or its
+// source is a taken target (the sensor model would add back the corrected
+// source, the removal subtracted the measured one).
+TEST(Crosstalk, APairFormsAChainWithATakenPairsTargetOrSource) {
+  const std::vector<SensorCrosstalk> taken = {{"fc1", "fc2", 0.3}};  // fc1 <- fc2
+  EXPECT_TRUE(residual::forms_chain({"fc1", "fc3", 0.3}, taken));   // the same target
+  EXPECT_TRUE(residual::forms_chain({"fc2", "fc3", 0.3}, taken));   // its target is the taken source
+  EXPECT_TRUE(residual::forms_chain({"fc0", "fc1", 0.3}, taken));   // its source is the taken target
+  EXPECT_FALSE(residual::forms_chain({"fc0", "fc2", 0.3}, taken));  // a shared source: no chain
+  EXPECT_FALSE(residual::forms_chain({"fc3", "fc4", 0.3}, taken));  // disjoint
+  EXPECT_FALSE(residual::forms_chain({"fc3", "fc4", 0.3}, {}));
+}
+
 // A curve's end as flat as its fit may be: one more step of the search
 // (x 0.93) would cross the slope bound 1/4 (CalibrationCurves::flat_at_end,
 // the simpler account's rail signature).

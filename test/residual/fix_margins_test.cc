@@ -47,6 +47,7 @@ TEST(FixMargins, EveryMeasuredValuePassesItsBound) {
   for (const Below& b : {kSensorDelay.winner_vs_before, kSensorDelay.winner_vs_control, kSensorDelay.aligned_vs_before,
                          kSensorDelay.aligned_median, kFriction.winner_vs_before, kFriction.winner_vs_control,
                          kFriction.family_vs_before, kCrosstalk.winner_vs_before, kCrosstalk.winner_vs_control,
+                         kCrosstalk.further_vs_before, kCrosstalk.further_vs_control,
                          kDrift.winner_vs_before, kDrift.winner_vs_control, kDrift.family_vs_before,
                          kDrift.each_vs_control, kDrift.group_vs_control, kDriftProbe.group_vs_before,
                          kDriftProbe.group_vs_control, kDriftProbe.decision_p,

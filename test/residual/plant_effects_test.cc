@@ -182,7 +182,7 @@ TEST(PlantEffects, CrosstalkIsNamedWithAPlantPairAndGain) {
       {name_of(o, w.hypothesis.source), name_of(o, w.hypothesis.target)}};
   for (const auto& r : o.attribution.ranked) {
     if (!r.significant) break;
-    if (r.hypothesis.kind != EffectKind::kCrosstalk || !r.plausible) continue;
+    if (r.hypothesis.kind != EffectKind::kCrosstalk) continue;
     const std::string source = name_of(o, r.hypothesis.source), target = name_of(o, r.hypothesis.target);
     if (channel_group(target) != "fc" || channel_group(source) != "fc") continue;
     const bool chained = std::any_of(expected.begin(), expected.end(), [&](const auto& x) {
@@ -193,13 +193,26 @@ TEST(PlantEffects, CrosstalkIsNamedWithAPlantPairAndGain) {
   std::vector<std::pair<std::string, std::string>> planned;
   for (const auto& x : pairs) planned.push_back({x.source, x.target});
   EXPECT_EQ(planned, expected);
-  // On these logs the plant's chain gives more than one pair: the extension is exercised.
+  // On these logs the plant's chain gives more than one pair: the extension is exercised;
+  // every pair taken is one of the plant's.
   EXPECT_GT(pairs.size(), 1u);
+  for (const auto& x : pairs) EXPECT_TRUE(plant_pairs.count({x.source, x.target})) << x.source << " -> " << x.target;
   ASSERT_EQ(two[0].channels.size(), pairs.size());
   for (std::size_t k = 0; k < pairs.size(); ++k) EXPECT_EQ(two[0].channels[k], pairs[k].target);
   EXPECT_EQ(two[0].found_on, two[0].channels);
   EXPECT_EQ(two[0].extended_channels, std::vector<std::string>(two[0].channels.begin() + 1, two[0].channels.end()));
   std::printf("cross-talk plan: %s\n", two[0].description.c_str());
+  // A model that already removes fc1 -> fc0 (an earlier round's pair): the
+  // further pairs chain with it no more (fc1 -> fc0 was one of them above).
+  ResidualData earlier = o.data;
+  earlier.crosstalk = {{"fc0", "fc1", 0.3}};
+  const std::vector<Augmentation> later = plan_candidates(earlier, o.attribution, 1);
+  ASSERT_EQ(later.size(), 1u);
+  ASSERT_TRUE(std::holds_alternative<CrosstalkRemoval>(later[0].change)) << later[0].effect;
+  const auto& later_pairs = std::get<CrosstalkRemoval>(later[0].change).pairs;
+  EXPECT_LT(later_pairs.size(), pairs.size());
+  for (std::size_t k = 1; k < later_pairs.size(); ++k)
+    EXPECT_FALSE(forms_chain(later_pairs[k], earlier.crosstalk)) << later_pairs[k].source << " -> " << later_pairs[k].target;
   // The winner's pair alone follows.
   ASSERT_TRUE(std::holds_alternative<CrosstalkRemoval>(two[1].change)) << two[1].effect;
   EXPECT_FALSE(two[1].group_extension);

@@ -183,10 +183,10 @@ struct TimeAlignment : ModelChange {
 };
 
 // crosstalk: removal of the winner's pair and, within one group, the
-// group's other pairs that pass the test (crosstalk::plan): each target
-// picks up `gain` times its source (the fitted gain); the model is
-// fine-tuned on y'_c = y_c - k y_s (in y and x); the measured y_c is
-// y'_c + k y'_s.
+// group's other significant pairs that form no chain (crosstalk::plan,
+// forms_chain): each target picks up `gain` times its source (the fitted
+// gain); the model is fine-tuned on y'_c = y_c - k y_s (in y and x); the
+// measured y_c is y'_c + k y'_s (exact without chains: y_s is then y'_s).
 struct CrosstalkRemoval : ModelChange {
   // target, source, gain (target units per source unit); the winner's pair
   // first, then one per further target (a.extended_channels), none twice.
@@ -298,10 +298,12 @@ struct Augmentation {
   // The screen's floor statistic of the hypothesis that led to it
   // (floor_statistic: excess_share with a null, else explained_std).
   double screen_statistic = 0;
-  // The group extension of a sensor delay, a calibration curve, a rail, a
-  // drift or a cross-talk within a group (effects.cc, passing_in_group): whether the plan may extend the family
-  // to the other channels of its group where the test finds the effect (set
-  // before planning), and the channels it added.
+  // The group extension of a sensor delay, a calibration curve, a rail or a
+  // drift (effects.cc, passing_in_group: the test without the floors), or
+  // of a cross-talk within a group (its group's significant pairs,
+  // crosstalk::plan): whether the plan may extend the family to the other
+  // channels of its group where the test finds the effect (set before
+  // planning), and the channels it added.
   bool group_extension = true;
   std::vector<std::string> extended_channels;
   std::variant<TimeAlignment, CrosstalkRemoval, BiasState, OutputClips, CalibrationCurves, DerivedCommandInputs,

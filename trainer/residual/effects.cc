@@ -1147,26 +1147,25 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
 
 // The winner's pair; when its source is in its target's group (and the
 // plan may extend: Augmentation::group_extension), also, in ranking order,
-// each significant plausible pair of the group (target and source in it)
-// that forms no chain with a pair taken: its target is no pair's target or
-// source, its source no pair's target. The channels of one sensor array
-// pick up their neighbours (the plant's fingertips each pick up one), and
-// the winner's pair alone left the other targets to a curve of the whole
-// group, which won the decision on 2 of 10 development cross-talk sets
-// (docs/residual.md, "Cross-talk in a group"). Without chains the removal
-// is exact: each pair removes its source's measured value, and the sensor
-// model adds back the network's source, the same when the source is no
-// pair's target (with a chain fc0 <- fc1 <- fc2 the two differ by
-// k1 k2 fc2; the group's pairs taken with chains gained less than the
-// winner's alone on the selection's rows of all 10 of those sets). Unlike
-// a delay's or a curve's, these pairs must pass the practical floors: each
-// is an effect of its own, and the model's misfit between neighbouring
-// loadcells shows as pairs. A cross-talk between groups (a tendon into a
-// palm loadcell) is one mechanical path: its pair alone. Removing every
-// pair of the winner's family (its target's other sources) was measured
-// worse: between correlated sources the family holds pairs the plant does
-// not have (fc6 -> fc5 with gain -0.27 on the default plant logs), and
-// fc1 got worse than before (docs/residual.md).
+// each significant pair of the group (target and source in it; significant
+// at the floors `attribution` has: fix() plans at the candidates' floor,
+// --fix-min-excess-null) that forms no chain (forms_chain) with a pair
+// taken or with one of the model's own (data.crosstalk: an earlier
+// round's). The channels of one sensor array pick up their neighbours (the
+// plant's fingertips each pick up one), and the winner's pair alone left
+// the other targets to a curve of the whole group, which won the decision
+// on 2 of 10 development cross-talk sets (docs/residual.md, "Cross-talk in
+// a group"). With a chain fc0 <- fc1 <- fc2 the removal and the sensor
+// model differ by k1 k2 fc2; the group's pairs taken with chains gained
+// less than the winner's alone on the selection's rows of all 10 of those
+// sets. Unlike a delay's or a curve's extension, these pairs must pass the
+// floors: each is an effect of its own, and the model's misfit between
+// neighbouring loadcells shows as pairs. A cross-talk between groups (a
+// tendon into a palm loadcell) is one mechanical path: its pair alone.
+// Removing every pair of the winner's family (its target's other sources)
+// was measured worse: between correlated sources the family holds pairs
+// the plant does not have (fc6 -> fc5 with gain -0.27 on the default plant
+// logs), and fc1 got worse than before (docs/residual.md).
 void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
   auto& change = a.change.emplace<CrosstalkRemoval>();
   const std::string target = y_name(data, w.hypothesis.target), source = source_name(w.hypothesis, data);
@@ -1174,18 +1173,18 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   change.pairs = {{target, source, w.parameter}};
   const std::string group = channel_group(target);
   if (a.group_extension && channel_group(source) == group) {
+    std::vector<SensorCrosstalk> taken = data.crosstalk;
+    taken.push_back(change.pairs.front());
     for (const HypothesisResult& r : attribution.ranked) {
-      if (!r.significant) break;  // ranked: the significant first
-      if (r.hypothesis.kind != EffectKind::kCrosstalk || !r.plausible) continue;
-      const std::string name = y_name(data, r.hypothesis.target), from = source_name(r.hypothesis, data);
-      if (channel_group(name) != group || channel_group(from) != group) continue;
-      const bool chained = std::any_of(change.pairs.begin(), change.pairs.end(), [&](const SensorCrosstalk& x) {
-        return x.target == name || x.source == name || x.target == from;
-      });
-      if (chained) continue;
-      a.channels.push_back(name);
-      a.extended_channels.push_back(name);
-      change.pairs.push_back({name, from, r.parameter});
+      if (!r.significant) break;  // ranked: the significant (plausible among them) first
+      if (r.hypothesis.kind != EffectKind::kCrosstalk) continue;
+      const SensorCrosstalk pair{y_name(data, r.hypothesis.target), source_name(r.hypothesis, data), r.parameter};
+      if (channel_group(pair.target) != group || channel_group(pair.source) != group || forms_chain(pair, taken))
+        continue;
+      a.channels.push_back(pair.target);
+      a.extended_channels.push_back(pair.target);
+      change.pairs.push_back(pair);
+      taken.push_back(pair);
     }
   }
   const auto removal = [](const SensorCrosstalk& x) {
@@ -1198,12 +1197,18 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
     a.description += "; in the same group: ";
     for (std::size_t k = 1; k < change.pairs.size(); ++k) a.description += (k > 1 ? ", " : "") + removal(change.pairs[k]);
   }
-  a.description += "; the sensor model adds it back";
+  a.description += change.pairs.size() > 1 ? "; the sensor model adds them back" : "; the sensor model adds it back";
   a.found_on = a.channels;
 }
 
 }  // namespace crosstalk
 }  // namespace
+
+bool forms_chain(const SensorCrosstalk& pair, const std::vector<SensorCrosstalk>& taken) {
+  return std::any_of(taken.begin(), taken.end(), [&](const SensorCrosstalk& x) {
+    return x.target == pair.target || x.source == pair.target || x.target == pair.source;
+  });
+}
 
 void CrosstalkRemoval::add_to_sensor(SensorModel& s, const Augmentation&) const {
   s.crosstalk.insert(s.crosstalk.end(), pairs.begin(), pairs.end());

@@ -161,6 +161,12 @@ struct EffectInfo {
 };
 // The table, in EffectKind order (the order hypotheses are enumerated in).
 const std::vector<EffectInfo>& effect_library();
+
+// Whether cross-talk `pair` forms a chain with one of `taken`: its target
+// is a taken pair's target or source, or its source a taken pair's target.
+// Without a chain, removing each pair's measured source is exact (the
+// sensor model adds back the network's source, the same signal then).
+bool forms_chain(const SensorCrosstalk& pair, const std::vector<SensorCrosstalk>& taken);
 const EffectInfo& effect_info(EffectKind kind);
 
 // The row's functions for any hypothesis:

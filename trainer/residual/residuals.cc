@@ -183,6 +183,7 @@ ResidualData compute_residuals(const HadynetModel& model, const std::vector<LogI
   data.aux_names = common_aux_names(logs);
   data.y_scale = model.norm.y.std;
   for (const std::string& name : data.y_names) data.y_frame_transformed.push_back(frame_transforms(model.sensor, name));
+  data.crosstalk = model.sensor.crosstalk;
 
   for (const auto& raw : logs) {
     // The model sees (and predicts) its own frame; the aux columns are read from the same rows.

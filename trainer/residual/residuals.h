@@ -84,6 +84,9 @@ struct ResidualData {
   // cross-talk or drift removed (frame_transforms, sensor_model.h), so its
   // levels in the logs below are not sensor readings. Empty: none is.
   std::vector<bool> y_frame_transformed;
+  // The model's cross-talk pairs (its sensor model's, from earlier rounds'
+  // fixes): a new pair must not chain with them (crosstalk::plan).
+  std::vector<SensorCrosstalk> crosstalk;
   std::vector<ResidualLog> logs;
 };
 
