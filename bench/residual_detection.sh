@@ -195,7 +195,9 @@
 # not kept), 2055-2064 crosstalk=0.35 (the group's pairs) and drift=0.02
 # (the first knot rule). Measured with the final code, nothing chosen on
 # them: 2110-2119 (--decision-loss absolute) and 2145-2154 (squared) every
-# effect at its larger strength and crosstalk=0.2. Next unused: 2190 on
+# effect at its larger strength and crosstalk=0.2; 2145-2154's cross-talk
+# cases again with stop 59's binary (the winner's pair alone, squared),
+# for a comparison on the same logs. Next unused: 2190 on
 # (2120-2139 and 2155-2174 are clean sets, 2175-2179 two effects,
 # 2180-2189 the gain wobble).
 #
