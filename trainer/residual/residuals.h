@@ -85,7 +85,8 @@ struct ResidualData {
   // levels in the logs below are not sensor readings. Empty: none is.
   std::vector<bool> y_frame_transformed;
   // The model's cross-talk pairs (its sensor model's, from earlier rounds'
-  // fixes): a new pair must not chain with them (crosstalk::plan).
+  // fixes): a plan's further pairs must not chain with them (crosstalk::plan;
+  // the winner's pair is planned whatever it chains with).
   std::vector<SensorCrosstalk> crosstalk;
   std::vector<ResidualLog> logs;
 };
