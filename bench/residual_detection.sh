@@ -202,7 +202,7 @@
 # 2180-2189 the gain wobble).
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
-#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--case EFFECT=STRENGTH]...
+#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...
 #   defaults: models/hand.safetensors, build/residual-detection, 10, 231, the tool's --candidates (5), every case
 #   (--case: only those; repeatable), the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
@@ -211,6 +211,8 @@
 #   --rezeroed-first-init I: the k-th seed's sets are recorded under the zeroing I + k, one the model
 #   never saw, and keep the trained state names (a re-zeroed hand; bench/residual_grasps.sh)
 #   --decision-loss L: passed to `hadynet residual --fix` (squared, its default, or absolute: its default in stop 59)
+#   --decision-scale S: passed to `hadynet residual --fix` (std or residual: each channel's error in its clean residual level)
+#   --fix-selection R: passed to `hadynet residual --fix` (screen-order or every-channel)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
 set -euo pipefail
@@ -234,6 +236,8 @@ while (($#)); do
     --candidates) candidates=(--candidates "$2"); shift 2 ;;
     --fix-min-excess-null) candidates+=(--fix-min-excess-null "$2"); shift 2 ;;
     --decision-loss) candidates+=(--decision-loss "$2"); shift 2 ;;
+    --decision-scale) candidates+=(--decision-scale "$2"); shift 2 ;;
+    --fix-selection) candidates+=(--fix-selection "$2"); shift 2 ;;
     --case) only_cases+=("$2"); shift 2 ;;
     --rezeroed-first-init) rezeroed_first_init=$2; shift 2 ;;
     *) echo "residual_detection: unknown argument $1" >&2; exit 2 ;;

@@ -100,7 +100,7 @@
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
-#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [SEED...]
+#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [SEED...]
 #   defaults: models/hand.safetensors, build/residual-false-positives, 161..180,
 #   no rated range (the plant's datasheet: --rated-range fc=0..50 --rated-range f=0..200),
 #   the null of `hadynet residual`'s default: the held-out logs stored in the model
@@ -109,6 +109,8 @@
 #   --rezeroed-first-init I: the n-th seed's set is recorded under the zeroing I + n - 1, one the
 #   model never saw, and keeps the trained state names (a re-zeroed hand; bench/residual_grasps.sh)
 #   --decision-loss L: passed to `hadynet residual --fix` (squared, its default, or absolute: its default in stop 59)
+#   --decision-scale S: passed to `hadynet residual --fix` (std or residual: each channel's error in its clean residual level)
+#   --fix-selection R: passed to `hadynet residual --fix` (screen-order or every-channel)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per seed with an ETA, then the counts; OUT/summary.txt.
 set -euo pipefail
@@ -129,6 +131,8 @@ while (($#)); do
     --candidates) ranges+=(--candidates "$2"); shift 2 ;;
     --fix-min-excess-null) ranges+=(--fix-min-excess-null "$2"); shift 2 ;;
     --decision-loss) ranges+=(--decision-loss "$2"); shift 2 ;;
+    --decision-scale) ranges+=(--decision-scale "$2"); shift 2 ;;
+    --fix-selection) ranges+=(--fix-selection "$2"); shift 2 ;;
     --rezeroed-first-init) rezeroed_first_init=$2; shift 2 ;;
     -*) echo "residual_false_positives: unknown option $1" >&2; exit 2 ;;
     *) seeds+=("$1"); shift ;;

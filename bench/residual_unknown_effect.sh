@@ -46,10 +46,12 @@
 # pairs, the squared loss; 0 of 10 confirmed).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
-#          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L]
+#          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--fix-selection R]
 #   defaults: models/hand.safetensors, build/residual-unknown-effect, 10, 221, the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
 #   --decision-loss L: passed to `hadynet residual --fix` (squared, its default, or absolute: its default in stop 59)
+#   --decision-scale S: passed to `hadynet residual --fix` (std or residual: each channel's error in its clean residual level)
+#   --fix-selection R: passed to `hadynet residual --fix` (screen-order or every-channel)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per log set with an ETA, then the counts (OUT/summary.txt).
 set -euo pipefail
@@ -71,6 +73,8 @@ while (($#)); do
     --first-seed) first_seed=$2; shift 2 ;;
     --effect-kind) kind=$2; shift 2 ;;
     --decision-loss) fix_args+=(--decision-loss "$2"); shift 2 ;;
+    --decision-scale) fix_args+=(--decision-scale "$2"); shift 2 ;;
+    --fix-selection) fix_args+=(--fix-selection "$2"); shift 2 ;;
     *) echo "residual_unknown_effect: unknown argument $1" >&2; exit 2 ;;
   esac
 done

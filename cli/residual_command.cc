@@ -278,6 +278,18 @@ int run_residual(int argc, char** argv) {
             "squared or absolute (lighter-tailed differences on contact-rich logs, but it confirmed curves on\n"
             "clean logs: docs/residual.md, \"The decision's loss\", \"Back to the squared loss\")",
             rs::decision_loss_name(rs::FixOptions{}.decision_loss));
+  opt.value("fix-selection", "screen-order|every-channel",
+            "with --fix: how the candidates are compared on the training rows: screen-order (each on its own\n"
+            "channels, the first in the screen's order that gains significantly) or every-channel (each on\n"
+            "every channel, the largest statistic among those that gain significantly)",
+            rs::selection_rule_name(rs::FixOptions{}.selection));
+  opt.value("decision-scale", "std|residual",
+            "with --fix: the unit of each channel's error in the held-out tests' loss (the decision and\n"
+            "the tests after it; the selection and the drift probe keep std) before the mean over the judged\n"
+            "channels: std (its standard deviation: channels the model predicts worse weigh more) or residual\n"
+            "(also divided by its clean 1-step residual level on the null, the floors' unit: each channel's\n"
+            "relative change counts alike; needs a null, else std is used and said)",
+            rs::decision_scale_name(rs::FixOptions{}.decision_scale));
   opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
                         "unchanged model, a weaker guard)");
   if (!opt.parse(argc, argv)) return 2;
@@ -331,6 +343,18 @@ int run_residual(int argc, char** argv) {
   if (!decision_loss) {
     std::fprintf(stderr, "hadynet residual: --decision-loss is squared or absolute, not '%s'\n",
                  opt.get("decision-loss").c_str());
+    return 2;
+  }
+  const std::optional<rs::DecisionScale> decision_scale = rs::decision_scale_named(opt.get("decision-scale"));
+  if (!decision_scale) {
+    std::fprintf(stderr, "hadynet residual: --decision-scale is std or residual, not '%s'\n",
+                 opt.get("decision-scale").c_str());
+    return 2;
+  }
+  const std::optional<rs::SelectionRule> selection = rs::selection_rule_named(opt.get("fix-selection"));
+  if (!selection) {
+    std::fprintf(stderr, "hadynet residual: --fix-selection is screen-order or every-channel, not '%s'\n",
+                 opt.get("fix-selection").c_str());
     return 2;
   }
   std::optional<double> fix_min_excess;  // given; else FixOptions' default (fix() keeps it at most the screen's)
@@ -426,6 +450,8 @@ int run_residual(int argc, char** argv) {
     fo.drift_probe_alpha = *drift_probe_alpha;
     fo.folds = static_cast<int>(*folds);
     fo.decision_loss = *decision_loss;
+    fo.decision_scale = *decision_scale;
+    fo.selection = *selection;
     if (fix_min_excess) fo.min_excess_null = fix_min_excess;
     fo.reference = &reference;
     fo.reference_pb_choice = stored_null ? "state" : "auto";

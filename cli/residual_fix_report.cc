@@ -35,6 +35,7 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
             {"changed", f.changed},
             {"none_gained", f.none_gained},
             {"look_alike", f.look_alike},
+            {"selection_rule", rs::selection_rule_name(o.selection)},
             {"train_fraction", o.train_fraction},
             {"epochs", o.epochs},
             {"lr", o.lr},
@@ -74,6 +75,12 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                          {"channels", f.confirmation_channels},
                          {"test", "Diebold-Mariano, one-sided, Newey-West variance"},
                          {"loss", rs::decision_loss_name(o.decision_loss)},
+                         {"scale", rs::decision_scale_name(f.scale)},
+                         {"scale_note", f.scale_note},
+                         {"own_channels", f.own_channels ? json{{"channels", f.own_channel_names},
+                                                                 {"mean_loss_difference", f.own_channels->mean},
+                                                                 {"statistic", f.own_channels->stat}}
+                                                           : json()},
                          {"mean_loss_difference", f.confirmation.mean},
                          {"statistic", f.confirmation.stat},
                          {"bandwidth", f.confirmation.bandwidth},
@@ -249,7 +256,9 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
     for (std::size_t i = 0; i < f.confirmation_channels.size(); ++i) m += (i ? ", " : "") + f.confirmation_channels[i];
     m += std::string(" (one-sided Diebold-Mariano test of the standardised ") +
          rs::decision_loss_name(o.decision_loss) +
-         " error, Newey-West variance over " +
+         (f.scale == rs::DecisionScale::kResidual ? " error relative to each channel's clean residual level" : " error") +
+         (f.scale_note.empty() ? std::string() : " (" + f.scale_note + ")") +
+         ", Newey-West variance over " +
          std::to_string(f.confirmation.bandwidth) + " lags, " + std::to_string(f.confirmation.samples) +
          " rows" + (f.folds > 1 ? " of " + std::to_string(f.folds) + " folds" : std::string()) +
          "): mean loss difference " + num("%.3g", f.confirmation.mean) + ", p " +
@@ -257,6 +266,12 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
          (f.folds > 1 ? " (the first fold alone: p " + num("%.2g", f.first_fold.p_value) + ")" : std::string()) +
          (f.folds_note.empty() ? std::string() : " (" + f.folds_note + ")") + ": **" + (f.changed ? "confirmed" : "not confirmed, nothing applied") +
          "**.\n\n";
+    if (f.own_channels) {
+      m += "Judged on every channel, it was also asked to predict its own channels (";
+      for (std::size_t i = 0; i < f.own_channel_names.size(); ++i) m += (i ? ", " : "") + f.own_channel_names[i];
+      m += ") better than " + f.reference + ": mean loss difference " + num("%.3g", f.own_channels->mean) +
+           (f.own_channels->mean > 0 ? " (it does)" : " (it does not)") + ".\n\n";
+    }
     if (f.simpler) m += simpler_sentence(*f.simpler, f.reference) + ".\n\n";
     for (const auto& e : f.extensions) m += extension_sentence(e) + ".\n\n";
     if (replaced_after_decision(f)) m += "The before/after below are the plan applied last.\n\n";

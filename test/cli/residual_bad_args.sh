@@ -88,6 +88,10 @@ expect 2 "--fix-min-excess-null: expected a number in 0..1e+06, got '1e9'" "$mod
 expect 2 "--fix-folds: expected a whole number in 1..2, got '3'" "$model" good.csv --fix --fix-folds 3 --json out.json
 expect 2 "--decision-loss is squared or absolute, not 'cubic'" "$model" good.csv --fix --decision-loss cubic \
   --json out.json
+expect 2 "--decision-scale is std or residual, not 'relative'" "$model" good.csv --fix --decision-scale relative \
+  --json out.json
+expect 2 "--fix-selection is screen-order or every-channel, not 'best'" "$model" good.csv --fix --fix-selection best \
+  --json out.json
 expect 2 "--fix-min-excess-null 4 is above the screen's --min-excess-null 3" "$model" good.csv --fix \
   --fix-min-excess-null 4 --json out.json
 expect 1 "--reference good.csv is also a log under test" "$model" good.csv --reference good.csv --json out.json

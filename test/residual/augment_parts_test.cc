@@ -423,6 +423,34 @@ TEST(FixCandidates, TheFirstSignificantElseTheClearestGainElseNoneIsTested) {
   EXPECT_EQ(chosen({}), 0u);
 }
 
+// --fix-selection every-channel (best_candidate): every candidate is judged
+// on every channel, so the statistics compare alike: the largest among the
+// significant ones, wherever it is in the screen's order; else the largest
+// positive; none when nothing gains.
+TEST(FixCandidates, EveryChannelTakesTheLargestSignificantStatistic) {
+  auto trial = [](double stat, bool judged = true) {
+    residual::CandidateTrial c;
+    c.selection.mean = stat / 100;
+    c.selection.stat = stat;
+    c.selection.p_value = 0.5 * std::erfc(stat / std::sqrt(2.0));
+    c.selected_by_training_rows = judged;
+    return c;
+  };
+  const auto best = [](const std::vector<residual::CandidateTrial>& c) { return residual::best_candidate(c, 0.01); };
+  // Both significant at 0.01 (p 0.0047 and 0.0002): the larger, not the first.
+  EXPECT_EQ(best({trial(-1.0), trial(2.6), trial(3.5)}), 2u);
+  EXPECT_EQ(best({trial(3.5), trial(2.6)}), 0u);
+  // None significant: the largest positive.
+  EXPECT_EQ(best({trial(1.2), trial(2.0), trial(-3.0)}), 1u);
+  EXPECT_EQ(best({trial(-1.0), trial(-4.0)}), std::nullopt);
+  // Not judged: never chosen; none judged: the screen's first.
+  EXPECT_EQ(best({trial(1.0), trial(9.0, false)}), 0u);
+  EXPECT_EQ(best({trial(0.0, false), trial(5.0, false)}), 0u);
+  EXPECT_STREQ(residual::selection_rule_name(residual::SelectionRule::kEveryChannel), "every-channel");
+  EXPECT_EQ(residual::selection_rule_named("screen-order"), residual::SelectionRule::kScreenOrder);
+  EXPECT_FALSE(residual::selection_rule_named("best").has_value());
+}
+
 // The plans fix() tries as the simpler account of a confirmed calibration
 // curve (EffectInfo::simpler: a rail): the rails planned on the curve's
 // lead channel, fewest channels first; none for a rail on another channel
@@ -674,16 +702,22 @@ TEST(DriftProbe, OneLoadDriftPerGroupAtOneRateTheBestGroupACandidate) {
   EXPECT_TRUE(residual::probe_drifts(model, data, rows, 0.01).empty());
 }
 
-// The per-row loss of --fix's Diebold-Mariano tests (standardised_loss):
-// each channel's error over the model's standard deviation of it, squared
-// or absolute (--decision-loss), averaged over the channels asked for, one
-// segment per log. Exact: hand-computed values, tolerance 1e-12.
-TEST(DecisionLoss, TheMeanOverTheChannelsOfTheStandardisedErrorSquaredOrAbsolute) {
+// A model of two y channels, a and b, of standard deviations 2 and 4.
+HadynetModel loss_model() {
   HadynetModel m;
   m.layout.y_names = {"a", "b"};
   m.norm.y.mean = Eigen::VectorXd::Zero(2);
   m.norm.y.std.resize(2);
   m.norm.y.std << 2.0, 4.0;
+  return m;
+}
+
+// The per-row loss of --fix's Diebold-Mariano tests (standardised_loss):
+// each channel's error over the model's standard deviation of it, squared
+// or absolute (--decision-loss), averaged over the channels asked for, one
+// segment per log. Exact: hand-computed values, tolerance 1e-12.
+TEST(DecisionLoss, TheMeanOverTheChannelsOfTheStandardisedErrorSquaredOrAbsolute) {
+  const HadynetModel m = loss_model();
   residual::HeldOutError e;
   e.channels = {"b", "a"};  // the evaluation's order need not be the model's
   e.residuals.resize(2);
@@ -711,6 +745,45 @@ TEST(DecisionLoss, TheMeanOverTheChannelsOfTheStandardisedErrorSquaredOrAbsolute
   EXPECT_EQ(residual::decision_loss_named("absolute"), DecisionLoss::kAbsolute);
   EXPECT_EQ(residual::decision_loss_named("squared"), DecisionLoss::kSquared);
   EXPECT_FALSE(residual::decision_loss_named("Squared").has_value());
+}
+
+// --decision-scale residual: each channel's standardised error is also
+// divided by the square root of its clean residual level on the null
+// (residual_levels), so that each channel's relative change counts alike.
+// Exact: hand-computed values, tolerance 1e-12.
+TEST(DecisionLoss, InResidualUnitsEachChannelIsDividedByItsCleanLevel) {
+  const HadynetModel m = loss_model();
+  residual::HeldOutError e;
+  e.channels = {"a", "b"};
+  e.residuals.resize(2);
+  e.residuals[0] = {Eigen::Vector2d(-2.0, 1.0)};  // a: standardised -1, 0.5
+  e.residuals[1] = {Eigen::Vector2d(4.0, -8.0)};  // b: 1, -2
+  // The null's levels (mean squared standardised residual): a 0.25, b 4.
+  Eigen::VectorXd level(2);
+  level << 0.25, 4.0;
+  const residual::ResidualLevels levels = residual::residual_levels(m.layout.y_names, level);
+  ASSERT_EQ(levels.size(), 2u);
+  using residual::DecisionLoss;
+  const residual::Segments sq = residual::standardised_loss(m, e, {"a", "b"}, DecisionLoss::kSquared, &levels);
+  const residual::Segments ab = residual::standardised_loss(m, e, {"a", "b"}, DecisionLoss::kAbsolute, &levels);
+  // Row 0: a -1/0.5 = -2, b 1/2 = 0.5; row 1: a 1, b -1.
+  EXPECT_NEAR(sq[0](0), (4.0 + 0.25) / 2, 1e-12);
+  EXPECT_NEAR(sq[0](1), (1.0 + 1.0) / 2, 1e-12);
+  EXPECT_NEAR(ab[0](0), (2.0 + 0.5) / 2, 1e-12);
+  EXPECT_NEAR(ab[0](1), (1.0 + 1.0) / 2, 1e-12);
+  // Without levels, the standard-deviation units: row 0 (1 + 1) / 2.
+  EXPECT_NEAR(residual::standardised_loss(m, e, {"a", "b"}, DecisionLoss::kSquared)[0](0), 1.0, 1e-12);
+  // A channel the levels lack is an error, not a silent unit.
+  const residual::ResidualLevels only_a{{"a", 0.25}};
+  EXPECT_THROW(residual::standardised_loss(m, e, {"b"}, DecisionLoss::kSquared, &only_a), std::logic_error);
+  // A level that is not positive takes the smallest positive one; none positive: no levels.
+  level << 0.0, 4.0;
+  EXPECT_DOUBLE_EQ(residual::residual_levels(m.layout.y_names, level).at("a"), 4.0);
+  EXPECT_TRUE(residual::residual_levels(m.layout.y_names, Eigen::VectorXd::Zero(2)).empty());
+  EXPECT_STREQ(residual::decision_scale_name(residual::DecisionScale::kStd), "std");
+  EXPECT_STREQ(residual::decision_scale_name(residual::DecisionScale::kResidual), "residual");
+  EXPECT_EQ(residual::decision_scale_named("residual"), residual::DecisionScale::kResidual);
+  EXPECT_FALSE(residual::decision_scale_named("relative").has_value());
 }
 
 // The rows fix() fine-tunes on and judges (decision_rows): the first fold and

@@ -179,6 +179,10 @@ TEST(ResidualFix, SensorDelayIsTimeAlignedAndCutsTheDelayedChannelsError) {
   const FixRun r = run_fix(logs, "sensor-delay");
   ASSERT_TRUE(fixed_as(r, EffectKind::kSensorDelay));
   EXPECT_FALSE(r.fix.candidates_floor.has_value());  // no null: the screen's absolute floors
+  // No null: the held-out tests fall back to the standard deviation's unit and say so.
+  EXPECT_EQ(r.fix.scale, DecisionScale::kStd);
+  EXPECT_NE(r.fix.scale_note.find("no calibrated null"), std::string::npos) << r.fix.scale_note;
+  EXPECT_FALSE(r.fix.own_channels.has_value());  // a delay is judged on its own channels
   // Its look-alike is said (one signature in 1-step residuals; docs/residual.md, "Open").
   EXPECT_NE(r.fix.look_alike.find("an input dead time"), std::string::npos) << r.fix.look_alike;
   const Augmentation& a = *r.fix.augmentation;
@@ -502,6 +506,17 @@ TEST(ResidualFix, ACalibrationCurveIsFittedAndCutsTheLoadcellsError) {
   const std::string& c = a.channels.front();
   expect_cut(r.fix, c, fm::kSensorCurve.winner_vs_before, fm::kSensorCurve.winner_vs_control);
   for (const auto& ch : a.channels) expect_cut(r.fix, ch, fm::kSensorCurve.family_vs_before);
+  // With the null, the held-out tests measure each channel in its clean
+  // residual's unit (--decision-scale residual, the default); a curve,
+  // judged on every channel, was also asked whether it predicts its own
+  // channels better than fine-tuning alone (the mean loss difference there
+  // is positive: it was confirmed).
+  EXPECT_EQ(r.fix.scale, DecisionScale::kResidual);
+  EXPECT_TRUE(r.fix.scale_note.empty()) << r.fix.scale_note;
+  ASSERT_TRUE(r.fix.own_channels.has_value());
+  EXPECT_GT(r.fix.own_channels->mean, 0);
+  EXPECT_FALSE(r.fix.own_channel_names.empty());
+  for (const auto& ch : r.fix.own_channel_names) EXPECT_EQ(channel_group(ch), "fc") << ch;
   expect_deployable(m);
 }
 

@@ -51,14 +51,32 @@ std::vector<int> held_out_starts(const std::vector<LogInput>& logs, double train
 
 }  // namespace
 
+ResidualLevels residual_levels(const std::vector<std::string>& y_names, const Eigen::VectorXd& residual_level) {
+  ResidualLevels out;
+  double smallest = 0;
+  for (Eigen::Index c = 0; c < residual_level.size(); ++c)
+    if (residual_level(c) > 0 && (smallest == 0 || residual_level(c) < smallest)) smallest = residual_level(c);
+  if (smallest == 0) return out;
+  for (std::size_t c = 0; c < y_names.size() && static_cast<Eigen::Index>(c) < residual_level.size(); ++c) {
+    const double level = residual_level(static_cast<Eigen::Index>(c));
+    out[y_names[c]] = level > 0 ? level : smallest;
+  }
+  return out;
+}
+
 Segments standardised_loss(const HadynetModel& model, const HeldOutError& e, const std::vector<std::string>& channels,
-                           DecisionLoss loss) {
+                           DecisionLoss loss, const ResidualLevels* levels) {
   Segments out;
   for (const auto& name : channels) {
     const int c = index_of(e.channels, name);
     const int k = index_of(model.layout.y_names, name);
     if (c < 0 || k < 0) throw std::logic_error("--fix: channel " + name + " missing from a held-out evaluation");
-    const double scale = model.norm.y.std(k);
+    double scale = model.norm.y.std(k);
+    if (levels != nullptr) {
+      const auto level = levels->find(name);
+      if (level == levels->end()) throw std::logic_error("--fix: channel " + name + " has no residual level on the null");
+      scale *= std::sqrt(level->second);
+    }
     const Segments& r = e.residuals[static_cast<std::size_t>(c)];
     if (out.empty()) out.assign(r.size(), Eigen::VectorXd());
     for (std::size_t s = 0; s < r.size(); ++s) {
@@ -78,6 +96,26 @@ const char* decision_loss_name(DecisionLoss loss) {
 std::optional<DecisionLoss> decision_loss_named(const std::string& name) {
   for (DecisionLoss loss : {DecisionLoss::kSquared, DecisionLoss::kAbsolute})
     if (name == decision_loss_name(loss)) return loss;
+  return std::nullopt;
+}
+
+const char* selection_rule_name(SelectionRule rule) {
+  return rule == SelectionRule::kScreenOrder ? "screen-order" : "every-channel";
+}
+
+std::optional<SelectionRule> selection_rule_named(const std::string& name) {
+  for (SelectionRule rule : {SelectionRule::kScreenOrder, SelectionRule::kEveryChannel})
+    if (name == selection_rule_name(rule)) return rule;
+  return std::nullopt;
+}
+
+const char* decision_scale_name(DecisionScale scale) {
+  return scale == DecisionScale::kStd ? "std" : "residual";
+}
+
+std::optional<DecisionScale> decision_scale_named(const std::string& name) {
+  for (DecisionScale scale : {DecisionScale::kStd, DecisionScale::kResidual})
+    if (name == decision_scale_name(scale)) return scale;
   return std::nullopt;
 }
 
@@ -137,6 +175,21 @@ std::optional<std::size_t> chosen_candidate(const std::vector<CandidateTrial>& c
   }
   if (!any_judged) return 0;
   return chosen;
+}
+
+std::optional<std::size_t> best_candidate(const std::vector<CandidateTrial>& candidates, double alpha) {
+  std::optional<std::size_t> significant, positive;
+  bool any_judged = false;
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    const CandidateTrial& c = candidates[k];
+    if (!c.selected_by_training_rows) continue;
+    any_judged = true;
+    if (gains_significantly(c, alpha) && (!significant || c.selection.stat > candidates[*significant].selection.stat))
+      significant = k;
+    if (c.selection.mean > 0 && (!positive || c.selection.stat > candidates[*positive].selection.stat)) positive = k;
+  }
+  if (!any_judged) return 0;
+  return significant ? significant : positive;
 }
 
 namespace {
@@ -368,6 +421,16 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   const DecisionLoss loss = options.decision_loss;  // every Diebold-Mariano test's per-row loss
   FixResult result;
   result.model = model;
+  // The channels' unit in that loss (FixOptions::decision_scale).
+  ResidualLevels null_levels;
+  if (options.decision_scale == DecisionScale::kResidual) {
+    if (attribution.null) null_levels = residual_levels(data.y_names, attribution.null->residual_level);
+    if (null_levels.empty())
+      result.scale_note = "no calibrated null: each channel's error is measured in its standard deviation (--decision-scale std)";
+    else
+      result.scale = DecisionScale::kResidual;
+  }
+  const ResidualLevels* levels = result.scale == DecisionScale::kResidual ? &null_levels : nullptr;
   const Attribution view = candidates_view(attribution, options);
   if (view.null) result.candidates_floor = view.options.min_excess_null;
   std::vector<Augmentation> planned = plan_candidates(data, view, options.candidates);
@@ -557,19 +620,24 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   if (planned.size() > 1 && can_select) {
     const Tuned control = tune(nullptr, selection_train);
     const HeldOutError control_rows = judged(control.model, selection_judged);
+    const bool every_channel = options.selection == SelectionRule::kEveryChannel;
     for (std::size_t k = 0; k < planned.size(); ++k) {
       // Re-estimated on the selection's training rows alone (the rows it is judged on stay unseen).
       const Augmentation a = refined(planned[k], selection_train, nullptr);
       const Tuned t = tune(&a, selection_train);
       const HeldOutError rows = judged(t.model, selection_judged);
       CandidateTrial& c = result.candidates[k];
-      c.selection = diebold_mariano(standardised_loss(model, control_rows, c.channels, loss),
-                                    standardised_loss(model, rows, c.channels, loss));
+      const std::vector<std::string>& judged_on = every_channel ? model.layout.y_names : c.channels;
+      c.selection = diebold_mariano(standardised_loss(model, control_rows, judged_on, loss),
+                                    standardised_loss(model, rows, judged_on, loss));
       c.selected_by_training_rows = true;
       c.description = a.description;  // as judged: re-estimated on the selection's training rows
-      if (gains_significantly(c, attribution.options.alpha)) break;  // chosen_candidate's choice: the rest are not needed
+      // chosen_candidate's choice: the rest are not needed
+      if (!every_channel && gains_significantly(c, attribution.options.alpha)) break;
     }
-    const std::optional<std::size_t> supported = chosen_candidate(result.candidates, attribution.options.alpha);
+    const std::optional<std::size_t> supported = every_channel
+                                                     ? best_candidate(result.candidates, attribution.options.alpha)
+                                                     : chosen_candidate(result.candidates, attribution.options.alpha);
     if (!supported) {
       // The clearest of them (the largest statistic), labelled as what it is.
       std::size_t best = 0;
@@ -611,8 +679,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.train_windows = after.train_windows;
   result.after = judged(after.model, held_out_part);
   result.confirmation_channels = result.candidates[chosen].channels;
-  Segments reference_loss = standardised_loss(model, reference, result.confirmation_channels, loss);
-  Segments after_loss = standardised_loss(model, result.after, result.confirmation_channels, loss);
+  Segments reference_loss = standardised_loss(model, reference, result.confirmation_channels, loss, levels);
+  Segments after_loss = standardised_loss(model, result.after, result.confirmation_channels, loss, levels);
   result.first_fold = diebold_mariano(reference_loss, after_loss);
   // The mirrored fold (FixOptions::folds 2): the same candidate and its
   // reference fine-tuned on each log's last rows, [T - split, T), and judged
@@ -629,14 +697,38 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     mirrored_after = judged(tune(&mirrored, mirrored_train).model, mirrored_judged);
     mirrored_reference = options.control ? judged(tune(nullptr, mirrored_train).model, mirrored_judged)
                                          : held_out_error(model, eval_rows(model, before_pbs, mirrored_judged));
-    for (auto& segment : standardised_loss(model, *mirrored_reference, result.confirmation_channels, loss))
+    for (auto& segment : standardised_loss(model, *mirrored_reference, result.confirmation_channels, loss, levels))
       reference_loss.push_back(std::move(segment));
-    for (auto& segment : standardised_loss(model, *mirrored_after, result.confirmation_channels, loss))
+    for (auto& segment : standardised_loss(model, *mirrored_after, result.confirmation_channels, loss, levels))
       after_loss.push_back(std::move(segment));
     result.folds = 2;
   }
   result.confirmation = diebold_mariano(reference_loss, after_loss);
-  const bool confirmed = result.confirmation.mean > 0 && result.confirmation.p_value < attribution.options.alpha;
+  bool confirmed = result.confirmation.mean > 0 && result.confirmation.p_value < attribution.options.alpha;
+  // A change judged on every channel (a calibration curve) must also predict
+  // its own channels better than the reference, on every fold judged (the
+  // mean loss difference there, no test): a curve that gains elsewhere
+  // while its own channels read worse is not their calibration
+  // (FixResult::own_channels).
+  if (result.augmentation->judged_on_every_channel) {
+    std::vector<std::string> own;
+    for (const auto& name : result.augmentation->found_on)
+      if (index_of(model.layout.y_names, name) >= 0 && std::find(own.begin(), own.end(), name) == own.end())
+        own.push_back(name);
+    if (!own.empty()) {
+      Segments reference_own = standardised_loss(model, reference, own, loss, levels);
+      Segments after_own = standardised_loss(model, result.after, own, loss, levels);
+      if (mirrored_after) {
+        for (auto& segment : standardised_loss(model, *mirrored_reference, own, loss, levels))
+          reference_own.push_back(std::move(segment));
+        for (auto& segment : standardised_loss(model, *mirrored_after, own, loss, levels))
+          after_own.push_back(std::move(segment));
+      }
+      result.own_channels = diebold_mariano(reference_own, after_own);
+      result.own_channel_names = own;
+      confirmed = confirmed && result.own_channels->mean > 0;
+    }
+  }
 
   // Another plan, re-estimated and fine-tuned as the tested candidate was,
   // on each fold the decision judged (the mirrored fold's when it did).
@@ -663,10 +755,10 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // of `a` (first fold, mirrored fold) minus that of `b`.
   const auto compare = [&](const HeldOutError& a, const std::optional<HeldOutError>& a_mirrored, const HeldOutError& b,
                            const std::optional<HeldOutError>& b_mirrored, const std::vector<std::string>& channels) {
-    Segments a_loss = standardised_loss(model, a, channels, loss), b_loss = standardised_loss(model, b, channels, loss);
+    Segments a_loss = standardised_loss(model, a, channels, loss, levels), b_loss = standardised_loss(model, b, channels, loss, levels);
     if (a_mirrored && b_mirrored) {
-      for (auto& segment : standardised_loss(model, *a_mirrored, channels, loss)) a_loss.push_back(std::move(segment));
-      for (auto& segment : standardised_loss(model, *b_mirrored, channels, loss)) b_loss.push_back(std::move(segment));
+      for (auto& segment : standardised_loss(model, *a_mirrored, channels, loss, levels)) a_loss.push_back(std::move(segment));
+      for (auto& segment : standardised_loss(model, *b_mirrored, channels, loss, levels)) b_loss.push_back(std::move(segment));
     }
     return diebold_mariano(a_loss, b_loss);
   };
@@ -821,10 +913,12 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   std::snprintf(p, sizeof p, "%.2g", result.confirmation.p_value);
   if (!confirmed) {
     const auto& a = *result.augmentation;
+    const bool own_worse = result.confirmation.mean > 0 && result.confirmation.p_value < attribution.options.alpha;
     result.status = "unexplained structure: adding " + a.effect + " (" + a.description + ") did not beat " +
                     result.reference + " on the held-out rows of " +
-                    (a.judged_on_every_channel ? "every channel" : "the channels it was found on") +
-                    " (Diebold-Mariano p " + p + ")";
+                    (own_worse ? "its own channels (it did on every channel, Diebold-Mariano p " + std::string(p) + ")"
+                               : (a.judged_on_every_channel ? "every channel" : "the channels it was found on") +
+                                     std::string(" (Diebold-Mariano p ") + p + ")");
     return result;
   }
   result.model = std::move(after.model);
