@@ -197,9 +197,19 @@
 # them: 2110-2119 (--decision-loss absolute) and 2145-2154 (squared) every
 # effect at its larger strength and crosstalk=0.2; 2145-2154's cross-talk
 # cases again with stop 59's binary (the winner's pair alone, squared),
-# for a comparison on the same logs. Next unused: 2190 on
-# (2120-2139 and 2155-2174 are clean sets, 2175-2179 two effects,
-# 2180-2189 the gain wobble).
+# for a comparison on the same logs (2120-2139 and 2155-2174 are clean
+# sets, 2175-2179 two effects, 2180-2189 the gain wobble).
+# Stop 61 (--decision-scale, --fix-selection): development: 2145-2154
+# every effect at its larger strength and crosstalk=0.2 (the residual's
+# unit everywhere, then with every-channel selection; both with the same
+# logs as stop 60's measurement), and 2145-2154 again with the final code
+# for a comparison on the same logs. 2190-2199 measured the rejected
+# combination (the residual's unit in the selection too, every-channel
+# selection) before the suite's injected effects rejected it; the final
+# code (the residual's unit in the held-out tests only, the curve's own
+# channels, screen-order selection) measured on 2240-2249, nothing chosen
+# on them (2250-2269 clean sets, 2270-2279 the gain wobble, 2280-2284 two
+# effects). Next unused: 2285 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

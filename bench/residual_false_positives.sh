@@ -95,8 +95,11 @@
 # (it did). Stop 60: 2120-2139 measured with --decision-loss absolute (2 of
 # 20: 2121, 2126), then development (2121, 2126 and 2065 for a knot rule
 # not kept) and the choice of the squared loss as the default again;
-# 2155-2174 measured with the squared loss (0 of 20). Next unused seed:
-# 2190 (bench/residual_detection.sh lists stop 60's other seeds).
+# 2155-2174 measured with the squared loss (0 of 20). Stop 61: 2121,
+# 2126 and 2155-2164 development of --decision-scale residual and
+# --fix-selection every-channel; 2250-2269 measured with the final code
+# (the residual's unit in the held-out tests). Next unused seed: 2285
+# (bench/residual_detection.sh lists stop 61's other seeds).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

@@ -45,7 +45,8 @@
 # then development: the squared loss and a decision-only variant re-run
 # on the same logs (docs/residual.md, "The decision's loss"). Stop 60:
 # 2175-2179 (the cross-talk group's pairs, --decision-loss squared: both
-# named in 15 of 20).
+# named in 15 of 20). Stop 61: 2280-2284 (the residual's unit in the
+# held-out tests).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]... [--decision-loss L] [--decision-scale S] [--fix-selection R]
