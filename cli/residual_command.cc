@@ -149,11 +149,16 @@ void print_fix(const rs::FixResult& fixed) {
     for (const auto& c : fixed.confirmation_channels) std::printf(" %s", c.c_str());
     std::printf(": Diebold-Mariano p %.2g", fixed.confirmation.p_value);
     if (fixed.folds > 1) std::printf(" (%d folds; the first alone: p %.2g)", fixed.folds, fixed.first_fold.p_value);
+    std::printf(", each channel in %s", fixed.scale == rs::DecisionScale::kResidual ? "its clean residual level"
+                                                                                     : "its standard deviation");
+    if (fixed.own_channels)
+      std::printf("; on its own channels mean loss difference %.3g", fixed.own_channels->mean);
     std::printf(": %s\n", fixed.changed ? "confirmed" : "not confirmed, nothing applied");
     if (fixed.simpler) std::printf("%s\n", simpler_sentence(*fixed.simpler, fixed.reference).c_str());
     for (const auto& wider : fixed.extensions) std::printf("%s\n", extension_sentence(wider).c_str());
     if (replaced_after_decision(fixed)) std::printf("the before/after above are the plan applied last\n");
     if (!fixed.folds_note.empty()) std::printf("note: %s\n", fixed.folds_note.c_str());
+    if (!fixed.scale_note.empty()) std::printf("note: %s\n", fixed.scale_note.c_str());
   }
   // The selection's candidates, also when it tested none (no gain, no decision).
   if (fixed.candidates.size() > 1 && (fixed.tried || fixed.none_gained)) {
