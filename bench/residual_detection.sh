@@ -210,7 +210,8 @@
 # channels, screen-order selection) measured on 2240-2249, nothing chosen
 # on them (2250-2269 clean sets, 2270-2279 the gain wobble, 2280-2284 two
 # effects), and on 2285-2294 every effect at its smaller strength but
-# cross-talk (measured at 0.2 on 2240-2249). Next unused: 2295 on.
+# cross-talk (measured at 0.2 on 2240-2249); 2295-2314 clean sets. Next
+# unused: 2315 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...
