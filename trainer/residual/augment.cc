@@ -705,30 +705,6 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   }
   result.confirmation = diebold_mariano(reference_loss, after_loss);
   bool confirmed = result.confirmation.mean > 0 && result.confirmation.p_value < attribution.options.alpha;
-  // A change judged on every channel (a calibration curve) must also predict
-  // its own channels better than the reference, on every fold judged (the
-  // mean loss difference there, no test): a curve that gains elsewhere
-  // while its own channels read worse is not their calibration
-  // (FixResult::own_channels).
-  if (result.augmentation->judged_on_every_channel) {
-    std::vector<std::string> own;
-    for (const auto& name : result.augmentation->found_on)
-      if (index_of(model.layout.y_names, name) >= 0 && std::find(own.begin(), own.end(), name) == own.end())
-        own.push_back(name);
-    if (!own.empty()) {
-      Segments reference_own = standardised_loss(model, reference, own, loss, levels);
-      Segments after_own = standardised_loss(model, result.after, own, loss, levels);
-      if (mirrored_after) {
-        for (auto& segment : standardised_loss(model, *mirrored_reference, own, loss, levels))
-          reference_own.push_back(std::move(segment));
-        for (auto& segment : standardised_loss(model, *mirrored_after, own, loss, levels))
-          after_own.push_back(std::move(segment));
-      }
-      result.own_channels = diebold_mariano(reference_own, after_own);
-      result.own_channel_names = own;
-      confirmed = confirmed && result.own_channels->mean > 0;
-    }
-  }
 
   // Another plan, re-estimated and fine-tuned as the tested candidate was,
   // on each fold the decision judged (the mirrored fold's when it did).
@@ -755,16 +731,35 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // of `a` (first fold, mirrored fold) minus that of `b`.
   const auto compare = [&](const HeldOutError& a, const std::optional<HeldOutError>& a_mirrored, const HeldOutError& b,
                            const std::optional<HeldOutError>& b_mirrored, const std::vector<std::string>& channels) {
-    Segments a_loss = standardised_loss(model, a, channels, loss, levels), b_loss = standardised_loss(model, b, channels, loss, levels);
+    Segments a_loss = standardised_loss(model, a, channels, loss, levels);
+    Segments b_loss = standardised_loss(model, b, channels, loss, levels);
     if (a_mirrored && b_mirrored) {
-      for (auto& segment : standardised_loss(model, *a_mirrored, channels, loss, levels)) a_loss.push_back(std::move(segment));
-      for (auto& segment : standardised_loss(model, *b_mirrored, channels, loss, levels)) b_loss.push_back(std::move(segment));
+      for (auto& segment : standardised_loss(model, *a_mirrored, channels, loss, levels))
+        a_loss.push_back(std::move(segment));
+      for (auto& segment : standardised_loss(model, *b_mirrored, channels, loss, levels))
+        b_loss.push_back(std::move(segment));
     }
     return diebold_mariano(a_loss, b_loss);
   };
   const auto significant = [&](const DieboldMariano& t) {
     return t.mean > 0 && t.p_value < attribution.options.alpha;
   };
+  // A change judged on every channel (a calibration curve) must also predict
+  // its own channels better than the reference, on every fold judged (the
+  // mean loss difference there, no test): a curve that gains elsewhere
+  // while its own channels read worse is not their calibration
+  // (FixResult::own_channels).
+  if (result.augmentation->judged_on_every_channel) {
+    std::vector<std::string> own;
+    for (const auto& name : result.augmentation->found_on)
+      if (index_of(model.layout.y_names, name) >= 0 && std::find(own.begin(), own.end(), name) == own.end())
+        own.push_back(name);
+    if (!own.empty()) {
+      result.own_channels = compare(reference, mirrored_reference, result.after, mirrored_after, own);
+      result.own_channel_names = own;
+      confirmed = confirmed && result.own_channels->mean > 0;
+    }
+  }
   // The trial's plan becomes the applied one.
   const auto apply = [&](FoldTrial& t) {
     result.augmentation = t.tested;

@@ -75,7 +75,8 @@ const char* decision_loss_name(DecisionLoss loss);  // "squared" or "absolute"
 // The loss decision_loss_name() names `name`; none for any other text.
 std::optional<DecisionLoss> decision_loss_named(const std::string& name);
 // The unit each channel's error is measured in before the mean over the
-// judged channels (--decision-scale):
+// judged channels, in the held-out tests (--decision-scale; the selection
+// and the drift probe use kStd):
 //   kStd:      the model's standard deviation of the channel (model.norm.y):
 //              channels the network predicts worse weigh more;
 //   kResidual: that times the square root of the channel's clean 1-step
