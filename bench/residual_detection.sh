@@ -210,8 +210,15 @@
 # channels, screen-order selection) measured on 2240-2249, nothing chosen
 # on them (2250-2269 clean sets, 2270-2279 the gain wobble, 2280-2284 two
 # effects), and on 2285-2294 every effect at its smaller strength but
-# cross-talk (measured at 0.2 on 2240-2249); 2295-2314 clean sets. Next
-# unused: 2315 on.
+# cross-talk (measured at 0.2 on 2240-2249); 2295-2314 clean sets.
+# Stop 62 (a cross-talk between groups a candidate of its own; an earlier
+# round's candidates, which only --rounds uses): development: stop 61's
+# tension-leak set 2242 (and its two-effect sets 2281-2283); measured with
+# the final code, nothing chosen on them: 2320-2329 every effect at its
+# larger strength and crosstalk=0.2 (and those logs' changed runs with stop
+# 61's binary), 2330-2349 clean sets, 2350-2354 two effects, 2355-2364 the
+# gain wobble (2315-2319: two effects with the earlier round's candidates
+# alone). Next unused: 2365 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

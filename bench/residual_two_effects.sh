@@ -46,7 +46,12 @@
 # on the same logs (docs/residual.md, "The decision's loss"). Stop 60:
 # 2175-2179 (the cross-talk group's pairs, --decision-loss squared: both
 # named in 15 of 20). Stop 61: 2280-2284 (the residual's unit in the
-# held-out tests).
+# held-out tests). Stop 62 (an earlier round's candidates, a cross-talk
+# between groups a candidate of its own): development on stop 61's
+# 2281-2283 (the sensor delay with friction) and 2281 (the dead time with
+# the rail); 2315-2319 measured the earlier round's candidates alone
+# (12 of 20; stop 61's code on the same logs 10), 2350-2354 the final
+# code, nothing chosen on either.
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]... [--decision-loss L] [--decision-scale S] [--fix-selection R]

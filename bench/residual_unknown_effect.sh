@@ -44,7 +44,8 @@
 # 1955) and 1977-1986 (stop 58, the final code); 2075-2084 (stop 59,
 # --decision-loss absolute); 2180-2189 (stop 60: the cross-talk group's
 # pairs, the squared loss; 0 of 10 confirmed); 2270-2279 (stop 61: the
-# residual's unit in the held-out tests).
+# residual's unit in the held-out tests); 2355-2364 (stop 62: a cross-talk
+# between groups a candidate of its own).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--fix-selection R]

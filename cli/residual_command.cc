@@ -168,6 +168,7 @@ void print_fix(const rs::FixResult& fixed) {
       std::printf("  %c %-74.74s", c.chosen ? '*' : ' ', (c.effect + ": " + c.description).c_str());
       if (c.below_screen_floor) std::printf(" below the screen's floor (%.2g);", c.screen_statistic);
       if (c.from_drift_probe) std::printf(" the drift probe's;");
+      if (c.from_earlier_round) std::printf(" an earlier round's;");
       if (c.selected_by_training_rows)
         std::printf(" training rows: DM %.2f, p %.2g\n", c.selection.stat, c.selection.p_value);
       else std::printf(" not judged\n");
@@ -498,6 +499,11 @@ int run_residual(int argc, char** argv) {
     std::string current_what;  // what `current` is from round 2 on, in words
     int confirmed_rounds = 0;
     std::vector<std::string> confirmed_effects;
+    // The next round also tries what the rounds before proposed and did not
+    // apply (FixOptions::earlier_candidates), of no effect confirmed yet.
+    std::vector<std::string> confirmed_kinds;
+    std::vector<rs::Augmentation> earlier_candidates;
+    fo.earlier_candidates = &earlier_candidates;
     const int round_count = opt.has("fix") ? static_cast<int>(*rounds) : 1;
     json first_json;
     for (int round = 1; round <= round_count; ++round) {
@@ -538,6 +544,8 @@ int run_residual(int argc, char** argv) {
       if (round == 1) first_json = j;
       else rounds_json.push_back(j);
       if (!fixed || !fixed->changed) break;
+      confirmed_kinds.push_back(fixed->augmentation->effect);
+      earlier_candidates = rs::earlier_candidates_for_next_round(*fixed, confirmed_kinds);
       // Without a control the next round's reference is its own input model:
       // it must be the fine-tuned one (else fine-tuning alone would count as the fix's gain).
       const bool untuned = fo.control && fixed->augmentation->carried_before_tuning();

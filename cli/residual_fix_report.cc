@@ -134,6 +134,7 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                             {"screen_statistic", c.screen_statistic},
                             {"below_screen_floor", c.below_screen_floor},
                             {"from_drift_probe", c.from_drift_probe},
+                            {"from_earlier_round", c.from_earlier_round},
                             {"selected_by_training_rows", c.selected_by_training_rows},
                             {"selection_statistic", c.selection.stat},
                             {"selection_p_value", c.selection.p_value},

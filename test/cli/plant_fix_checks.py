@@ -1,5 +1,6 @@
 """Checks shared by the CLI tests of `hadynet residual --fix` on plant logs
-(residual_plant_delay_test.sh, residual_rail_simpler_test.sh).
+(residual_plant_delay_test.sh, residual_rail_simpler_test.sh,
+residual_leak_between_groups_test.sh).
 
 lead_and_loadcells(fix, check): issue 12's bar on the fix's lead channel
 (the first of the applied plan's channels: held-out RMSE cut by 30 % and
@@ -23,3 +24,24 @@ def lead_and_loadcells(fix, check):
     total_after, total_control = sum(after[c] for c in fc), sum(control[c] for c in fc)
     print(f"summed loadcell RMSE: fixed {total_after:.4g}, fine-tuning alone {total_control:.4g}")
     check(total_after < total_control, "the loadcells as a whole not below fine-tuning alone")
+
+
+def checked_fix(json_path):
+    """The JSON file's "fix" object, its augmentation ({} when none) and
+    (check, finish): check(ok, what) records a failure; finish() prints
+    every failure and exits 1 when there is one, else 0."""
+    import json
+    import sys
+    fix = json.load(open(json_path))["fix"]
+    failures = []
+
+    def check(ok, what):
+        if not ok:
+            failures.append(what)
+
+    def finish():
+        for f in failures:
+            print("FAIL:", f)
+        sys.exit(1 if failures else 0)
+
+    return fix, fix.get("augmentation") or {}, check, finish

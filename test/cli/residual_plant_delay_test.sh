@@ -22,25 +22,15 @@
 set -uo pipefail
 hadynet=$1 model=$2 work=$3
 here=$(cd "$(dirname "$0")/../.." && pwd)
-rm -rf "$work" && mkdir -p "$work/logs" || exit 2
-source "$here/bench/residual_grasps.sh"
-RESIDUAL_ROWS=300 collect_residual_grasps "$hadynet" "$work/raw" 1583 --effect sensor-delay=2 || { echo "FAIL: collect"; exit 1; }
-find "$work/raw" -name "*.csv" -exec cp {} "$work/logs/" \;
-[[ $(ls "$work/logs" | wc -l) -eq 4 ]] || { echo "FAIL: not the four grasps' logs"; exit 1; }
-"$hadynet" residual "$model" "$work/logs" --rated-range fc=0..50 --rated-range f=0..200 --fix \
-  --json "$work/residual.json" >"$work/out.txt" 2>&1 || { echo "FAIL: residual"; tail -5 "$work/out.txt"; exit 1; }
+source "$here/test/cli/plant_fix_run.sh"
+plant_fix_run "$hadynet" "$model" "$work" 1583 -- --effect sensor-delay=2 || exit 1
 grep -E "^(decision|Extension)" "$work/out.txt"
 python3 - "$work/residual.json" "$here/test/cli" <<'PY'
-import json, sys
+import sys
 sys.path.insert(0, sys.argv[2])
-from plant_fix_checks import lead_and_loadcells
-fix = json.load(open(sys.argv[1]))["fix"]
-aug = fix.get("augmentation") or {}
+from plant_fix_checks import checked_fix, lead_and_loadcells
+fix, aug, check, finish = checked_fix(sys.argv[1])
 channels = aug.get("channels", [])
-failures = []
-def check(ok, what):
-    if not ok:
-        failures.append(what)
 check(bool(fix.get("changed")), "nothing confirmed: " + fix.get("status", "")[:120])
 check(aug.get("effect") == "sensor-delay" and aug.get("delay_steps") == 2, "not a 2-step sensor delay: " + aug.get("effect", "-"))
 print("aligned:", channels)
@@ -54,7 +44,5 @@ for e in extensions or []:
 family_alone_first = bool(extensions) and extensions[0]["what"].startswith("its group's channels")
 check(not family_alone_first or extensions[0]["applied"], "the family alone was not extended to its group")
 lead_and_loadcells(fix, check)
-for f in failures:
-    print("FAIL:", f)
-sys.exit(1 if failures else 0)
+finish()
 PY

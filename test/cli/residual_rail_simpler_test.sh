@@ -22,25 +22,15 @@
 set -uo pipefail
 hadynet=$1 model=$2 work=$3
 here=$(cd "$(dirname "$0")/../.." && pwd)
-rm -rf "$work" && mkdir -p "$work/logs" || exit 2
-source "$here/bench/residual_grasps.sh"
-RESIDUAL_ROWS=300 collect_residual_grasps "$hadynet" "$work/raw" 1595 --effect saturation=2 || { echo "FAIL: collect"; exit 1; }
-find "$work/raw" -name "*.csv" -exec cp {} "$work/logs/" \;
-[[ $(ls "$work/logs" | wc -l) -eq 4 ]] || { echo "FAIL: not the four grasps' logs"; exit 1; }
-"$hadynet" residual "$model" "$work/logs" --rated-range fc=0..50 --rated-range f=0..200 --fix \
-  --json "$work/residual.json" >"$work/out.txt" 2>&1 || { echo "FAIL: residual"; tail -5 "$work/out.txt"; exit 1; }
+source "$here/test/cli/plant_fix_run.sh"
+plant_fix_run "$hadynet" "$model" "$work" 1595 -- --effect saturation=2 || exit 1
 grep -E "^(fix|decision|Simpler|Extension)" "$work/out.txt"
 python3 - "$work/residual.json" "$here/bench" "$here/test/cli" <<'PY'
-import json, sys
+import sys
 sys.path[:0] = sys.argv[2:4]
 from residual_named import names
-from plant_fix_checks import lead_and_loadcells
-fix = json.load(open(sys.argv[1]))["fix"]
-aug = fix.get("augmentation") or {}
-failures = []
-def check(ok, what):
-    if not ok:
-        failures.append(what)
+from plant_fix_checks import checked_fix, lead_and_loadcells
+fix, aug, check, finish = checked_fix(sys.argv[1])
 check(bool(fix.get("changed")), "nothing confirmed: " + fix.get("status", "")[:120])
 check(names("saturation", 2.0, fix), "not the 2 N rail: " + aug.get("effect", "-") + ": " + aug.get("description", "")[:100])
 chosen = [c for c in fix.get("candidates", []) if c.get("chosen")]
@@ -53,7 +43,5 @@ if simpler:
           f"p {simpler['against_reference']['p_value']:.2g} against fine-tuning alone, "
           f"the curve's gain p {g.get('p_value', float('nan')):.2g}, applied {simpler['applied']}")
 lead_and_loadcells(fix, check)
-for f in failures:
-    print("FAIL:", f)
-sys.exit(1 if failures else 0)
+finish()
 PY

@@ -562,6 +562,58 @@ TEST(FixCandidates, ASimplerAccountBelowTheFloorKeepsTheLeadsGroupAndSide) {
 // never above the screen's floor; unset, the screen's; without a null the
 // absolute floors. Three drift hypotheses, significant but for the floor,
 // with shares 5, 2 and 0.5.
+// The plans the next round of --rounds also tries
+// (earlier_candidates_for_next_round): a round's plans it did not apply, in
+// order, but none of an effect confirmed in any round (the chosen one's
+// included: a confirmed curve replaced by its simpler rail keeps no other
+// curve), none that cannot be added, and none that is the confirmed
+// change's other account of the same residual (friction's simpler curve
+// on a channel friction was found on; a curve elsewhere stays).
+TEST(FixCandidates, TheNextRoundTriesWhatThisRoundDidNotApply) {
+  using residual::EffectKind;
+  const auto plan = [](EffectKind kind, const std::string& effect, std::vector<std::string> channels) {
+    residual::Augmentation a;
+    a.kind = kind;
+    a.effect = effect;
+    a.channels = std::move(channels);
+    a.found_on = a.channels;
+    return a;
+  };
+  residual::FixResult fixed;
+  fixed.candidate_plans = {plan(EffectKind::kFriction, "friction", {"f1", "f0", "f2"}),
+                           plan(EffectKind::kSensorCurve, "sensor-curve", {"f0", "f5"}),
+                           plan(EffectKind::kSensorDelay, "sensor-delay", {"fc3", "fc4", "fc1"}),
+                           plan(EffectKind::kSensorDelay, "sensor-delay", {"fc3"}),
+                           plan(EffectKind::kSensorCurve, "sensor-curve", {"fc3", "fc4"}),
+                           plan(EffectKind::kFriction, "friction", {"f1"}),
+                           plan(EffectKind::kSaturation, "saturation", {"fc2"})};
+  fixed.candidate_plans.back().not_fixable = "nothing to clip";
+  fixed.candidates.resize(fixed.candidate_plans.size());
+  for (std::size_t k = 0; k < fixed.candidates.size(); ++k)
+    fixed.candidates[k].effect = fixed.candidate_plans[k].effect;
+  fixed.candidates[0].chosen = true;
+  fixed.augmentation = fixed.candidate_plans[0];
+  const auto next = [&](const std::vector<std::string>& confirmed) {
+    std::vector<std::vector<std::string>> out;
+    for (const auto& a : residual::earlier_candidates_for_next_round(fixed, confirmed)) out.push_back(a.channels);
+    return out;
+  };
+  using Channels = std::vector<std::vector<std::string>>;
+  EXPECT_EQ(next({"friction"}), (Channels{{"fc3", "fc4", "fc1"}, {"fc3"}, {"fc3", "fc4"}}));
+  // An earlier round confirmed a sensor delay: no delay again.
+  EXPECT_EQ(next({"sensor-delay", "friction"}), (Channels{{"fc3", "fc4"}}));
+  // The chosen candidate was a curve and its simpler rail was applied: no curve
+  // is carried; the rail's other account (a curve) is on fc2 only.
+  fixed.candidates[0].chosen = false;
+  fixed.candidates[4].chosen = true;
+  fixed.augmentation = plan(EffectKind::kSaturation, "saturation", {"fc3"});
+  EXPECT_EQ(next({"saturation"}), (Channels{{"f1", "f0", "f2"}, {"fc3", "fc4", "fc1"}, {"fc3"}, {"f1"}}));
+  // Nothing confirmed has nothing to carry beyond what was not chosen.
+  fixed.augmentation.reset();
+  fixed.candidates[4].chosen = false;
+  EXPECT_EQ(next({}).size(), 6u);
+}
+
 TEST(FixCandidates, ByDefaultTheyReachDownToAShareOfOne) {
   residual::Attribution screen;
   screen.null = residual::NullCalibration{};

@@ -110,13 +110,18 @@ void expect_every_sensor_delay_is_a_dead_time(const Outcome& o) {
 }
 
 // At most one of --fix's candidates per effect, besides a plan on its
-// family alone right after the same plan extended to its group.
+// family alone right after the same plan extended to its group; a
+// cross-talk once within a group and once between groups (two mechanisms,
+// plan_candidates).
 void expect_one_candidate_per_effect(const std::vector<Augmentation>& candidates) {
-  std::set<EffectKind> kinds;
+  std::set<std::pair<EffectKind, bool>> classes;
   for (std::size_t k = 0; k < candidates.size(); ++k) {
     const Augmentation& a = candidates[k];
-    EXPECT_TRUE(kinds.insert(a.kind).second || is_family_alone(candidates, k))
-        << "a second " << a.effect << ": " << a.description;
+    const auto* removal = std::get_if<CrosstalkRemoval>(&a.change);
+    const bool between = removal != nullptr && !removal->pairs.empty() &&
+                         channel_group(removal->pairs.front().target) != channel_group(removal->pairs.front().source);
+    EXPECT_TRUE(classes.insert({a.kind, between}).second || is_family_alone(candidates, k))
+        << "a second " << a.effect << (between ? " between groups" : "") << ": " << a.description;
   }
 }
 

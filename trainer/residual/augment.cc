@@ -226,7 +226,33 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   // delay, is skipped and said (why_not_fixable); a sensor delay that shows
   // on other groups too is planned as the commands' dead time.
   std::string winner_not_fixable;
-  std::vector<EffectKind> leads;
+  // A candidate's class: its effect, and for a cross-talk whether its source
+  // is in another group than its target. Between groups it is a mechanical
+  // path (a tendon into a palm loadcell), planned as its pair alone; within
+  // one it is a sensor array's neighbours, planned with the group's pairs:
+  // two mechanisms, a candidate each. With one per effect, the model's own
+  // misfit between neighbouring fingertips (fc2 -> fc1, gain 0.50) took
+  // cross-talk's one place on the tension leak's set 2242, where the
+  // plant's f5 -> fc6 ranked fourth at gain 0.165 and was never tried
+  // (docs/residual.md, "A cross-talk between groups is its own candidate").
+  struct PlanClass {
+    EffectKind kind;
+    bool between_groups;
+    bool operator==(const PlanClass&) const = default;
+  };
+  const auto class_of_lead = [&](const HypothesisResult& r) {
+    const bool crosstalk = r.hypothesis.kind == EffectKind::kCrosstalk;
+    const std::string& target = data.y_names[static_cast<std::size_t>(r.hypothesis.target)];
+    return PlanClass{r.hypothesis.kind,
+                     crosstalk && channel_group(target) != channel_group(source_name(r.hypothesis, data))};
+  };
+  const auto class_of_plan = [](const Augmentation& a) {
+    const auto* removal = std::get_if<CrosstalkRemoval>(&a.change);
+    const bool between = a.kind == EffectKind::kCrosstalk && removal != nullptr && !removal->pairs.empty() &&
+                         channel_group(removal->pairs.front().target) != channel_group(removal->pairs.front().source);
+    return PlanClass{a.kind, between};
+  };
+  std::vector<PlanClass> leads;
   const auto plan_of = [&](const HypothesisResult& r, bool group_extension) {
     return planned_for(data, attribution, r, group_extension);
   };
@@ -235,28 +261,29 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
     const std::string why = why_not_fixable(data, attribution, r);
     if (r.label == winner->label) winner_not_fixable = why;
     if (!why.empty()) continue;
-    // One candidate per effect: by the effect of the hypothesis that led to
-    // a candidate, and by the effect planned (a sensor delay that shows on
-    // other groups plans a dead time: effects.cc). A lead whose plan repeats
-    // an effect already planned counts as having led.
-    const auto planned = [&](EffectKind kind) {
-      return std::any_of(out.begin(), out.end(), [&](const Augmentation& b) { return b.kind == kind; });
+    // One candidate per class (PlanClass): by the class of the hypothesis
+    // that led to a candidate, and by the class planned (a sensor delay that
+    // shows on other groups plans a dead time: effects.cc). A lead whose plan
+    // repeats a class already planned counts as having led.
+    const auto planned = [&](const PlanClass& c) {
+      return std::any_of(out.begin(), out.end(), [&](const Augmentation& b) { return class_of_plan(b) == c; });
     };
-    if (planned(r.hypothesis.kind) || std::find(leads.begin(), leads.end(), r.hypothesis.kind) != leads.end()) continue;
+    const PlanClass lead = class_of_lead(r);
+    if (planned(lead) || std::find(leads.begin(), leads.end(), lead) != leads.end()) continue;
     Augmentation a = plan_of(r, true);
     if (!a.not_fixable.empty()) {  // the plan found nothing to add (a curve without two distinct levels)
       if (r.label == winner->label) winner_not_fixable = a.not_fixable;
       continue;
     }
-    if (planned(a.kind)) {
-      leads.push_back(r.hypothesis.kind);
+    if (planned(class_of_plan(a))) {
+      leads.push_back(lead);
       continue;
     }
     if (out.empty() && r.label != winner->label)
       a.description = "the winner (" + winner->effect + ": " + winner->label + ") is not added (" +
                       winner_not_fixable + "); the best significant effect that can be: " + r.label + "; " +
                       a.description;
-    leads.push_back(r.hypothesis.kind);
+    leads.push_back(lead);
     const bool extended = !a.extended_channels.empty();
     out.push_back(std::move(a));
     if (!extended || static_cast<int>(out.size()) >= count) continue;
@@ -290,6 +317,32 @@ bool flat_end_at_rail(const Augmentation& confirmed, const Augmentation& rail) {
 }
 
 }  // namespace
+
+std::vector<Augmentation> earlier_candidates_for_next_round(const FixResult& fixed,
+                                                            const std::vector<std::string>& confirmed) {
+  std::vector<std::string> applied = confirmed;
+  for (std::size_t k = 0; k < fixed.candidates.size(); ++k)
+    if (fixed.candidates[k].chosen) applied.push_back(fixed.candidates[k].effect);
+  // The confirmed change's other account of the same residual: a plan of
+  // its simpler effect, or of the effect it is the simpler account of,
+  // that shares a channel with it.
+  const auto other_account = [&](const Augmentation& a) {
+    if (!fixed.augmentation) return false;
+    const Augmentation& c = *fixed.augmentation;
+    if (effect_info(c.kind).simpler != a.kind && effect_info(a.kind).simpler != c.kind) return false;
+    const auto shared = [&](const std::string& name) {
+      return std::find(c.found_on.begin(), c.found_on.end(), name) != c.found_on.end() ||
+             std::find(c.channels.begin(), c.channels.end(), name) != c.channels.end();
+    };
+    return std::any_of(a.channels.begin(), a.channels.end(), shared);
+  };
+  std::vector<Augmentation> out;
+  for (const Augmentation& a : fixed.candidate_plans)
+    if (a.not_fixable.empty() && std::find(applied.begin(), applied.end(), a.effect) == applied.end() &&
+        !other_account(a))
+      out.push_back(a);
+  return out;
+}
 
 bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k) {
   return k > 0 && k < planned.size() && !planned[k].group_extension && planned[k - 1].kind == planned[k].kind &&
@@ -434,10 +487,23 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   const Attribution view = candidates_view(attribution, options);
   if (view.null) result.candidates_floor = view.options.min_excess_null;
   std::vector<Augmentation> planned = plan_candidates(data, view, options.candidates);
+  // An earlier round's plans (FixOptions::earlier_candidates), tried after
+  // this round's: none this round's screen plans too (kind and channels).
+  std::vector<Augmentation> earlier;
+  if (options.earlier_candidates != nullptr) {
+    for (const Augmentation& a : *options.earlier_candidates) {
+      if (static_cast<int>(earlier.size()) >= options.candidates) break;
+      const bool planned_now = std::any_of(planned.begin(), planned.end(), [&](const Augmentation& p) {
+        return p.kind == a.kind && p.channels == a.channels;
+      });
+      if (a.not_fixable.empty() && !planned_now) earlier.push_back(a);
+    }
+  }
   // Rows a sensor delay costs at the end of each log, before or after: the
   // largest over every candidate, so that all are judged on the same rows.
   int d = model.sensor.max_delay();
   for (const auto& a : planned) d = std::max(d, sensor_after(model.sensor, a).max_delay());
+  for (const auto& a : earlier) d = std::max(d, sensor_after(model.sensor, a).max_delay());
 
   // The rows each model is fine-tuned on and judged on (decision_rows):
   // the first fold's held-out rows are the same for every model reported.
@@ -560,6 +626,14 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       }
     }
   }
+  // The earlier round's plans after this round's (a winner of this round
+  // that cannot be added gives way to them).
+  std::size_t first_earlier = planned.size();
+  if (!earlier.empty()) {
+    if (!planned.empty() && !planned.front().not_fixable.empty()) planned.clear();
+    first_earlier = planned.size();
+    planned.insert(planned.end(), earlier.begin(), earlier.end());
+  }
   if (planned.empty()) {
     result.status = "no significant effect";
     return result;
@@ -613,10 +687,12 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     c.channels = channels_of(planned[k]);
     c.screen_statistic = planned[k].screen_statistic;
     c.from_drift_probe = probed && *probed == k;
-    c.below_screen_floor =
-        !c.from_drift_probe && attribution.null && c.screen_statistic < attribution.options.min_excess_null;
+    c.from_earlier_round = k >= first_earlier;
+    c.below_screen_floor = !c.from_drift_probe && !c.from_earlier_round && attribution.null &&
+                           c.screen_statistic < attribution.options.min_excess_null;
     result.candidates.push_back(std::move(c));
   }
+  result.candidate_plans = planned;
   if (planned.size() > 1 && can_select) {
     const Tuned control = tune(nullptr, selection_train);
     const HeldOutError control_rows = judged(control.model, selection_judged);
