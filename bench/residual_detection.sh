@@ -218,7 +218,10 @@
 # larger strength and crosstalk=0.2 (and those logs' changed runs with stop
 # 61's binary), 2330-2349 clean sets, 2350-2354 two effects, 2355-2364 the
 # gain wobble (2315-2319: two effects with the earlier round's candidates
-# alone). Next unused: 2365 on.
+# alone); 2320-2329's curve sets then developed one curve for the whole
+# group (not kept), and 2365-2374 measured it and the final code on the
+# same logs (every effect at its larger strength and crosstalk=0.2). Next
+# unused: 2375 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...
