@@ -239,8 +239,9 @@ int run_residual(int argc, char** argv) {
             "with --fix: repeat analysis and fix until nothing is confirmed, at most N rounds (so that two\n"
             "effects at once are both found); the next round analyses the confirmed change on the network\n"
             "before fine-tuning when the change alone describes the effect (sensor changes, an input dead\n"
-            "time), else the fine-tuned model; the reference logs are read through the sensors they were\n"
-            "recorded with in every round; round k > 1 reports into DIR/round-k", "1");
+            "time), else the fine-tuned model, and also tries the candidates the rounds before proposed\n"
+            "and did not apply; the reference logs are read through the sensors they were recorded with\n"
+            "in every round; round k > 1 reports into DIR/round-k", "1");
   opt.value("out", "FILE", "with --fix: write the augmented model of the last confirmed round (only when\n"
                            "something was fixed)");
   opt.value("fix-epochs", "N", "with --fix: fine-tuning epochs", "20");
