@@ -220,8 +220,9 @@
 # gain wobble (2315-2319: two effects with the earlier round's candidates
 # alone); 2320-2329's curve sets then developed one curve for the whole
 # group (not kept), and 2365-2374 measured it and the final code on the
-# same logs (every effect at its larger strength and crosstalk=0.2). Next
-# unused: 2375 on.
+# same logs (every effect at its larger strength and crosstalk=0.2);
+# 2375-2384 every effect at its smaller strength but cross-talk. Next
+# unused: 2385 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...
