@@ -221,8 +221,9 @@
 # alone); 2320-2329's curve sets then developed one curve for the whole
 # group (not kept), and 2365-2374 measured it and the final code on the
 # same logs (every effect at its larger strength and crosstalk=0.2);
-# 2375-2384 every effect at its smaller strength but cross-talk. Next
-# unused: 2385 on.
+# 2375-2384 every effect at its smaller strength but cross-talk;
+# 2385-2404 clean sets and 2405-2409 two effects, the final code. Next
+# unused: 2410 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

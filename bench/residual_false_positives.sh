@@ -99,9 +99,10 @@
 # 2126 and 2155-2164 development of --decision-scale residual and
 # --fix-selection every-channel; 2250-2269 measured with the final code
 # (the residual's unit in the held-out tests), and 2295-2314 with it
-# too (0 of 40 in all). Stop 62: 2330-2349 measured with its final code
-# (a cross-talk between groups a candidate of its own; 0 of 20). Next
-# unused seed: 2385 (bench/residual_detection.sh lists the other seeds).
+# too (0 of 40 in all). Stop 62: 2330-2349 and 2385-2404 measured with
+# its final code (a cross-talk between groups a candidate of its own; 0 of
+# 40). Next unused seed: 2410 (bench/residual_detection.sh lists the
+# other seeds).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
