@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <cstdio>
 #include <stdexcept>
 
@@ -89,14 +90,22 @@ Segments standardised_loss(const HadynetModel& model, const HeldOutError& e, con
   return out;
 }
 
+namespace {
+// The one of `values` whose `name_of` is `name` (the options' names: --decision-loss, ...); none otherwise.
+template <typename E>
+std::optional<E> value_named(const std::string& name, std::initializer_list<E> values, const char* (*name_of)(E)) {
+  for (E value : values)
+    if (name == name_of(value)) return value;
+  return std::nullopt;
+}
+}  // namespace
+
 const char* decision_loss_name(DecisionLoss loss) {
   return loss == DecisionLoss::kSquared ? "squared" : "absolute";
 }
 
 std::optional<DecisionLoss> decision_loss_named(const std::string& name) {
-  for (DecisionLoss loss : {DecisionLoss::kSquared, DecisionLoss::kAbsolute})
-    if (name == decision_loss_name(loss)) return loss;
-  return std::nullopt;
+  return value_named(name, {DecisionLoss::kSquared, DecisionLoss::kAbsolute}, decision_loss_name);
 }
 
 const char* selection_rule_name(SelectionRule rule) {
@@ -104,9 +113,7 @@ const char* selection_rule_name(SelectionRule rule) {
 }
 
 std::optional<SelectionRule> selection_rule_named(const std::string& name) {
-  for (SelectionRule rule : {SelectionRule::kScreenOrder, SelectionRule::kEveryChannel})
-    if (name == selection_rule_name(rule)) return rule;
-  return std::nullopt;
+  return value_named(name, {SelectionRule::kScreenOrder, SelectionRule::kEveryChannel}, selection_rule_name);
 }
 
 const char* decision_scale_name(DecisionScale scale) {
@@ -114,9 +121,7 @@ const char* decision_scale_name(DecisionScale scale) {
 }
 
 std::optional<DecisionScale> decision_scale_named(const std::string& name) {
-  for (DecisionScale scale : {DecisionScale::kStd, DecisionScale::kResidual})
-    if (name == decision_scale_name(scale)) return scale;
-  return std::nullopt;
+  return value_named(name, {DecisionScale::kStd, DecisionScale::kResidual}, decision_scale_name);
 }
 
 DecisionRows decision_rows(int T, int split, int d) {
