@@ -28,6 +28,7 @@
 #include "trainer/model_file.h"
 #include "trainer/model_frame.h"
 #include "trainer/residual/augment.h"
+#include "trainer/residual/held_out.h"
 #include "trainer/residual/analysis.h"
 #include "trainer/residual/residuals.h"
 
@@ -354,6 +355,40 @@ TEST(ResidualFix, TheUntunedChangeFineTunedIsTheFixedModel) {
   fine_tune(control, seqs, rows, {defaults.epochs, defaults.batch, defaults.lr, defaults.seed}, &windows);
   EXPECT_TRUE(trainer::testing::bit_identical(control.params, first.fix.model.params));
   EXPECT_FALSE(trainer::testing::bit_identical(first.fix.untuned.params, first.fix.model.params));
+}
+
+// held_out_error's two details (HeldOutDetail): the probes' errors alone
+// are the report's errors, bit for bit (the probes decide on them), and only
+// the report's carry the diagnostics. The rows: the last 40 % of each log.
+TEST(HeldOutError, ErrorsAloneAreTheReportsErrors) {
+  const trainer::HadynetModel& model = build_model();
+  const std::vector<LogInput> logs = plant_logs("sensor-delay");
+  const ResidualData data = compute_residuals(model, logs, "auto");
+  std::vector<HeldOutLog> rows;
+  for (std::size_t i = 0; i < logs.size(); ++i) {
+    HeldOutLog e;
+    e.raw = &logs[i];
+    e.measured = trainer::log_sequence(logs[i].table, logs[i].file, model.layout);
+    e.frame = trainer::in_model_frame(model.sensor, model.layout, logs[i].table, logs[i].file).sequence;
+    e.pb = data.logs[i].pb;
+    e.end = e.measured.steps();
+    e.first = e.end - e.end * 2 / 5;
+    rows.push_back(std::move(e));
+  }
+  const HeldOutError full = held_out_error(model, rows);
+  const HeldOutError errors = held_out_error(model, rows, HeldOutDetail::kErrorsOnly);
+  ASSERT_EQ(full.channels, errors.channels);
+  EXPECT_EQ(full.samples, errors.samples);
+  EXPECT_TRUE(full.rmse.cwiseEqual(errors.rmse).all());
+  EXPECT_TRUE(full.fit.cwiseEqual(errors.fit).all());
+  ASSERT_EQ(full.residuals.size(), errors.residuals.size());
+  for (std::size_t c = 0; c < full.residuals.size(); ++c)
+    for (std::size_t s = 0; s < full.residuals[c].size(); ++s)
+      EXPECT_TRUE(full.residuals[c][s].cwiseEqual(errors.residuals[c][s]).all()) << full.channels[c];
+  EXPECT_EQ(full.whiteness.size(), full.channels.size());
+  EXPECT_EQ(full.inputs_outside.size(), full.channels.size());
+  EXPECT_TRUE(errors.whiteness.empty());
+  EXPECT_TRUE(errors.inputs_outside.empty());
 }
 
 // The null is read through the sensors it was recorded with

@@ -549,9 +549,11 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     for (const auto& log : data.logs) pbs.push_back(m.params.pb.row(m.state_index(log.seq.state)).transpose());
     return pbs;
   };
-  // A fine-tuned model (its states' PBs) judged on `rows`.
+  // A fine-tuned model (its states' PBs) judged on `rows`: with the
+  // diagnostics a report shows on the held-out part, errors alone elsewhere.
   auto judged = [&](const HadynetModel& m, const RowSpan& rows) {
-    return held_out_error(m, eval_rows(m, state_pbs(m), rows));
+    const HeldOutDetail detail = &rows == &held_out_part ? HeldOutDetail::kWithDiagnostics : HeldOutDetail::kErrorsOnly;
+    return held_out_error(m, eval_rows(m, state_pbs(m), rows), detail);
   };
   const FineTuneOptions tuning{options.epochs, options.batch, options.lr, options.seed};
   std::vector<Eigen::VectorXf> before_pbs;
@@ -573,7 +575,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
         train[i].first = std::max(rows[i].from, ResidualLog::kFirstRow + d);
         train[i].end = std::min(rows[i].to, train[i].measured.steps() - d);
       }
-      return Eigen::VectorXd(held_out_error(probe, train).rmse);
+      return Eigen::VectorXd(held_out_error(probe, train, HeldOutDetail::kErrorsOnly).rmse);
     };
     std::vector<double> rates;
     std::visit([&](auto& change) { change.refine(a, model.sensor, training_rmse, rates); }, a.change);
@@ -609,7 +611,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     rows.loss = [&](const SensorModel& sensor, const std::vector<std::string>& channels) {
       const auto judged_rows = [&] {
         probe.sensor = sensor;
-        return held_out_error(probe, eval_rows(probe, before_pbs, selection_judged));
+        return held_out_error(probe, eval_rows(probe, before_pbs, selection_judged), HeldOutDetail::kErrorsOnly);
       };
       if (sensor != model.sensor) return standardised_loss(model, judged_rows(), channels, loss);
       if (!unchanged) unchanged = judged_rows();
@@ -777,7 +779,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     const Augmentation mirrored = refined(planned[chosen], mirrored_train, nullptr);
     mirrored_after = judged(tune(&mirrored, mirrored_train).model, mirrored_judged);
     mirrored_reference = options.control ? judged(tune(nullptr, mirrored_train).model, mirrored_judged)
-                                         : held_out_error(model, eval_rows(model, before_pbs, mirrored_judged));
+                                         : held_out_error(model, eval_rows(model, before_pbs, mirrored_judged),
+                                                          HeldOutDetail::kErrorsOnly);
     for (auto& segment : standardised_loss(model, *mirrored_reference, result.confirmation_channels, loss, levels))
       reference_loss.push_back(std::move(segment));
     for (auto& segment : standardised_loss(model, *mirrored_after, result.confirmation_channels, loss, levels))

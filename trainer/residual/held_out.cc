@@ -88,7 +88,7 @@ Eigen::MatrixXd measured_predictions(const HadynetModel& model, const LogSequenc
 
 }  // namespace
 
-HeldOutError held_out_error(const HadynetModel& model, const std::vector<HeldOutLog>& logs) {
+HeldOutError held_out_error(const HadynetModel& model, const std::vector<HeldOutLog>& logs, HeldOutDetail detail) {
   const OutputMap map = output_map(model);
   HeldOutError e;
   e.channels = model.layout.y_names;
@@ -119,8 +119,9 @@ HeldOutError held_out_error(const HadynetModel& model, const std::vector<HeldOut
     e.rmse(c) = std::sqrt(sum_ee(c) / n);
     e.fit(c) = ss_total > 0 ? 100.0 * (1.0 - std::sqrt(sum_ee(c) / ss_total)) : 0.0;
     const auto& rc = res[static_cast<std::size_t>(c)];
-    e.whiteness.push_back(whiteness(rc, kDefaultMaxLag));
     e.residuals.push_back(rc);
+    if (detail == HeldOutDetail::kErrorsOnly) continue;
+    e.whiteness.push_back(whiteness(rc, kDefaultMaxLag));
     int outside = 0;
     for (const auto& u : inp) outside += cross_correlate(rc, u, kDefaultMaxLag).outside;
     e.inputs_outside.push_back(outside);

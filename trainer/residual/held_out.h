@@ -43,9 +43,18 @@ struct HeldOutLog {
   int first = 0, end = 0;
 };
 
-// RMSE, fit, whiteness and independence (against the logged commands) per
-// channel over the held-out rows of every log (verdict left empty). Throws
-// std::logic_error if a held-out row has no prediction (rows before D + 2).
-HeldOutError held_out_error(const HadynetModel& model, const std::vector<HeldOutLog>& logs);
+// What held_out_error computes besides RMSE, fit and the residuals: the
+// whiteness and independence diagnostics, which a report shows, or nothing
+// more (the probes and tests that only compare errors; these diagnostics
+// were about a seventh of a `--fix` run's time).
+enum class HeldOutDetail { kWithDiagnostics, kErrorsOnly };
+
+// RMSE, fit and residuals, and (kWithDiagnostics) whiteness and independence
+// (against the logged commands) per channel over the held-out rows of every
+// log (verdict left empty; with kErrorsOnly, whiteness and inputs_outside
+// are left empty). Throws std::logic_error if a held-out row has no
+// prediction (rows before D + 2).
+HeldOutError held_out_error(const HadynetModel& model, const std::vector<HeldOutLog>& logs,
+                            HeldOutDetail detail = HeldOutDetail::kWithDiagnostics);
 
 }  // namespace hadynet::trainer::residual
