@@ -222,8 +222,14 @@
 # group (not kept), and 2365-2374 measured it and the final code on the
 # same logs (every effect at its larger strength and crosstalk=0.2);
 # 2375-2384 every effect at its smaller strength but cross-talk;
-# 2385-2404 clean sets and 2405-2409 two effects, the final code. Next
-# unused: 2410 on.
+# 2385-2404 clean sets and 2405-2409 two effects, the final code.
+# Stop 63 (a mutual cross-talk pair is not extended): development: the
+# curve sets of 2320-2329 (two fits of the curve, not kept), stop 62's
+# cross-talk misses 2321 and 2327 (crosstalk=0.35, recorded again), and
+# 2410-2419 (crosstalk at both strengths and the curve, run with the
+# rule's first version); measured with the final code, nothing chosen on
+# them: 2420-2429 crosstalk=0.35 and 0.2, 2430-2449 clean sets. Next
+# unused: 2450 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -101,8 +101,9 @@
 # (the residual's unit in the held-out tests), and 2295-2314 with it
 # too (0 of 40 in all). Stop 62: 2330-2349 and 2385-2404 measured with
 # its final code (a cross-talk between groups a candidate of its own; 0 of
-# 40). Next unused seed: 2410 (bench/residual_detection.sh lists the
-# other seeds).
+# 40). Stop 63: 2430-2449 measured with its final code (a mutual
+# cross-talk pair is not extended). Next unused seed: 2450
+# (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
