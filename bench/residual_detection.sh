@@ -228,8 +228,13 @@
 # cross-talk misses 2321 and 2327 (crosstalk=0.35, recorded again), and
 # 2410-2419 (crosstalk at both strengths and the curve, run with the
 # rule's first version); measured with the final code, nothing chosen on
-# them: 2420-2429 crosstalk=0.35 and 0.2, 2430-2449 clean sets. Next
-# unused: 2450 on.
+# them: 2420-2429 crosstalk=0.35 and 0.2, 2430-2449 clean sets.
+# Stop 64 (a confirmed cross-talk within a group gives way to a curve
+# that predicts better, the richer account): development: the curve sets
+# 2321 and 2328 (recorded again) and the crosstalk=0.35 sets 2410-2415;
+# measured with the final code, nothing chosen on them: 2450-2459
+# sensor-curve=0.7 and crosstalk=0.35, 2460-2469 every effect at its
+# larger strength and crosstalk=0.2. Next unused: 2470 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

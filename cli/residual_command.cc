@@ -155,6 +155,7 @@ void print_fix(const rs::FixResult& fixed) {
       std::printf("; on its own channels mean loss difference %.3g", fixed.own_channels->mean);
     std::printf(": %s\n", fixed.changed ? "confirmed" : "not confirmed, nothing applied");
     if (fixed.simpler) std::printf("%s\n", simpler_sentence(*fixed.simpler, fixed.reference).c_str());
+    if (fixed.richer) std::printf("%s\n", richer_sentence(*fixed.richer, fixed.reference).c_str());
     for (const auto& wider : fixed.extensions) std::printf("%s\n", extension_sentence(wider).c_str());
     if (replaced_after_decision(fixed)) std::printf("the before/after above are the plan applied last\n");
     if (!fixed.folds_note.empty()) std::printf("note: %s\n", fixed.folds_note.c_str());
@@ -256,7 +257,10 @@ int run_residual(int argc, char** argv) {
                               "screen's winner); a confirmed calibration curve gives way to a rail planned on its lead\n"
                               "channel when the rail is confirmed itself and the curve does not predict the channels\n"
                               "either claims significantly better (the simpler account; a confirmed friction gives way\n"
-                              "likewise to a calibration curve of its lead channel); a family alone confirmed is\n"
+                              "likewise to a calibration curve of its lead channel); a confirmed cross-talk within a\n"
+                              "group gives way to a calibration curve of its target's group only when the curve is\n"
+                              "confirmed itself and predicts the channels either claims significantly better (the\n"
+                              "richer account); a family alone confirmed is\n"
                               "then extended to its group when the extended plan predicts the channels it adds\n"
                               "significantly better on the held-out rows, and a delay seen beyond its family likewise\n"
                               "to every channel of its group; when a place is left or the screen proposes a load drift,\n"

@@ -15,7 +15,6 @@ namespace {
 namespace rs = trainer::residual;
 using nlohmann::json;
 
-
 json held_out_json(const rs::HeldOutError& e) {
   json ch = json::array();
   for (std::size_t c = 0; c < e.channels.size(); ++c) {
@@ -26,6 +25,21 @@ json held_out_json(const rs::HeldOutError& e) {
                   {"white", w.white()}, {"acf_lags_outside", w.outside}, {"input_lags_outside", e.inputs_outside[c]}});
   }
   return {{"samples", e.samples}, {"verdict", e.verdict}, {"channels", ch}};
+}
+
+// The fields the simpler and the richer account share (FixResult::OtherAccount).
+json other_account_json(const rs::FixResult::OtherAccount& a, const std::string& reference) {
+  return {{"effect", a.effect},
+          {"replaces", a.replaces},
+          {"description", a.description},
+          {"channels", a.channels},
+          {"a_candidate", a.a_candidate},
+          {"against_reference", {{"against", reference},
+                                 {"mean_loss_difference", a.against_reference.mean},
+                                 {"statistic", a.against_reference.stat},
+                                 {"rows", a.against_reference.samples},
+                                 {"p_value", a.against_reference.p_value}}},
+          {"applied", a.applied}};
 }
 
 }  // namespace
@@ -106,18 +120,8 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
     // The simpler account tried after the confirmation (FixResult::simpler).
     if (f.simpler) {
       const rs::FixResult::SimplerAccount& a = *f.simpler;
-      json account = {{"effect", a.effect},
-                      {"replaces", a.replaces},
-                      {"description", a.description},
-                      {"channels", a.channels},
-                      {"a_candidate", a.a_candidate},
-                      {"against_reference", {{"against", f.reference},
-                                             {"mean_loss_difference", a.against_reference.mean},
-                                             {"statistic", a.against_reference.stat},
-                                             {"rows", a.against_reference.samples},
-                                             {"p_value", a.against_reference.p_value}}},
-                      {"flat_end", a.flat_end},
-                      {"applied", a.applied}};
+      json account = other_account_json(a, f.reference);
+      account["flat_end"] = a.flat_end;
       if (a.gain_tested)
         account["confirmed_gain"] = {{"channels", a.gain_channels},
                                      {"mean_loss_difference", a.confirmed_gain.mean},
@@ -125,6 +129,20 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                                      {"rows", a.confirmed_gain.samples},
                                      {"p_value", a.confirmed_gain.p_value}};
       j["simpler"] = account;
+    }
+    // The richer account tried after the confirmation (FixResult::richer).
+    if (f.richer) {
+      const rs::FixResult::RicherAccount& a = *f.richer;
+      json account = other_account_json(a, f.reference);
+      if (!a.own_channels.empty())
+        account["own_channels"] = {{"channels", a.own_channels}, {"mean_loss_difference", a.own_gain}};
+      if (a.gain_tested)
+        account["gain_over_confirmed"] = {{"channels", a.gain_channels},
+                                          {"mean_loss_difference", a.gain.mean},
+                                          {"statistic", a.gain.stat},
+                                          {"rows", a.gain.samples},
+                                          {"p_value", a.gain.p_value}};
+      j["richer"] = account;
     }
     json candidates = json::array();
     for (const auto& c : f.candidates)
@@ -194,7 +212,7 @@ std::string fix_table(const rs::FixResult& f) {
 }  // namespace
 
 bool replaced_after_decision(const rs::FixResult& f) {
-  return (f.simpler && f.simpler->applied) ||
+  return (f.simpler && f.simpler->applied) || (f.richer && f.richer->applied) ||
          std::any_of(f.extensions.begin(), f.extensions.end(), [](const auto& e) { return e.applied; });
 }
 
@@ -215,6 +233,26 @@ std::string simpler_sentence(const rs::FixResult::SimplerAccount& s, const std::
            " applied in its place";
   return m + (s.applied ? "no significant gain, " + s.effect + " applied in its place"
                         : "a significant gain, " + s.replaces + " kept");
+}
+
+std::string richer_sentence(const rs::FixResult::RicherAccount& r, const std::string& reference) {
+  const auto listed = [](const std::vector<std::string>& names) {
+    std::string out;
+    for (std::size_t i = 0; i < names.size(); ++i) out += (i ? ", " : "") + names[i];
+    return out;
+  };
+  std::string m = "Richer account: " + r.effect + " (" + r.description + ")";
+  if (!r.a_candidate) m += " (not among the candidates)";
+  m += ", against " + reference + " on the held-out rows of " + listed(r.channels) + " (Diebold-Mariano, " +
+       std::to_string(r.against_reference.samples) + " rows): mean loss difference " +
+       num("%.3g", r.against_reference.mean) + ", p " + num("%.2g", r.against_reference.p_value);
+  if (!r.own_channels.empty())
+    m += "; on its own channels (" + listed(r.own_channels) + ") mean loss difference " + num("%.3g", r.own_gain);
+  if (!r.gain_tested) return m + ": not confirmed, " + r.replaces + " kept";
+  m += "; against " + r.replaces + " on " + listed(r.gain_channels) + ": mean loss difference " +
+       num("%.3g", r.gain.mean) + ", p " + num("%.2g", r.gain.p_value) + ": ";
+  return m + (r.applied ? "a significant gain, " + r.effect + " applied in its place"
+                        : "no significant gain, " + r.replaces + " kept");
 }
 
 std::string extension_sentence(const rs::FixResult::Extension& e) {
@@ -251,8 +289,9 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
   m += "Verdict before: " + f.before.verdict + "\n\n";
   for (const auto& p : f.drift_probes) m += drift_probe_sentence(p) + ".\n\n";
   if (f.tried) {
-    const bool replaced = f.simpler && f.simpler->applied;
-    m += "Decision: the " + (replaced ? "chosen candidate (" + f.simpler->replaces + ")" : std::string("augmented model")) +
+    const bool replaced = (f.simpler && f.simpler->applied) || (f.richer && f.richer->applied);
+    const std::string chosen = f.simpler && f.simpler->applied ? f.simpler->replaces : f.richer ? f.richer->replaces : "";
+    m += "Decision: the " + (replaced ? "chosen candidate (" + chosen + ")" : std::string("augmented model")) +
          " against " + f.reference + " on the held-out rows of ";
     for (std::size_t i = 0; i < f.confirmation_channels.size(); ++i) m += (i ? ", " : "") + f.confirmation_channels[i];
     m += std::string(" (one-sided Diebold-Mariano test of the standardised ") +
@@ -274,6 +313,7 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
            (f.own_channels->mean > 0 ? " (it does)" : " (it does not)") + ".\n\n";
     }
     if (f.simpler) m += simpler_sentence(*f.simpler, f.reference) + ".\n\n";
+    if (f.richer) m += richer_sentence(*f.richer, f.reference) + ".\n\n";
     for (const auto& e : f.extensions) m += extension_sentence(e) + ".\n\n";
     if (replaced_after_decision(f)) m += "The before/after below are the plan applied last.\n\n";
     m += "Verdict after (the augmented model on its own frame): " + f.after.verdict + "\n\n";

@@ -32,8 +32,14 @@ std::string drift_probe_sentence(const trainer::residual::DriftProbe& p);
 // For stdout and REPORT.md.
 std::string simpler_sentence(const trainer::residual::FixResult::SimplerAccount& s, const std::string& reference);
 
+// One sentence on the richer account tried after the confirmation
+// (FixResult::richer): its channels, its test against the reference (and on
+// its own channels), its gain over the confirmed change when tested, and
+// whether it was applied. For stdout and REPORT.md.
+std::string richer_sentence(const trainer::residual::FixResult::RicherAccount& r, const std::string& reference);
+
 // Whether a plan other than the decision's was applied after the
-// confirmation (the simpler account or a wider plan): the before/after are
+// confirmation (the simpler or richer account, or a wider plan): the before/after are
 // then the plan applied last.
 bool replaced_after_decision(const trainer::residual::FixResult& f);
 

@@ -525,6 +525,51 @@ TEST(FixCandidates, TheSimplerAccountOfFrictionIsACurveOnItsLeadChannel) {
   EXPECT_EQ(simpler({friction, plan(EffectKind::kSaturation, {"fc4"})}), Channels{});
 }
 
+// The plans fix() tries as the richer account of a confirmed cross-talk
+// (EffectInfo::richer: a calibration curve, when every pair the removal
+// takes reads a channel of its target's group): the curves planned on its
+// lead channel (the winner's target), fewest channels first; none for a
+// removal with a pair between groups (a tension leaking into a loadcell is
+// no loadcell's curve), for a curve that leaves the target out, and none
+// for a curve, which names no richer effect.
+TEST(FixCandidates, TheRicherAccountOfACrosstalkWithinAGroupIsItsGroupsCurve) {
+  using residual::EffectKind;
+  const auto plan = [](EffectKind kind, std::vector<std::string> channels) {
+    residual::Augmentation a;
+    a.kind = kind;
+    a.channels = std::move(channels);
+    return a;
+  };
+  const auto crosstalk = [&](std::vector<SensorCrosstalk> pairs) {
+    residual::Augmentation a = plan(EffectKind::kCrosstalk, {});
+    for (const auto& p : pairs) a.channels.push_back(p.target);
+    a.change = residual::CrosstalkRemoval{{}, std::move(pairs)};
+    return a;
+  };
+  residual::ResidualData data;
+  data.y_names = {"f5", "fc0", "fc1", "fc2", "fc3", "fc4", "fc6", "fc7"};
+  const residual::Attribution floorless;
+  const auto richer = [&](const std::vector<residual::Augmentation>& planned) {
+    std::vector<std::vector<std::string>> out;
+    for (const auto& a : residual::richer_plans(data, floorless, planned, 0)) out.push_back(a.channels);
+    return out;
+  };
+  using Channels = std::vector<std::vector<std::string>>;
+  const auto group_curve = plan(EffectKind::kSensorCurve, {"fc1", "fc3", "fc7", "fc4", "fc2"});
+  const auto family_curve = plan(EffectKind::kSensorCurve, {"fc1", "fc3"});
+  const auto within = crosstalk({{"fc1", "fc2", 0.43}});
+  EXPECT_EQ(richer({within, group_curve, family_curve}), (Channels{{"fc1", "fc3"}, group_curve.channels}));
+  EXPECT_EQ(richer({crosstalk({{"fc1", "fc2", 0.43}, {"fc3", "fc4", 0.3}}), group_curve}), Channels{group_curve.channels});
+  // A pair between groups anywhere in the removal: no curve stands for it.
+  EXPECT_EQ(richer({crosstalk({{"fc6", "f5", 0.2}}), plan(EffectKind::kSensorCurve, {"fc6", "fc1"})}), Channels{});
+  EXPECT_EQ(richer({crosstalk({{"fc1", "fc2", 0.43}, {"fc6", "f5", 0.2}}), group_curve}), Channels{});
+  // A curve without the target.
+  EXPECT_EQ(richer({within, plan(EffectKind::kSensorCurve, {"fc3", "fc4"})}), Channels{});
+  // A curve names no richer account; a cross-talk has no simpler one.
+  EXPECT_EQ(richer({group_curve, within}), Channels{});
+  EXPECT_TRUE(residual::simpler_plans(data, floorless, {within, group_curve}, 0).empty());
+}
+
 // With no rail among the candidates, the simpler account is planned from
 // the ranking without its floor: on the lead's group and side only, the
 // lead first, though a rail of another group (a length's lower rail) or

@@ -354,20 +354,24 @@ bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k) {
          !planned[k - 1].extended_channels.empty();
 }
 
-std::vector<Augmentation> simpler_plans(const ResidualData& data, const Attribution& floorless,
-                                       const std::vector<Augmentation>& planned, std::size_t k) {
+namespace {
+
+// simpler_plans() and richer_plans(): the plans of effect `other` that
+// account for planned[k]'s lead channel (their contracts).
+std::vector<Augmentation> other_account_plans(const ResidualData& data, const Attribution& floorless,
+                                              const std::vector<Augmentation>& planned, std::size_t k,
+                                              std::optional<EffectKind> other) {
   std::vector<Augmentation> out;
-  const std::optional<EffectKind> simpler = effect_info(planned[k].kind).simpler;
-  if (!simpler || planned[k].channels.empty()) return out;
+  if (!other || planned[k].channels.empty()) return out;
   const std::string& lead = planned[k].channels.front();
   for (const Augmentation& a : planned)
-    if (a.kind == *simpler && a.not_fixable.empty() &&
+    if (a.kind == *other && a.not_fixable.empty() &&
         std::find(a.channels.begin(), a.channels.end(), lead) != a.channels.end())
       out.push_back(a);
   if (out.empty()) {
     const int target = index_of(data.y_names, lead);
     const auto best = std::find_if(floorless.ranked.begin(), floorless.ranked.end(), [&](const HypothesisResult& r) {
-      return r.significant && r.hypothesis.kind == *simpler && r.hypothesis.target == target;
+      return r.significant && r.hypothesis.kind == *other && r.hypothesis.target == target;
     });
     if (best == floorless.ranked.end() || !why_not_fixable(data, floorless, *best).empty()) return out;
     // Without the floor, the effect's family (Attribution::family_of: every
@@ -376,13 +380,13 @@ std::vector<Augmentation> simpler_plans(const ResidualData& data, const Attribut
     Attribution view = floorless;
     const std::string group = channel_group(lead);
     for (auto& r : view.ranked)
-      if (r.hypothesis.kind == *simpler &&
+      if (r.hypothesis.kind == *other &&
           (channel_group(data.y_names[static_cast<std::size_t>(r.hypothesis.target)]) != group ||
            r.hypothesis.side != best->hypothesis.side))
         r.significant = false;
     std::stable_partition(view.ranked.begin(), view.ranked.end(), [](const HypothesisResult& r) { return r.significant; });
     const auto lead_at = std::find_if(view.ranked.begin(), view.ranked.end(), [&](const HypothesisResult& r) {
-      return r.significant && r.hypothesis.kind == *simpler && r.hypothesis.target == target;
+      return r.significant && r.hypothesis.kind == *other && r.hypothesis.target == target;
     });
     std::rotate(view.ranked.begin(), lead_at, lead_at + 1);
     Augmentation a = planned_for(data, view, view.ranked.front(), true);
@@ -397,6 +401,19 @@ std::vector<Augmentation> simpler_plans(const ResidualData& data, const Attribut
   std::stable_sort(out.begin(), out.end(),
                    [](const Augmentation& a, const Augmentation& b) { return a.channels.size() < b.channels.size(); });
   return out;
+}
+
+}  // namespace
+
+std::vector<Augmentation> simpler_plans(const ResidualData& data, const Attribution& floorless,
+                                       const std::vector<Augmentation>& planned, std::size_t k) {
+  return other_account_plans(data, floorless, planned, k, effect_info(planned[k].kind).simpler);
+}
+
+std::vector<Augmentation> richer_plans(const ResidualData& data, const Attribution& floorless,
+                                       const std::vector<Augmentation>& planned, std::size_t k) {
+  const auto richer = effect_info(planned[k].kind).richer;
+  return other_account_plans(data, floorless, planned, k, richer ? richer(planned[k]) : std::nullopt);
 }
 
 std::optional<Augmentation> on_whole_group(const std::vector<std::string>& y_names, const SensorModel& sensor,
@@ -833,11 +850,16 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // mean loss difference there, no test): a curve that gains elsewhere
   // while its own channels read worse is not their calibration
   // (FixResult::own_channels).
-  if (result.augmentation->judged_on_every_channel) {
+  // The model's channels a plan changes (its found_on, once each).
+  const auto own_channels_of = [&](const Augmentation& plan) {
     std::vector<std::string> own;
-    for (const auto& name : result.augmentation->found_on)
+    for (const auto& name : plan.found_on)
       if (index_of(model.layout.y_names, name) >= 0 && std::find(own.begin(), own.end(), name) == own.end())
         own.push_back(name);
+    return own;
+  };
+  if (result.augmentation->judged_on_every_channel) {
+    const std::vector<std::string> own = own_channels_of(*result.augmentation);
     if (!own.empty()) {
       result.own_channels = compare(reference, mirrored_reference, result.after, mirrored_after, own);
       result.own_channel_names = own;
@@ -873,9 +895,11 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     return std::all_of(plans.begin(), plans.end(),
                        [&](const Augmentation& a) { return sensor_after(model.sensor, a).max_delay() <= d; });
   };
-  if (!simpler.empty() && judged_rows_suffice(simpler)) {
-    const Augmentation& plan = simpler.front();
-    FixResult::SimplerAccount account;
+  // The other account's plan `plan` fine-tuned on each fold (`t`) and
+  // judged against the reference on its channels; gain_channels: where
+  // either account claims something (the confirmed change's channels and
+  // the plan's).
+  const auto other_account = [&](FixResult::OtherAccount& account, const Augmentation& plan, FoldTrial& t) {
     account.effect = plan.effect;
     account.replaces = planned[chosen].effect;
     account.description = plan.description;
@@ -883,26 +907,65 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     account.a_candidate = std::any_of(planned.begin(), planned.end(), [&](const Augmentation& a) {
       return a.kind == plan.kind && a.channels == plan.channels;
     });
-    FoldTrial t = fold_trial(plan);
+    t = fold_trial(plan);
     account.against_reference = compare(reference, mirrored_reference, t.rows, t.mirrored, account.channels);
+    account.gain_channels = result.confirmation_channels;
+    for (const auto& name : account.channels)
+      if (std::find(account.gain_channels.begin(), account.gain_channels.end(), name) == account.gain_channels.end())
+        account.gain_channels.push_back(name);
+  };
+  // The other account's first plan (`plans`' front, trial `t`) applied in
+  // the confirmed change's place; its last, if another, is then the wider plan.
+  const auto apply_account = [&](FoldTrial& t, const std::vector<Augmentation>& plans) {
+    apply(t);
+    applied_plan = &plans.front();
+    extended_of_applied = plans.size() > 1 ? &plans.back() : nullptr;
+    applied_extended = !plans.front().extended_channels.empty();
+  };
+  if (!simpler.empty() && judged_rows_suffice(simpler)) {
+    const Augmentation& plan = simpler.front();
+    FixResult::SimplerAccount account;
+    FoldTrial t;
+    other_account(account, plan, t);
     if (significant(account.against_reference)) {
-      // Where either account claims something: the confirmed change's channels and the simpler plan's.
-      account.gain_channels = result.confirmation_channels;
-      for (const auto& name : account.channels)
-        if (std::find(account.gain_channels.begin(), account.gain_channels.end(), name) == account.gain_channels.end())
-          account.gain_channels.push_back(name);
       account.gain_tested = true;
       account.confirmed_gain = compare(t.rows, t.mirrored, result.after, mirrored_after, account.gain_channels);
       account.flat_end = flat_end_at_rail(*result.augmentation, plan);
       account.applied = account.flat_end || !significant(account.confirmed_gain);
     }
-    if (account.applied) {
-      apply(t);
-      applied_plan = &plan;
-      extended_of_applied = simpler.size() > 1 ? &simpler.back() : nullptr;
-      applied_extended = !plan.extended_channels.empty();
-    }
+    if (account.applied) apply_account(t, simpler);
     result.simpler = std::move(account);
+  }
+
+  // The richer account (FixResult::richer): a confirmed change that a richer
+  // effect's plan may explain (a cross-talk within a group, the group's
+  // calibration curve) gives way to that plan only when the plan is
+  // confirmed against the reference itself and predicts the channels either
+  // claims significantly better than the change. Tried on the plan with the
+  // fewest channels; its extended plan, if any, is then a wider plan.
+  std::vector<Augmentation> richer;
+  if (confirmed && !(result.simpler && result.simpler->applied) && effect_info(planned[chosen].kind).richer)
+    richer = richer_plans(data, with_null_floor(attribution, 0), planned, chosen);
+  if (!richer.empty() && judged_rows_suffice(richer)) {
+    const Augmentation& plan = richer.front();
+    FixResult::RicherAccount account;
+    FoldTrial t;
+    other_account(account, plan, t);
+    bool confirmed_itself = significant(account.against_reference);
+    if (plan.judged_on_every_channel) {  // as the decision asks of such a plan
+      account.own_channels = own_channels_of(plan);
+      if (!account.own_channels.empty()) {
+        account.own_gain = compare(reference, mirrored_reference, t.rows, t.mirrored, account.own_channels).mean;
+        confirmed_itself = confirmed_itself && account.own_gain > 0;
+      }
+    }
+    if (confirmed_itself) {
+      account.gain_tested = true;
+      account.gain = compare(result.after, mirrored_after, t.rows, t.mirrored, account.gain_channels);
+      account.applied = significant(account.gain);
+    }
+    if (account.applied) apply_account(t, richer);
+    result.richer = std::move(account);
   }
 
   // A wider plan, tested only after the test before it was significant (a fixed

@@ -421,6 +421,15 @@ bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k);
 std::vector<Augmentation> simpler_plans(const ResidualData& data, const Attribution& floorless,
                                         const std::vector<Augmentation>& planned, std::size_t k);
 
+// The plans fix() tries as the richer account of a confirmed planned[k]
+// (its effect's EffectInfo::richer for that plan), planned as
+// simpler_plans() plans a simpler effect: the richer effect's candidates
+// holding the lead channel, else its best hypothesis on the lead channel in
+// `floorless`, on the lead's group; fewest channels first. Empty when the
+// effect names none for planned[k] or neither holds one.
+std::vector<Augmentation> richer_plans(const ResidualData& data, const Attribution& floorless,
+                                       const std::vector<Augmentation>& planned, std::size_t k);
+
 // The ranking fix() plans its candidates from: `attribution` re-floored at
 // options.min_excess_null (with_null_floor) when that is below the screen's
 // floor, else `attribution` itself (never above the screen's floor; unset:
@@ -616,6 +625,19 @@ struct FixResult {
     bool applied = false;
   };
   std::vector<Extension> extensions;
+  // What the simpler and the richer account below hold alike: another
+  // plan of the confirmed change's lead channel, tried after the decision.
+  struct OtherAccount {
+    std::string effect;                 // the plan's effect
+    std::string replaces;               // the confirmed change's effect
+    std::string description;            // the plan, as planned
+    bool a_candidate = false;           // the plan was one of the candidates (else planned from the ranking)
+    std::vector<std::string> channels;  // the channels it is judged on against the reference
+    DieboldMariano against_reference;   // the reference's loss minus the plan's on `channels`
+    std::vector<std::string> gain_channels;  // the confirmation's channels and the plan's
+    bool gain_tested = false;           // confirmed against the reference, so the plans were compared
+    bool applied = false;
+  };
   // The simpler account, tried after a confirmed change whose effect has
   // one (EffectInfo::simpler; simpler_plans() plans it) and before the
   // wider plans: the simpler plan, re-estimated and fine-tuned as the
@@ -634,24 +656,35 @@ struct FixResult {
   // the first runs only after the decision confirmed, so nothing is
   // applied that the decision did not confirm. `confirmation` stays the
   // decision's.
-  struct SimplerAccount {
-    std::string effect;                 // the simpler plan's effect
-    std::string replaces;               // the confirmed change's effect
-    std::string description;            // the simpler plan, as planned
-    bool a_candidate = false;           // the plan was one of the candidates (else planned from the ranking)
-    std::vector<std::string> channels;  // the simpler plan's channels of the model
-    DieboldMariano against_reference;   // the reference's loss minus the simpler plan's on `channels`
-    std::vector<std::string> gain_channels;  // the confirmation's channels and the plan's (if tested)
+  struct SimplerAccount : OtherAccount {
     DieboldMariano confirmed_gain;      // the simpler plan's loss minus the confirmed change's on gain_channels
-    bool gain_tested = false;           // against_reference was significant, so confirmed_gain was tested
     // The confirmed change is a calibration curve whose lead channel's end
     // on the rail's side is as flat as its fit may be
     // (CalibrationCurves::flat_at_end): the rail is applied once confirmed
     // against the reference, whatever confirmed_gain says.
     bool flat_end = false;
-    bool applied = false;
   };
   std::optional<SimplerAccount> simpler;
+  // The richer account, tried after a confirmed change whose effect names
+  // one for it (EffectInfo::richer; richer_plans() plans it) when no
+  // simpler account replaced it, and before the wider plans: the richer
+  // plan, re-estimated and fine-tuned as the tested candidate was (on each
+  // fold the decision judged), judged against the reference on the held-out
+  // rows of its channels as the decision judges a plan of its effect (a
+  // calibration curve: every channel, and its own channels must gain), then,
+  // only if it is confirmed so, against the confirmed change on the
+  // channels either claims. It replaces the confirmed change only if it
+  // predicts those channels significantly better: of two accounts of one
+  // channel, the one with more parameters must earn its place (the mirror of
+  // the simpler account). The wider plans then start from the plan applied.
+  // Both tests at the attribution's alpha; `confirmation` stays the
+  // decision's.
+  struct RicherAccount : OtherAccount {
+    std::vector<std::string> own_channels;  // a plan judged on every channel: the channels it changes
+    double own_gain = 0;                // the mean loss difference there (reference minus plan), every fold
+    DieboldMariano gain;                // the confirmed change's loss minus the richer plan's on gain_channels
+  };
+  std::optional<RicherAccount> richer;
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
   // drift: the attribution's rate per channel, before refine() (0 for a

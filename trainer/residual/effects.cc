@@ -1227,6 +1227,16 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   a.found_on = a.channels;
 }
 
+// EffectInfo::richer: a removal whose every pair reads a channel of its
+// target's group stands in for the group's calibration curve.
+std::optional<EffectKind> richer(const Augmentation& confirmed) {
+  const auto* removal = std::get_if<CrosstalkRemoval>(&confirmed.change);
+  if (removal == nullptr || removal->pairs.empty()) return std::nullopt;
+  for (const SensorCrosstalk& pair : removal->pairs)
+    if (channel_group(pair.source) != channel_group(pair.target)) return std::nullopt;
+  return EffectKind::kSensorCurve;
+}
+
 }  // namespace crosstalk
 }  // namespace
 
@@ -1403,7 +1413,7 @@ const std::vector<EffectInfo>& effect_library() {
        "removal: train on y_c - k y_s (in y and x); the sensor model adds k times the predicted y_s back; "
        "within one group also the group's further significant pairs that form no chain",
        SourceKind::kObserved, crosstalk::enumerate, crosstalk::features, first_coefficient, crosstalk::fraction,
-       crosstalk::describe, crosstalk::plan, nullptr},
+       crosstalk::describe, crosstalk::plan, nullptr, nullptr, nullptr, std::nullopt, crosstalk::richer},
       {EffectKind::kAuxChannel, "aux-channel", "an aux_* column's value at t: a logged channel the model does not use",
        "gain (target units per aux unit)",
        "use it: the aux channel becomes an observed channel (an input in x, predicted in y)", SourceKind::kAux,

@@ -158,6 +158,15 @@ struct EffectInfo {
   // motor, fine-tuned, imitate its loadcell's calibration curve), and
   // that fix() then tries in its place (FixResult::simpler); nullopt: none.
   std::optional<EffectKind> simpler = std::nullopt;
+  // --fix: a richer effect of the library, more parameters per channel,
+  // whose residual a confirmed change `confirmed` of this effect can stand in
+  // for on its lead channel (a cross-talk between two loadcells of one group
+  // imitates the group's calibration curve: neighbouring loadcells load
+  // together, so each one's level explains the other's compression), and
+  // that fix() then tries after the confirmation, applying it only when it
+  // predicts the channels either claims significantly better
+  // (FixResult::richer); nullptr, or nullopt for `confirmed`: none.
+  std::optional<EffectKind> (*richer)(const Augmentation& confirmed) = nullptr;
 };
 // The table, in EffectKind order (the order hypotheses are enumerated in).
 const std::vector<EffectInfo>& effect_library();
