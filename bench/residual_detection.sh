@@ -234,7 +234,8 @@
 # 2321 and 2328 (recorded again) and the crosstalk=0.35 sets 2410-2415;
 # measured with the final code, nothing chosen on them: 2450-2459
 # sensor-curve=0.7 and crosstalk=0.35, 2460-2469 every effect at its
-# larger strength and crosstalk=0.2. Next unused: 2470 on.
+# larger strength and crosstalk=0.2; 2470-2474 two effects
+# (bench/residual_two_effects.sh). Next unused: 2475 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

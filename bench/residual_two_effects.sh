@@ -51,7 +51,8 @@
 # 2281-2283 (the sensor delay with friction) and 2281 (the dead time with
 # the rail); 2315-2319 measured the earlier round's candidates alone
 # (12 of 20; stop 61's code on the same logs 10), 2350-2354 and 2405-2409
-# the final code (17 of 20 each), nothing chosen on any of them.
+# the final code (17 of 20 each), nothing chosen on any of them. Stop
+# 64 (the richer account): 2470-2474 measured with its final code.
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]... [--decision-loss L] [--decision-scale S] [--fix-selection R]
