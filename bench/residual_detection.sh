@@ -235,7 +235,8 @@
 # measured with the final code, nothing chosen on them: 2450-2459
 # sensor-curve=0.7 and crosstalk=0.35, 2460-2469 every effect at its
 # larger strength and crosstalk=0.2; 2470-2474 two effects
-# (bench/residual_two_effects.sh). Next unused: 2475 on.
+# (bench/residual_two_effects.sh), 2475-2494 clean sets
+# (bench/residual_false_positives.sh). Next unused: 2495 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -103,7 +103,8 @@
 # its final code (a cross-talk between groups a candidate of its own; 0 of
 # 40). Stop 63: 2430-2449 measured with its final code (a mutual
 # cross-talk pair is not extended). Stop 64: 2450-2469 effect sets
-# (bench/residual_detection.sh), 2470-2474 two effects. Next unused seed: 2475
+# (bench/residual_detection.sh), 2470-2474 two effects, 2475-2494 clean
+# sets measured with its final code (0 of 20). Next unused seed: 2495
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
