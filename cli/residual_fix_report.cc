@@ -27,6 +27,13 @@ json held_out_json(const rs::HeldOutError& e) {
   return {{"samples", e.samples}, {"verdict", e.verdict}, {"channels", ch}};
 }
 
+// "a, b, c".
+std::string comma_separated(const std::vector<std::string>& names) {
+  std::string out;
+  for (std::size_t i = 0; i < names.size(); ++i) out += (i ? ", " : "") + names[i];
+  return out;
+}
+
 // The fields the simpler and the richer account share (FixResult::OtherAccount).
 json other_account_json(const rs::FixResult::OtherAccount& a, const std::string& reference) {
   return {{"effect", a.effect},
@@ -218,14 +225,14 @@ bool replaced_after_decision(const rs::FixResult& f) {
 
 std::string simpler_sentence(const rs::FixResult::SimplerAccount& s, const std::string& reference) {
   std::string m = "Simpler account: " + s.effect + " on ";
-  for (std::size_t i = 0; i < s.channels.size(); ++i) m += (i ? ", " : "") + s.channels[i];
+  m += comma_separated(s.channels);
   if (!s.a_candidate) m += " (not among the candidates)";
   m += ", against " + reference + " on their held-out rows (Diebold-Mariano, " +
        std::to_string(s.against_reference.samples) + " rows): mean loss difference " +
        num("%.3g", s.against_reference.mean) + ", p " + num("%.2g", s.against_reference.p_value);
   if (!s.gain_tested) return m + ": not confirmed, " + s.replaces + " kept";
   m += "; " + s.replaces + " against it on ";
-  for (std::size_t i = 0; i < s.gain_channels.size(); ++i) m += (i ? ", " : "") + s.gain_channels[i];
+  m += comma_separated(s.gain_channels);
   m += ": mean loss difference " + num("%.3g", s.confirmed_gain.mean) +
        ", p " + num("%.2g", s.confirmed_gain.p_value) + ": ";
   if (s.flat_end)
@@ -236,20 +243,16 @@ std::string simpler_sentence(const rs::FixResult::SimplerAccount& s, const std::
 }
 
 std::string richer_sentence(const rs::FixResult::RicherAccount& r, const std::string& reference) {
-  const auto listed = [](const std::vector<std::string>& names) {
-    std::string out;
-    for (std::size_t i = 0; i < names.size(); ++i) out += (i ? ", " : "") + names[i];
-    return out;
-  };
   std::string m = "Richer account: " + r.effect + " (" + r.description + ")";
   if (!r.a_candidate) m += " (not among the candidates)";
-  m += ", against " + reference + " on the held-out rows of " + listed(r.channels) + " (Diebold-Mariano, " +
+  m += ", against " + reference + " on the held-out rows of " + comma_separated(r.channels) + " (Diebold-Mariano, " +
        std::to_string(r.against_reference.samples) + " rows): mean loss difference " +
        num("%.3g", r.against_reference.mean) + ", p " + num("%.2g", r.against_reference.p_value);
   if (!r.own_channels.empty())
-    m += "; on its own channels (" + listed(r.own_channels) + ") mean loss difference " + num("%.3g", r.own_gain);
+    m += "; on its own channels (" + comma_separated(r.own_channels) + ") mean loss difference " +
+         num("%.3g", r.own_gain);
   if (!r.gain_tested) return m + ": not confirmed, " + r.replaces + " kept";
-  m += "; against " + r.replaces + " on " + listed(r.gain_channels) + ": mean loss difference " +
+  m += "; against " + r.replaces + " on " + comma_separated(r.gain_channels) + ": mean loss difference " +
        num("%.3g", r.gain.mean) + ", p " + num("%.2g", r.gain.p_value) + ": ";
   return m + (r.applied ? "a significant gain, " + r.effect + " applied in its place"
                         : "no significant gain, " + r.replaces + " kept");
@@ -257,7 +260,7 @@ std::string richer_sentence(const rs::FixResult::RicherAccount& r, const std::st
 
 std::string extension_sentence(const rs::FixResult::Extension& e) {
   std::string m = "Extension to " + e.what + ": ";
-  for (std::size_t i = 0; i < e.channels.size(); ++i) m += (i ? ", " : "") + e.channels[i];
+  m += comma_separated(e.channels);
   m += ", against the plan applied before it on their held-out rows (Diebold-Mariano, " +
        std::to_string(e.test.samples) + " rows): mean loss difference " + num("%.3g", e.test.mean) + ", p " +
        num("%.2g", e.test.p_value) + ": " + (e.applied ? "applied" : "not applied");
@@ -293,7 +296,7 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
     const std::string chosen = f.simpler && f.simpler->applied ? f.simpler->replaces : f.richer ? f.richer->replaces : "";
     m += "Decision: the " + (replaced ? "chosen candidate (" + chosen + ")" : std::string("augmented model")) +
          " against " + f.reference + " on the held-out rows of ";
-    for (std::size_t i = 0; i < f.confirmation_channels.size(); ++i) m += (i ? ", " : "") + f.confirmation_channels[i];
+    m += comma_separated(f.confirmation_channels);
     m += std::string(" (one-sided Diebold-Mariano test of the standardised ") +
          rs::decision_loss_name(o.decision_loss) +
          (f.scale == rs::DecisionScale::kResidual ? " error relative to each channel's clean residual level" : " error") +
@@ -308,7 +311,7 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
          "**.\n\n";
     if (f.own_channels) {
       m += "Judged on every channel, it was also asked to predict its own channels (";
-      for (std::size_t i = 0; i < f.own_channel_names.size(); ++i) m += (i ? ", " : "") + f.own_channel_names[i];
+      m += comma_separated(f.own_channel_names);
       m += ") better than " + f.reference + ": mean loss difference " + num("%.3g", f.own_channels->mean) +
            (f.own_channels->mean > 0 ? " (it does)" : " (it does not)") + ".\n\n";
     }
