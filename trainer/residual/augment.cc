@@ -349,6 +349,32 @@ std::vector<Augmentation> earlier_candidates_for_next_round(const FixResult& fix
   return out;
 }
 
+namespace {
+bool addable_load_drift(const Augmentation& a) {
+  return a.not_fixable.empty() && a.kind == EffectKind::kDriftLoad && !a.channels.empty();
+}
+// No plan can be added: the screen proposed nothing, or its winner's plan
+// says why it cannot be added (plan_candidates).
+bool none_addable(const std::vector<Augmentation>& planned) {
+  return planned.empty() || !planned.front().not_fixable.empty();
+}
+}  // namespace
+
+bool drift_probe_has_place(const std::vector<Augmentation>& planned, int candidates) {
+  return none_addable(planned) || static_cast<int>(planned.size()) < candidates ||
+         std::any_of(planned.begin(), planned.end(), addable_load_drift);
+}
+
+ProbePlace drift_probe_place(const std::vector<Augmentation>& planned, const std::string& group, int candidates) {
+  if (none_addable(planned)) return {0, true};
+  const auto last = std::find_if(planned.rbegin(), planned.rend(), [&](const Augmentation& a) {
+    return addable_load_drift(a) && channel_group(a.channels.front()) == group;
+  });
+  if (last != planned.rend()) return {static_cast<std::size_t>(planned.rend() - last), false};
+  if (!drift_probe_has_place(planned, candidates)) throw std::logic_error("drift_probe_place: the probe has no place");
+  return {planned.size(), false};
+}
+
 bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k) {
   return k > 0 && k < planned.size() && !planned[k].group_extension && planned[k - 1].kind == planned[k].kind &&
          !planned[k - 1].extended_channels.empty();
@@ -604,23 +630,11 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // slow drift, and lists it on a family of one or two channels, so every
   // channel group is asked with the unchanged network whether a load drift
   // at one re-estimated rate predicts the selection's judged rows better.
-  // The best group that does is one more candidate: right after the
-  // screen's load drifts of that group when it lists one (a drift's third
-  // plan, beside its family and the family alone, beyond
-  // FixOptions::candidates), else after the screen's candidates where a
-  // place is left, or the only one when the screen has none that can be
-  // added. The selection then chooses among them as among any.
+  // The best group that does is one more candidate, where
+  // drift_probe_place() puts it. The selection then chooses among them as
+  // among any.
   std::optional<std::size_t> probed;  // its index in `planned`
-  const bool none_addable = planned.empty() || !planned.front().not_fixable.empty();
-  const bool place_left = none_addable || static_cast<int>(planned.size()) < options.candidates;
-  const auto load_drift_of = [&](const Augmentation& a, const std::string& group) {
-    return a.not_fixable.empty() && a.kind == EffectKind::kDriftLoad && !a.channels.empty() &&
-           channel_group(a.channels.front()) == group;
-  };
-  const bool any_load_drift = std::any_of(planned.begin(), planned.end(), [](const Augmentation& a) {
-    return a.not_fixable.empty() && a.kind == EffectKind::kDriftLoad;
-  });
-  if (options.drift_probe_alpha > 0 && can_select && (place_left || any_load_drift)) {
+  if (options.drift_probe_alpha > 0 && can_select && drift_probe_has_place(planned, options.candidates)) {
     DriftProbeRows rows;
     rows.refined = [&](const Augmentation& plan) { return refined(plan, selection_train, nullptr); };
     // The unchanged network without a drift is every group's reference: judged once.
@@ -636,18 +650,11 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     };
     result.drift_probes = probe_drifts(model, data, rows, options.drift_probe_alpha);
     if (const DriftProbe* best = best_drift_probe(result.drift_probes)) {
-      Augmentation group = group_drift_plan(best->channels, data.logs.front().dt_s, best->start_rate);
-      const auto last = std::find_if(planned.rbegin(), planned.rend(),
-                                     [&](const Augmentation& a) { return load_drift_of(a, best->group); });
-      if (last != planned.rend()) {
-        const auto at = planned.rend() - last;  // right after the screen's last load drift of the group
-        planned.insert(planned.begin() + at, std::move(group));
-        probed = static_cast<std::size_t>(at);
-      } else if (place_left) {
-        if (none_addable) planned.clear();  // a winner that cannot be added gives way
-        planned.push_back(std::move(group));
-        probed = planned.size() - 1;
-      }
+      const ProbePlace place = drift_probe_place(planned, best->group, options.candidates);
+      if (place.replaces_all) planned.clear();
+      planned.insert(planned.begin() + static_cast<std::ptrdiff_t>(place.at),
+                     group_drift_plan(best->channels, data.logs.front().dt_s, best->start_rate));
+      probed = place.at;
     }
   }
   // The earlier round's plans after this round's (a winner of this round

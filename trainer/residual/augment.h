@@ -43,14 +43,18 @@ inline constexpr double kDefaultFixMinExcessNull = 1.0;
 // FixOptions::drift_probe_alpha's default. The probe only proposes: the
 // selection and the decision on held-out rows against fine-tuning alone
 // judge its candidate (as FixOptions::min_excess_null lets the screen's
-// candidates reach below its floor). 0.05 rather than the screen's 0.01:
-// on the development sets (drift=0.02, seeds 1712-1716) the probe's Holm p
-// of the loadcells' group was 0.011 and 0.033 where the screen's own drift
-// was then not confirmed; on the clean sets 1732-1751 (run at 0.01, then
-// development of this level) its smallest was 0.021, in a group whose
-// candidate the selection and decision then judge (docs/residual.md, "A
-// drift probe of the unchanged network").
-inline constexpr double kDefaultDriftProbeAlpha = 0.05;
+// candidates reach below its floor). Above the screen's 0.01: on the
+// development sets of stop 56 (drift=0.02, seeds 1712-1716) the probe's
+// Holm p of the loadcells' group was 0.011 and 0.033 where the screen's own
+// drift was then not confirmed (0.05 then); 0.1 since stop 65: on the drift
+// sets 2460-2469 (then development) it was 0.061-0.099 on three of the four
+// missed, which at 0.1 the selection chose and the decision confirmed on two;
+// on 40 clean sets (2430-2449, 2475-2494) its smallest was 0.18, and on the
+// six cross-talk sets where it fell between 0.05 and 0.1 (2421, 2424,
+// 2428 at 0.2 and 0.35, 2452, 2467) its candidate was not chosen
+// (docs/residual.md, "A drift probe of the unchanged network", "The drift
+// probe's place and level (stop 65)").
+inline constexpr double kDefaultDriftProbeAlpha = 0.1;
 
 // --fix-selection (FixOptions::selection).
 enum class SelectionRule { kScreenOrder, kEveryChannel };
@@ -406,6 +410,28 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
 // Whether planned[k] of plan_candidates() is a family alone: the plan right
 // after the same plan extended to its group.
 bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k);
+
+// Where fix() puts the drift probe's candidate (drift_probe.h) among the
+// screen's plans `planned` (plan_candidates(), at most `candidates`):
+// right after the screen's last load drift of the probe's group when it
+// lists one (a drift's third plan, beside its family and the family alone,
+// beyond `candidates`); else last: where a place is left, or beyond
+// `candidates` when the screen lists a load drift of another group (the
+// probe then names the group the screen's drift missed: on the loadcells'
+// drift set 2461 of stop 64 the screen proposed a drift of one tendon and
+// filled every place, and the probe's loadcell drift was dropped); the
+// only one (replaces_all) when the screen has no plan that can be added.
+struct ProbePlace {
+  std::size_t at = 0;         // the candidate's index once inserted
+  bool replaces_all = false;  // `planned` is cleared first
+};
+// Whether the probe's candidate has a place whatever its group: the screen
+// has no plan that can be added, a place is left, or it lists a load
+// drift. fix() runs the probe only then.
+bool drift_probe_has_place(const std::vector<Augmentation>& planned, int candidates);
+// Throws std::logic_error when drift_probe_has_place() is false and the
+// screen lists no load drift of `group`.
+ProbePlace drift_probe_place(const std::vector<Augmentation>& planned, const std::string& group, int candidates);
 
 // The plans fix() tries as the simpler account of a confirmed planned[k]
 // (its effect's EffectInfo::simpler), fewest channels first: the plans of
