@@ -236,7 +236,13 @@
 # sensor-curve=0.7 and crosstalk=0.35, 2460-2469 every effect at its
 # larger strength and crosstalk=0.2; 2470-2474 two effects
 # (bench/residual_two_effects.sh), 2475-2494 clean sets
-# (bench/residual_false_positives.sh). Next unused: 2495 on.
+# (bench/residual_false_positives.sh). Stop 65 (the drift probe's place
+# and level): the drift sets 2460-2469 re-run as development, with the
+# cross-talk sets 2421, 2424, 2428 (0.2 and 0.35), 2452 and 2467 (at the
+# level 0.1), and the probe's p read off the clean sets 2430-2449 and
+# 2475-2494; 2495-2504 every effect at its larger strength and
+# crosstalk=0.2 measured with its final code, 2505-2524 clean sets,
+# 2525-2529 two effects. Next unused: 2530 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -104,7 +104,9 @@
 # 40). Stop 63: 2430-2449 measured with its final code (a mutual
 # cross-talk pair is not extended). Stop 64: 2450-2469 effect sets
 # (bench/residual_detection.sh), 2470-2474 two effects, 2475-2494 clean
-# sets measured with its final code (0 of 20). Next unused seed: 2495
+# sets measured with its final code (0 of 20). Stop 65: the probe's p
+# read off 2430-2449 and 2475-2494 (development of its level); 2505-2524
+# measured with its final code (0 of 20). Next unused seed: 2530
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

@@ -52,7 +52,9 @@
 # the rail); 2315-2319 measured the earlier round's candidates alone
 # (12 of 20; stop 61's code on the same logs 10), 2350-2354 and 2405-2409
 # the final code (17 of 20 each), nothing chosen on any of them. Stop
-# 64 (the richer account): 2470-2474 measured with its final code.
+# 64 (the richer account): 2470-2474 measured with its final code. Stop
+# 65 (the drift probe's place and level): 2525-2529 measured with its
+# final code.
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]... [--decision-loss L] [--decision-scale S] [--fix-selection R]

@@ -157,7 +157,8 @@ struct FixOptions {
   // drift probe (drift_probe.h) takes a place left when the screen proposes
   // no load drift of its group (or the only place, when no screened
   // candidate can be added), and is one beyond it when it follows the
-  // screen's load drift of its group.
+  // screen's load drift of its group or, last, one of another group
+  // (drift_probe_place).
   int candidates = 5;
   // With a calibrated null: the floor of excess_share (in units of the
   // channel's clean residual level) of the candidates fix() may try
