@@ -242,7 +242,9 @@
 # level 0.1), and the probe's p read off the clean sets 2430-2449 and
 # 2475-2494; 2495-2504 every effect at its larger strength and
 # crosstalk=0.2 measured with its final code, 2505-2524 clean sets,
-# 2525-2529 two effects. Next unused: 2530 on.
+# 2525-2529 two effects, 2530-2549 drift=0.02 (a second block, also
+# re-run where the change came into play with stop 64's binary). Next
+# unused: 2550 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -106,7 +106,7 @@
 # (bench/residual_detection.sh), 2470-2474 two effects, 2475-2494 clean
 # sets measured with its final code (0 of 20). Stop 65: the probe's p
 # read off 2430-2449 and 2475-2494 (development of its level); 2505-2524
-# measured with its final code (0 of 20). Next unused seed: 2530
+# measured with its final code (0 of 20). Next unused seed: 2550
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
