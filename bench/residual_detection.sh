@@ -243,8 +243,11 @@
 # 2475-2494; 2495-2504 every effect at its larger strength and
 # crosstalk=0.2 measured with its final code, 2505-2524 clean sets,
 # 2525-2529 two effects, 2530-2549 drift=0.02 (a second block, also
-# re-run where the change came into play with stop 64's binary). Next
-# unused: 2550 on.
+# re-run where the change came into play with stop 64's binary);
+# 2550-2559 every effect at its larger strength, measured with a
+# throw-away build (the curve through its rated range's top, not kept)
+# and re-run with the final code where that build fitted a curve;
+# 2560-2579 clean sets of that build. Next unused: 2580 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

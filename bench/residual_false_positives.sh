@@ -106,7 +106,8 @@
 # (bench/residual_detection.sh), 2470-2474 two effects, 2475-2494 clean
 # sets measured with its final code (0 of 20). Stop 65: the probe's p
 # read off 2430-2449 and 2475-2494 (development of its level); 2505-2524
-# measured with its final code (0 of 20). Next unused seed: 2550
+# measured with its final code (0 of 20); 2560-2579 with a throw-away
+# build of a curve rule not kept (0 of 20). Next unused seed: 2580
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
