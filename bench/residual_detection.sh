@@ -246,7 +246,9 @@
 # re-run where the change came into play with stop 64's binary);
 # 2550-2559 every effect at its larger strength, measured with a
 # throw-away build (the curve through its rated range's top, not kept)
-# and re-run with the final code where that build fitted a curve;
+# and re-run with the final code where that build fitted a curve (the
+# block then decided against that rule: development for a curve rule
+# since);
 # 2560-2579 clean sets of that build. Next unused: 2580 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
