@@ -7,22 +7,32 @@
 # images under QEMU (test/boards/), then the libFuzzer targets (fuzz preset:
 # clang, ASan + UBSan, 10 s each from their seeds), then the same host suite
 # under ASan + UBSan (debug preset: clang, CMakePresets.json says why), without
-# the tests labelled `slow` (model fine-tuning; they ran in release already).
+# the tests labelled `slow` (model fine-tuning; they ran in release already,
+# and the sanitizer build does not build the executables that hold only them).
+# Ends with each step's wall time, so a slow CI run shows where it went.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-scripts/setup.sh
+step_times=()
+step() {  # step COMMAND...: runs it and records its wall time in seconds
+  local start=$SECONDS
+  "$@"
+  step_times+=("$(printf '%6d s  %s' $((SECONDS - start)) "$*")")
+}
+trap 'printf "%s\n" "wall time per step:" "${step_times[@]}"' EXIT
+
+step scripts/setup.sh
 # The presets chain the builds: the cross build generates its model headers
 # with build/release's codegen, the release suite runs
 # build/cortex-m4/images under QEMU, and the fuzz build runs build/release's
 # codegen and fuzz tools (CMakePresets.json).
-scripts/build.sh release
-scripts/build.sh cortex-m4
+step scripts/build.sh release
+step scripts/build.sh cortex-m4
 echo "cross build (cortex-m4): ok"
-ctest --preset release
+step ctest --preset release
 # Fails (no skip) when clang or its libFuzzer runtime (libclang-rt-dev) is
 # missing.
-scripts/build.sh fuzz
-ctest --preset fuzz
-scripts/build.sh debug
-ctest --preset debug
+step scripts/build.sh fuzz
+step ctest --preset fuzz
+step scripts/build.sh debug
+step ctest --preset debug
