@@ -5,10 +5,11 @@
 # must compile without warnings, link no heap or exceptions and fit each
 # board's memory), then the release suite under CTest, which also runs the
 # images under QEMU (test/boards/), then the libFuzzer targets (fuzz preset:
-# clang, ASan + UBSan, 10 s each from their seeds), then the same host suite
-# under ASan + UBSan (debug preset: clang, CMakePresets.json says why), without
-# the tests labelled `slow` (model fine-tuning; they ran in release already,
-# and the sanitizer build does not build the executables that hold only them).
+# clang, ASan + UBSan, 10 s each from their seeds), then, under ASan + UBSan
+# (debug preset: clang, CMakePresets.json says why), the code that runs on the
+# MCU or reads untrusted input with its tests: the build without the trainer
+# (HADYNET_TRAINER OFF), whose Eigen numerics, CLI and their tests ran in the
+# release suite already.
 # Ends with each step's wall time, so a slow CI run shows where it went.
 set -euo pipefail
 cd "$(dirname "$0")/.."
