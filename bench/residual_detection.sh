@@ -253,8 +253,9 @@
 # stop 65's code): 2580-2599 clean sets, 2600-2609 sensor-curve=0.7,
 # 2610-2619 crosstalk=0.35, 2620-2629 drift=0.02, 2630-2639 friction=4,
 # all measured. Stop 67 (no change to the loop; RESIDUAL_ROWS=600):
-# 2640-2649 sensor-curve=0.7, 2650-2659 crosstalk=0.35, measured (2660-2679:
-# clean sets, bench/residual_false_positives.sh). Next unused: 2680 on.
+# 2640-2649 sensor-curve=0.7, 2650-2659 crosstalk=0.35, 2680-2689
+# drift=0.02, 2690-2699 friction=4, measured (2660-2679: clean sets,
+# bench/residual_false_positives.sh). Next unused: 2700 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...
