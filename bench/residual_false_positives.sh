@@ -110,7 +110,7 @@
 # build of a curve rule not kept (0 of 20). Stop 66 (no change to the
 # loop): 2580-2599 measured with stop 65's code (0 of 20). Stop 67 (no
 # change): 2660-2679 measured at RESIDUAL_ROWS=600 (0 of 20). Next unused
-# seed: 2700 (bench/residual_detection.sh lists the other seeds).
+# seed: 2720 (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
