@@ -256,8 +256,10 @@
 # 2640-2649 sensor-curve=0.7, 2650-2659 crosstalk=0.35, 2680-2689
 # drift=0.02, 2690-2699 friction=4, 2700-2709 sensor-delay=2 and
 # tension-leak=0.2, 2710-2719 input-delay=2 and saturation=2, measured
-# (2660-2679: clean sets, bench/residual_false_positives.sh). Next unused:
-# 2720 on.
+# (2660-2679: clean sets, bench/residual_false_positives.sh). Stop 68 (a
+# drift at rate 0 left out): 2686 and 2724 development; 2720-2729
+# drift=0.02, 2730-2739 drift=0.02 at RESIDUAL_ROWS=600, 2760-2769
+# drift=0.02, measured (2740-2759: clean sets). Next unused: 2770 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

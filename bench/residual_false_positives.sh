@@ -109,8 +109,9 @@
 # measured with its final code (0 of 20); 2560-2579 with a throw-away
 # build of a curve rule not kept (0 of 20). Stop 66 (no change to the
 # loop): 2580-2599 measured with stop 65's code (0 of 20). Stop 67 (no
-# change): 2660-2679 measured at RESIDUAL_ROWS=600 (0 of 20). Next unused
-# seed: 2720 (bench/residual_detection.sh lists the other seeds).
+# change): 2660-2679 measured at RESIDUAL_ROWS=600 (0 of 20). Stop 68:
+# 2740-2759 measured with its final code (0 of 20). Next unused seed: 2770
+# (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

@@ -362,6 +362,61 @@ TEST(SensorFrame, ThePlansCurvesAreFittedAsOneOnTheUnionOfTheirKnots) {
   EXPECT_NE(a.description.find("one curve, 5 knots"), std::string::npos) << a.description;
 }
 
+// A drift re-estimated at rate 0 changes nothing, so it leaves the change,
+// the affected channels and the channels the models are compared on
+// (found_on).
+// The plan of fresh drift set 2686 (600 rows, stop 67): the loadcells'
+// drift at one rate for the group, and the screen's family member f4 (a
+// tension), re-estimated at 0, which the change listed as drifting. A
+// faked probe of the unchanged network: fc0's and fc1's errors are least
+// at rate 0.02 (the grid of 2^(k/4) times 0.01 holds it), f4's grows with
+// its rate.
+TEST(SensorFrame, ADriftReEstimatedAtRateZeroLeavesTheChange) {
+  residual::Augmentation a;
+  a.kind = residual::EffectKind::kDriftLoad;
+  a.channels = {"fc0", "f4", "fc1"};
+  a.extended_channels = {"fc1"};
+  a.found_on = {"fc0", "f4", "fc1"};
+  auto& change = a.change.emplace<residual::BiasState>();
+  change.drifts = {{"fc0", true, 0.01}, {"f4", true, 0.003}, {"fc1", true, 0.0}};
+  change.period_s = 0.2;
+  change.common_rate = true;
+  residual::TrainingRmse rmse;
+  rmse.y_names = {"fc0", "fc1", "f4"};
+  rmse.all = [](const SensorModel& s) {
+    Eigen::VectorXd e = Eigen::VectorXd::Ones(3);
+    for (const SensorDrift& d : s.drifts) {
+      if (d.channel == "f4") e(2) += d.rate;
+      if (d.channel == "fc0") e(0) += std::pow(d.rate - 0.02, 2);
+      if (d.channel == "fc1") e(1) += std::pow(d.rate - 0.02, 2);
+    }
+    return e;
+  };
+  std::vector<double> fitted;
+  change.refine(a, SensorModel{}, rmse, fitted);
+  ASSERT_EQ(change.drifts.size(), 2u);
+  EXPECT_EQ(change.drifts[0].channel, "fc0");
+  EXPECT_EQ(change.drifts[1].channel, "fc1");
+  for (const SensorDrift& d : change.drifts) EXPECT_NEAR(d.rate, 0.02, 1e-12) << d.channel;
+  EXPECT_EQ(a.channels, (std::vector<std::string>{"fc0", "fc1"}));
+  EXPECT_EQ(a.extended_channels, (std::vector<std::string>{"fc1"}));
+  EXPECT_EQ(a.found_on, (std::vector<std::string>{"fc0", "fc1"}));
+  EXPECT_EQ(fitted, (std::vector<double>{0.01, 0.0}));  // the screen's rates of the drifts kept
+  EXPECT_NE(a.description.find("left out at rate 0: f4"), std::string::npos) << a.description;
+
+  // Every rate 0: the change stays as planned (it changes nothing and is never confirmed).
+  residual::Augmentation none = a;
+  auto& flat = std::get<residual::BiasState>(none.change);
+  flat.drifts = {{"f4", true, 0.003}};
+  flat.common_rate = false;
+  none.channels = {"f4"};
+  fitted.clear();
+  flat.refine(none, SensorModel{}, rmse, fitted);
+  ASSERT_EQ(flat.drifts.size(), 1u);
+  EXPECT_EQ(flat.drifts[0].rate, 0.0);
+  EXPECT_EQ(none.channels, (std::vector<std::string>{"f4"}));
+}
+
 // A cross-talk pair chains with a taken pair when its target is a taken
 // target (two removals of one channel) or a taken source (its removal
 // would change a source another removal subtracts as measured), or its

@@ -734,6 +734,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       const Tuned t = tune(&a, selection_train);
       const HeldOutError rows = judged(t.model, selection_judged);
       CandidateTrial& c = result.candidates[k];
+      // On the channels the re-estimated plan changes (a drift at rate 0 left out: BiasState::refine).
+      c.channels = channels_of(a);
       const std::vector<std::string>& judged_on = every_channel ? model.layout.y_names : c.channels;
       c.selection = diebold_mariano(standardised_loss(model, control_rows, judged_on, loss),
                                     standardised_loss(model, rows, judged_on, loss));
@@ -785,6 +787,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   result.loss_history = after.loss_history;
   result.train_windows = after.train_windows;
   result.after = judged(after.model, held_out_part);
+  // The channels the re-estimated plan changes (a drift at rate 0 left out:
+  // BiasState::refine), the same for both folds.
+  result.candidates[chosen].channels = channels_of(tested);
   result.confirmation_channels = result.candidates[chosen].channels;
   Segments reference_loss = standardised_loss(model, reference, result.confirmation_channels, loss, levels);
   Segments after_loss = standardised_loss(model, result.after, result.confirmation_channels, loss, levels);
@@ -910,11 +915,11 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     account.effect = plan.effect;
     account.replaces = planned[chosen].effect;
     account.description = plan.description;
-    account.channels = channels_of(plan);
     account.a_candidate = std::any_of(planned.begin(), planned.end(), [&](const Augmentation& a) {
       return a.kind == plan.kind && a.channels == plan.channels;
     });
     t = fold_trial(plan);
+    account.channels = channels_of(t.tested);  // as re-estimated, as the decision's
     account.against_reference = compare(reference, mirrored_reference, t.rows, t.mirrored, account.channels);
     account.gain_channels = result.confirmation_channels;
     for (const auto& name : account.channels)

@@ -279,6 +279,10 @@ struct BiasState : ModelChange {
   void refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
               std::vector<double>& fitted);
   bool carried_before_tuning() const { return true; }  // refine() fitted it
+
+ private:
+  // refine()'s last step: drops the drifts re-estimated at rate 0 (effects.cc).
+  void leave_out_zero_rates(Augmentation& a, std::size_t first, std::vector<double>& fitted);
 };
 
 // saturation: clipping: each family channel's prediction passes through

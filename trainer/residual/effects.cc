@@ -724,6 +724,42 @@ void BiasState::refine(Augmentation& a, const SensorModel& before, const Trainin
   }
   a.description += std::string(common_rate ? "; rates re-estimated (one for the group): " : "; rates re-estimated: ") +
                    rates;
+  leave_out_zero_rates(a, fitted.size() - drifts.size(), fitted);
+}
+
+// A drift re-estimated at rate 0 changes nothing: it leaves the change, the
+// affected channels (a.channels, a.extended_channels), the channels the
+// selection and the decision compare the models on (a.found_on: the
+// channels the fix changes) and `fitted` (whose entries from `first` on are
+// this change's drifts, in order), and the description says so. When every
+// rate is 0 the change stays as planned (a candidate that changes nothing,
+// never confirmed).
+void BiasState::leave_out_zero_rates(Augmentation& a, std::size_t first, std::vector<double>& fitted) {
+  const auto zero = [](const SensorDrift& d) { return d.rate == 0.0; };
+  if (std::all_of(drifts.begin(), drifts.end(), zero)) return;
+  std::vector<std::string> left_out;
+  std::vector<SensorDrift> kept;
+  std::vector<double> kept_fitted(fitted.begin(), fitted.begin() + static_cast<std::ptrdiff_t>(first));
+  for (std::size_t i = 0; i < drifts.size(); ++i) {
+    if (zero(drifts[i])) {
+      left_out.push_back(drifts[i].channel);
+      continue;
+    }
+    kept.push_back(drifts[i]);
+    kept_fitted.push_back(fitted[first + i]);
+  }
+  if (left_out.empty()) return;
+  const auto erase_left_out = [&](std::vector<std::string>& names) {
+    std::erase_if(names, [&](const std::string& n) {
+      return std::find(left_out.begin(), left_out.end(), n) != left_out.end();
+    });
+  };
+  erase_left_out(a.channels);
+  erase_left_out(a.extended_channels);
+  erase_left_out(a.found_on);
+  drifts = std::move(kept);
+  fitted = std::move(kept_fitted);
+  a.description += "; left out at rate 0: " + join(left_out);
 }
 
 namespace {
