@@ -42,7 +42,10 @@
 # became development of --decision-loss): 6 of 10 confirmed, 5 pass.
 # Stop 62: re-run on the sensor-curve=0.7 sets 2320-2329 (measured with
 # stop 62's tool first, nothing chosen on them): 10 of 10 confirmed, 8
-# pass (the patch moved to stop 62's augment.cc).
+# pass (the patch moved to stop 62's augment.cc). Stop 68: re-run on the
+# 600-row sensor-curve=0.7 sets 2640-2649 (measured with stop 65's tool in
+# stop 67, nothing chosen on them): 8 of 10 confirmed, 7 pass (the patch
+# moved to stop 68's augment.cc).
 set -euo pipefail
 usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
 model=models/hand-4seeds.safetensors
