@@ -260,8 +260,10 @@
 # drift at rate 0 left out): 2686 and 2724 development; 2720-2729
 # drift=0.02, 2730-2739 drift=0.02 at RESIDUAL_ROWS=600, 2760-2769
 # drift=0.02, measured (2740-2759: clean sets); after their measurement
-# 2629, 2724, 2763 and 2768 development of a selection rule not kept.
-# Next unused: 2770 on.
+# 2629, 2724, 2763 and 2768 development of a selection rule not kept,
+# 2762 of the probe's place (a drift family that holds its group);
+# 2770-2789 drift=0.02 measured with the final code (2790-2809: clean
+# sets). Next unused: 2810 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -110,8 +110,9 @@
 # build of a curve rule not kept (0 of 20). Stop 66 (no change to the
 # loop): 2580-2599 measured with stop 65's code (0 of 20). Stop 67 (no
 # change): 2660-2679 measured at RESIDUAL_ROWS=600 (0 of 20). Stop 68:
-# 2740-2759 measured with its final code (0 of 20). Next unused seed: 2770
-# (bench/residual_detection.sh lists the other seeds).
+# 2740-2759 measured with its first change (a drift at rate 0; 0 of 20),
+# 2790-2809 with its final code (the probe's place; 0 of 20). Next unused
+# seed: 2810 (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

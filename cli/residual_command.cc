@@ -267,8 +267,8 @@ int run_residual(int argc, char** argv) {
                               "the drift probe asks each channel group whether a load drift at one rate, fitted on the\n"
                               "first 75 % of the training rows, makes the unchanged network predict the rest better\n"
                               "(one-sided Diebold-Mariano, Holm over the groups), and the best group that does is one\n"
-                              "more candidate (after the screen's drift of its group, beyond K, when it lists one; last, beyond\n"
-                              "K, when it lists a load drift of another group)", "5");
+                              "more candidate (after the screen's drift of its group, one holding a channel of it, beyond\n"
+                              "K, when it lists one; last, beyond K, when it lists a load drift of another group)", "5");
   opt.value("fix-min-excess-null", "S",
             "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"
             "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"

@@ -886,6 +886,15 @@ TEST(DriftProbe, ItsCandidateFollowsTheScreensDriftOfItsGroupElseComesLast) {
   EXPECT_TRUE(residual::drift_probe_has_place({f_drift, curve, crosstalk}, 3));
   EXPECT_EQ(place({f_drift, curve, crosstalk}, "fc"), std::make_pair(std::size_t{3}, false));
   EXPECT_EQ(place({f_drift, curve, crosstalk}, "f"), std::make_pair(std::size_t{1}, false));
+  // A drift family led by a tendon's tension that holds a loadcell (drift
+  // set 2762 of stop 68: f4 and fc4) is a drift of both groups: the
+  // loadcells' probe follows it. Until stop 68 it came last, beyond the
+  // count, and a curve gained first on the selection's rows.
+  auto mixed_drift = f_drift;
+  mixed_drift.channels = {"f4", "fc4"};
+  EXPECT_EQ(place({mixed_drift, curve, crosstalk}, "fc"), std::make_pair(std::size_t{1}, false));
+  EXPECT_EQ(place({mixed_drift, curve, crosstalk}, "f"), std::make_pair(std::size_t{1}, false));
+  EXPECT_EQ(place({mixed_drift, curve, crosstalk}, "l"), std::make_pair(std::size_t{3}, false));
   // Nothing that can be added: the only one.
   auto unfixable = curve;
   unfixable.not_fixable = "no knots";

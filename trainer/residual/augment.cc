@@ -367,8 +367,13 @@ bool drift_probe_has_place(const std::vector<Augmentation>& planned, int candida
 
 ProbePlace drift_probe_place(const std::vector<Augmentation>& planned, const std::string& group, int candidates) {
   if (none_addable(planned)) return {0, true};
+  // A load drift of the group: one that holds a channel of it, whichever
+  // channel leads its family (a loadcell drift also shows on a tendon's
+  // tension, which can lead the screen's family: drift set 2762).
   const auto last = std::find_if(planned.rbegin(), planned.rend(), [&](const Augmentation& a) {
-    return addable_load_drift(a) && channel_group(a.channels.front()) == group;
+    return addable_load_drift(a) && std::any_of(a.channels.begin(), a.channels.end(), [&](const std::string& name) {
+             return channel_group(name) == group;
+           });
   });
   if (last != planned.rend()) return {static_cast<std::size_t>(planned.rend() - last), false};
   if (!drift_probe_has_place(planned, candidates)) throw std::logic_error("drift_probe_place: the probe has no place");

@@ -420,7 +420,8 @@ bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k);
 // screen's plans `planned` (plan_candidates(), at most `candidates`):
 // right after the screen's last load drift of the probe's group when it
 // lists one (a drift's third plan, beside its family and the family alone,
-// beyond `candidates`); else last: where a place is left, or beyond
+// beyond `candidates`; a drift of the group holds a channel of it, whichever
+// channel leads it: since stop 68); else last: where a place is left, or beyond
 // `candidates` when the screen lists a load drift of another group (the
 // probe then names the group the screen's drift missed: on the loadcells'
 // drift set 2461 of stop 64 the screen proposed a drift of one tendon and
