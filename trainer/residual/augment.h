@@ -353,7 +353,8 @@ struct Augmentation {
   std::vector<std::string> channels;
   // The model's y channels the effect was found on: the decision compares
   // the models there (fix()). The channels above, or for an aux channel the
-  // targets it explains.
+  // targets it explains; a drift re-estimated at rate 0 leaves it
+  // (BiasState::refine: the change does nothing there).
   std::vector<std::string> found_on;
   // The selection and the decision compare the models on every channel of
   // the model, not only on found_on. A calibration curve: it changes the

@@ -674,6 +674,7 @@ void BiasState::add_to_sensor(SensorModel& s, const Augmentation&) const {
 void BiasState::refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
                        std::vector<double>& fitted) {
   if (drifts.empty()) return;
+  const std::size_t first_fitted = fitted.size();  // this change's entries of `fitted` start here
   for (const SensorDrift& drift : drifts) fitted.push_back(drift.rate);
   const std::string group = channel_group(drifts.front().channel);
   // A time drift of the other sign keeps its own rate (a load drift's is >= 0).
@@ -724,7 +725,7 @@ void BiasState::refine(Augmentation& a, const SensorModel& before, const Trainin
   }
   a.description += std::string(common_rate ? "; rates re-estimated (one for the group): " : "; rates re-estimated: ") +
                    rates;
-  leave_out_zero_rates(a, fitted.size() - drifts.size(), fitted);
+  leave_out_zero_rates(a, first_fitted, fitted);
 }
 
 // A drift re-estimated at rate 0 changes nothing: it leaves the change, the
