@@ -263,7 +263,13 @@
 # 2629, 2724, 2763 and 2768 development of a selection rule not kept,
 # 2762 of the probe's place (a drift family that holds its group);
 # 2770-2789 drift=0.02 measured with the final code (2790-2809: clean
-# sets). Next unused: 2810 on.
+# sets). Stop 69 (a drift family gives way to the drift probe's plan of
+# its group): 2629, 2724, 2763 and 2768 development (and seed 11's
+# injected tension drift, a suite test, for the rule's comparison);
+# 2770-2789 re-run as a measurement; 2810-2829 drift=0.02 and 2850-2859
+# every effect at its larger strength and drift=0.01, measured with the
+# rule's first version (2830-2849: clean sets); 2860-2879 drift=0.02
+# measured with its final version. Next unused: 2880 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -111,8 +111,9 @@
 # loop): 2580-2599 measured with stop 65's code (0 of 20). Stop 67 (no
 # change): 2660-2679 measured at RESIDUAL_ROWS=600 (0 of 20). Stop 68:
 # 2740-2759 measured with its first change (a drift at rate 0; 0 of 20),
-# 2790-2809 with its final code (the probe's place; 0 of 20). Next unused
-# seed: 2810 (bench/residual_detection.sh lists the other seeds).
+# 2790-2809 with its final code (the probe's place; 0 of 20). Stop 69 (a
+# drift family gives way to its group): 2830-2849. Next unused seed: 2880
+# (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]

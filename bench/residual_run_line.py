@@ -8,8 +8,11 @@ test), shared by bench/residual_detection.sh and bench/residual_oracle.sh.
                   (bench/residual_named.py's rule for the plant effect);
         cut       the held-out 1-step RMSE on the changed channels (mean
                   ratio after/before) is at most 0.7 (the changed channels
-                  the decision judged, or a simpler account's, when one was
-                  applied: its own test's);
+                  the decision judged, with those of every wider plan
+                  applied after it (fix.extensions: its own test's; since
+                  stop 69, before which a drift confirmed on fc3 and then
+                  applied on its whole group was cut on fc3 alone), or a
+                  simpler account's, when one was applied: its own test's);
         <control  the augmented model's summed RMSE there is below
                   fine-tuning alone's.
   residual_run_line.py table RUNS_FILE CASE...
@@ -45,6 +48,11 @@ def run_line(case, seed, path, progress):
         # change's place (fix.simpler) was confirmed on its own channels.
         simpler = fix.get("simpler") or {}
         judged = simpler["channels"] if simpler.get("applied") else fix.get("confirmation", {}).get("channels")
+        # A wider plan applied after the confirmation (fix.extensions) changes
+        # the channels its own test judged too.
+        for wider in fix.get("extensions") or []:
+            if wider.get("applied"):
+                judged = list(judged or []) + [c for c in wider.get("channels", []) if c not in (judged or [])]
         # The changed channels among them: a calibration curve is judged on
         # every channel (Augmentation::judged_on_every_channel) and cut on
         # its curved ones; an aux channel's decision is on the targets it

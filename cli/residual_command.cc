@@ -164,12 +164,17 @@ void print_fix(const rs::FixResult& fixed) {
   // The selection's candidates, also when it tested none (no gain, no decision).
   if (fixed.candidates.size() > 1 && (fixed.tried || fixed.none_gained)) {
     std::printf("candidates (the screen's order; * the one tested: the first whose gain over fine-tuning alone\n"
-                "on the training rows' last 25 %% is significant, else the clearest gain; none when none gains):\n");
+                "on the training rows' last 25 %% is significant, else the clearest gain; none when none gains;\n"
+                "a load drift gives way to the drift probe's plan of its group when that plan gains there too\n"
+                "and predicts the channels either changes better there):\n");
     for (const auto& c : fixed.candidates) {
       std::printf("  %c %-74.74s", c.chosen ? '*' : ' ', (c.effect + ": " + c.description).c_str());
       if (c.below_screen_floor) std::printf(" below the screen's floor (%.2g);", c.screen_statistic);
       if (c.from_drift_probe) std::printf(" the drift probe's;");
       if (c.from_earlier_round) std::printf(" an earlier round's;");
+      if (c.group_drift_gain)
+        std::printf(" the drift probe's plan of its group %s (DM %.2f);",
+                    c.gave_way_to_group_drift ? "predicts better: gave way" : "not preferred", c.group_drift_gain->stat);
       if (c.selected_by_training_rows)
         std::printf(" training rows: DM %.2f, p %.2g\n", c.selection.stat, c.selection.p_value);
       else std::printf(" not judged\n");
@@ -268,7 +273,9 @@ int run_residual(int argc, char** argv) {
                               "first 75 % of the training rows, makes the unchanged network predict the rest better\n"
                               "(one-sided Diebold-Mariano, Holm over the groups), and the best group that does is one\n"
                               "more candidate (after the screen's drift of its group, one holding a channel of it, beyond\n"
-                              "K, when it lists one; last, beyond K, when it lists a load drift of another group)", "5");
+                              "K, when it lists one; last, beyond K, when it lists a load drift of another group); a\n"
+                              "load drift of its group chosen on the training rows gives way to it when it gains there\n"
+                              "too and predicts the channels either changes better there", "5");
   opt.value("fix-min-excess-null", "S",
             "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"
             "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"

@@ -160,6 +160,12 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                             {"below_screen_floor", c.below_screen_floor},
                             {"from_drift_probe", c.from_drift_probe},
                             {"from_earlier_round", c.from_earlier_round},
+                            {"group_drift_gain", c.group_drift_gain
+                                                     ? json{{"statistic", c.group_drift_gain->stat},
+                                                            {"p_value", c.group_drift_gain->p_value},
+                                                            {"mean_loss_difference", c.group_drift_gain->mean}}
+                                                     : json()},
+                            {"gave_way_to_group_drift", c.gave_way_to_group_drift},
                             {"selected_by_training_rows", c.selected_by_training_rows},
                             {"selection_statistic", c.selection.stat},
                             {"selection_p_value", c.selection.p_value},

@@ -550,17 +550,21 @@ TEST(FixCandidates, TheSimplerAccountIsARailOnTheCurvesLeadChannel) {
   EXPECT_EQ(simpler(planned), Channels{});
 }
 
+// A plan of `kind` on `channels`, as plan_candidates() gives it; the rules
+// tested with it read only kind, channels and not_fixable.
+residual::Augmentation planned_on(residual::EffectKind kind, std::vector<std::string> channels) {
+  residual::Augmentation a;
+  a.kind = kind;
+  a.channels = std::move(channels);
+  return a;
+}
+
 // The simpler account of a confirmed friction (EffectInfo::simpler: a
 // calibration curve, a static map where friction adds a state): the curves
 // planned on its lead channel, fewest channels first; none for a curve of
 // its group that leaves the lead channel out.
 TEST(FixCandidates, TheSimplerAccountOfFrictionIsACurveOnItsLeadChannel) {
-  const auto plan = [](residual::EffectKind kind, std::vector<std::string> channels) {
-    residual::Augmentation a;
-    a.kind = kind;
-    a.channels = std::move(channels);
-    return a;
-  };
+  const auto plan = planned_on;
   using residual::EffectKind;
   residual::ResidualData data;
   data.y_names = {"fc0", "fc1", "fc2", "fc3", "fc4", "fc5", "fc6", "fc7", "fc8"};
@@ -904,6 +908,36 @@ TEST(DriftProbe, ItsCandidateFollowsTheScreensDriftOfItsGroupElseComesLast) {
   auto unfixable_drift = f_drift;
   unfixable_drift.not_fixable = "no level";
   EXPECT_FALSE(residual::drift_probe_has_place({curve, unfixable_drift, crosstalk}, 3));
+}
+
+// Which choice of the selection gives way to the drift probe's plan of its
+// group (stop 69: on drift sets 2763 and 2768 the screen's drift of one to
+// three loadcells was chosen and not confirmed, where the plant's drift of
+// every loadcell passes). Only kind, channels and not_fixable matter.
+TEST(DriftProbe, ALoadDriftOfItsGroupGivesWayToItsPlanAndNothingElseDoes) {
+  const auto plan = planned_on;
+  using residual::EffectKind;
+  const auto probe = plan(EffectKind::kDriftLoad, {"fc0", "fc1", "fc2", "fc3"});
+  const auto family = plan(EffectKind::kDriftLoad, {"fc3", "fc1"});
+  const auto tendon_led = plan(EffectKind::kDriftLoad, {"f4", "fc4"});  // 2762's family: holds a loadcell
+  const auto tendon = plan(EffectKind::kDriftLoad, {"f4"});
+  const auto time_drift = plan(EffectKind::kDriftTime, {"fc3"});
+  const auto curve = plan(EffectKind::kSensorCurve, {"fc3"});
+  const std::vector<residual::Augmentation> planned = {curve, family, tendon_led, tendon, time_drift, probe};
+  const std::size_t probed = planned.size() - 1;
+  EXPECT_TRUE(residual::gives_way_to_group_drift(planned, 1, probed));
+  EXPECT_TRUE(residual::gives_way_to_group_drift(planned, 2, probed));
+  // Another group's drift, another kind of drift, another effect: no.
+  EXPECT_FALSE(residual::gives_way_to_group_drift(planned, 3, probed));
+  EXPECT_FALSE(residual::gives_way_to_group_drift(planned, 4, probed));
+  EXPECT_FALSE(residual::gives_way_to_group_drift(planned, 0, probed));
+  // The probe's own plan, or an index out of range: no.
+  EXPECT_FALSE(residual::gives_way_to_group_drift(planned, probed, probed));
+  EXPECT_FALSE(residual::gives_way_to_group_drift(planned, 1, planned.size()));
+  // A drift that cannot be added is no choice to give way.
+  auto unfixable = planned;
+  unfixable[1].not_fixable = "no level";
+  EXPECT_FALSE(residual::gives_way_to_group_drift(unfixable, 1, probed));
 }
 
 // A model of two y channels, a and b, of standard deviations 2 and 4.

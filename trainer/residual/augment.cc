@@ -380,6 +380,17 @@ ProbePlace drift_probe_place(const std::vector<Augmentation>& planned, const std
   return {planned.size(), false};
 }
 
+bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::size_t chosen, std::size_t probed) {
+  if (chosen == probed || chosen >= planned.size() || probed >= planned.size()) return false;
+  const Augmentation& probe = planned[probed];
+  if (probe.kind != EffectKind::kDriftLoad || probe.channels.empty()) return false;
+  const std::string group = channel_group(probe.channels.front());
+  const Augmentation& a = planned[chosen];
+  return addable_load_drift(a) && std::any_of(a.channels.begin(), a.channels.end(), [&](const std::string& name) {
+           return channel_group(name) == group;
+         });
+}
+
 bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k) {
   return k > 0 && k < planned.size() && !planned[k].group_extension && planned[k - 1].kind == planned[k].kind &&
          !planned[k - 1].extended_channels.empty();
@@ -733,11 +744,13 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     const Tuned control = tune(nullptr, selection_train);
     const HeldOutError control_rows = judged(control.model, selection_judged);
     const bool every_channel = options.selection == SelectionRule::kEveryChannel;
-    for (std::size_t k = 0; k < planned.size(); ++k) {
+    // Each judged candidate's errors on the selection's judged rows.
+    std::vector<std::optional<HeldOutError>> judged_rows(planned.size());
+    const auto judge = [&](std::size_t k) {
       // Re-estimated on the selection's training rows alone (the rows it is judged on stay unseen).
       const Augmentation a = refined(planned[k], selection_train, nullptr);
       const Tuned t = tune(&a, selection_train);
-      const HeldOutError rows = judged(t.model, selection_judged);
+      const HeldOutError& rows = judged_rows[k].emplace(judged(t.model, selection_judged));
       CandidateTrial& c = result.candidates[k];
       // On the channels the re-estimated plan changes (a drift at rate 0 left out: BiasState::refine).
       c.channels = channels_of(a);
@@ -746,8 +759,11 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
                                     standardised_loss(model, rows, judged_on, loss));
       c.selected_by_training_rows = true;
       c.description = a.description;  // as judged: re-estimated on the selection's training rows
+    };
+    for (std::size_t k = 0; k < planned.size(); ++k) {
+      judge(k);
       // chosen_candidate's choice: the rest are not needed
-      if (!every_channel && gains_significantly(c, attribution.options.alpha)) break;
+      if (!every_channel && gains_significantly(result.candidates[k], attribution.options.alpha)) break;
     }
     const std::optional<std::size_t> supported = every_channel
                                                      ? best_candidate(result.candidates, attribution.options.alpha)
@@ -769,6 +785,25 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       return result;
     }
     chosen = *supported;
+    // A drift family gives way to the drift probe's plan of its group when
+    // that plan gains on the selection's rows too and predicts the channels
+    // either changes better there (gives_way_to_group_drift).
+    if (probed && judged_rows[chosen] && gives_way_to_group_drift(planned, chosen, *probed)) {
+      if (!judged_rows[*probed]) judge(*probed);
+      CandidateTrial& family = result.candidates[chosen];
+      const CandidateTrial& group = result.candidates[*probed];
+      std::vector<std::string> either;  // in the model's order
+      for (const auto& name : model.layout.y_names)
+        if (std::find(family.channels.begin(), family.channels.end(), name) != family.channels.end() ||
+            std::find(group.channels.begin(), group.channels.end(), name) != group.channels.end())
+          either.push_back(name);
+      family.group_drift_gain = diebold_mariano(standardised_loss(model, *judged_rows[chosen], either, loss),
+                                                standardised_loss(model, *judged_rows[*probed], either, loss));
+      if (group.selection.mean > 0 && family.group_drift_gain->mean > 0) {
+        family.gave_way_to_group_drift = true;
+        chosen = *probed;
+      }
+    }
   }
   result.candidates[chosen].chosen = true;
 

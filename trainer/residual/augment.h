@@ -413,6 +413,21 @@ std::string why_not_fixable(const ResidualData& data, const Attribution& attribu
 // supported"). Empty without a winner.
 std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attribution& attribution, int count);
 
+// Whether the selection's choice planned[chosen] may give way to the drift
+// probe's plan planned[probed] (drift_probe.h: a load drift of every channel
+// of one group at one rate): planned[chosen] is another load drift that
+// holds a channel of the probe's group (as drift_probe_place()), the
+// screen's family of one to three channels, each at its own rate. fix()
+// then judges the probe's plan on the selection's rows if it has not, and
+// tests it instead when, on those rows, it gains over fine-tuning alone and
+// predicts the channels either plan changes better than the chosen plan
+// (the mean of the loss difference, CandidateTrial::group_drift_gain,
+// positive; docs/residual.md, "A drift family gives way to its group",
+// stop 69): the probe saw the drift on the whole group with the unchanged
+// network, and sensors of one kind age together, unless their rates differ
+// so much that one rate for the group predicts worse.
+bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::size_t chosen, std::size_t probed);
+
 // Whether planned[k] of plan_candidates() is a family alone: the plan right
 // after the same plan extended to its group.
 bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k);
@@ -515,6 +530,15 @@ struct CandidateTrial {
   // Proposed by an earlier round's screen (FixOptions::earlier_candidates):
   // its screen_statistic is that round's.
   bool from_earlier_round = false;
+  // Chosen by the selection, a load drift of the drift probe's group
+  // (gives_way_to_group_drift): on the selection's judged rows, this plan's
+  // loss minus the probe plan's, over the channels either changes (each
+  // fine-tuned on the selection's training rows).
+  std::optional<DieboldMariano> group_drift_gain;
+  // ... and given way to the probe's plan, which the decision tested
+  // instead: it gained over fine-tuning alone and group_drift_gain's mean
+  // is positive.
+  bool gave_way_to_group_drift = false;
 };
 
 // One channel group's drift probe (drift_probe.h, probe_drifts): a load
