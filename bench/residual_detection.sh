@@ -270,7 +270,8 @@
 # every effect at its larger strength and drift=0.01, measured with the
 # rule's first version (2830-2849: clean sets); 2860-2879 drift=0.02
 # and 2880-2889 drift=0.02 at RESIDUAL_ROWS=600 measured with its final
-# version. Next unused: 2890 on.
+# version (2890-2909: clean sets at RESIDUAL_ROWS=600). Next unused:
+# 2910 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -112,7 +112,8 @@
 # change): 2660-2679 measured at RESIDUAL_ROWS=600 (0 of 20). Stop 68:
 # 2740-2759 measured with its first change (a drift at rate 0; 0 of 20),
 # 2790-2809 with its final code (the probe's place; 0 of 20). Stop 69 (a
-# drift family gives way to its group): 2830-2849. Next unused seed: 2890
+# drift family gives way to its group): 2830-2849 (its first version),
+# 2890-2909 at RESIDUAL_ROWS=600 (its final version). Next unused seed: 2910
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
