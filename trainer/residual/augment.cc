@@ -353,6 +353,14 @@ namespace {
 bool addable_load_drift(const Augmentation& a) {
   return a.not_fixable.empty() && a.kind == EffectKind::kDriftLoad && !a.channels.empty();
 }
+// A load drift of `group`: one that holds a channel of it, whichever
+// channel leads its family (a loadcell drift also shows on a tendon's
+// tension, which can lead the screen's family: drift set 2762).
+bool load_drift_of_group(const Augmentation& a, const std::string& group) {
+  return addable_load_drift(a) && std::any_of(a.channels.begin(), a.channels.end(), [&](const std::string& name) {
+           return channel_group(name) == group;
+         });
+}
 // No plan can be added: the screen proposed nothing, or its winner's plan
 // says why it cannot be added (plan_candidates).
 bool none_addable(const std::vector<Augmentation>& planned) {
@@ -367,14 +375,8 @@ bool drift_probe_has_place(const std::vector<Augmentation>& planned, int candida
 
 ProbePlace drift_probe_place(const std::vector<Augmentation>& planned, const std::string& group, int candidates) {
   if (none_addable(planned)) return {0, true};
-  // A load drift of the group: one that holds a channel of it, whichever
-  // channel leads its family (a loadcell drift also shows on a tendon's
-  // tension, which can lead the screen's family: drift set 2762).
-  const auto last = std::find_if(planned.rbegin(), planned.rend(), [&](const Augmentation& a) {
-    return addable_load_drift(a) && std::any_of(a.channels.begin(), a.channels.end(), [&](const std::string& name) {
-             return channel_group(name) == group;
-           });
-  });
+  const auto last = std::find_if(planned.rbegin(), planned.rend(),
+                                 [&](const Augmentation& a) { return load_drift_of_group(a, group); });
   if (last != planned.rend()) return {static_cast<std::size_t>(planned.rend() - last), false};
   if (!drift_probe_has_place(planned, candidates)) throw std::logic_error("drift_probe_place: the probe has no place");
   return {planned.size(), false};
@@ -384,11 +386,7 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
   if (chosen == probed || chosen >= planned.size() || probed >= planned.size()) return false;
   const Augmentation& probe = planned[probed];
   if (probe.kind != EffectKind::kDriftLoad || probe.channels.empty()) return false;
-  const std::string group = channel_group(probe.channels.front());
-  const Augmentation& a = planned[chosen];
-  return addable_load_drift(a) && std::any_of(a.channels.begin(), a.channels.end(), [&](const std::string& name) {
-           return channel_group(name) == group;
-         });
+  return load_drift_of_group(planned[chosen], channel_group(probe.channels.front()));
 }
 
 bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k) {
