@@ -155,6 +155,7 @@ void print_fix(const rs::FixResult& fixed) {
       std::printf("; on its own channels mean loss difference %.3g", fixed.own_channels->mean);
     std::printf(": %s\n", fixed.changed ? "confirmed" : "not confirmed, nothing applied");
     if (fixed.simpler) std::printf("%s\n", simpler_sentence(*fixed.simpler, fixed.reference).c_str());
+    if (fixed.rival) std::printf("%s\n", rival_sentence(*fixed.rival, fixed.reference).c_str());
     if (fixed.richer) std::printf("%s\n", richer_sentence(*fixed.richer, fixed.reference).c_str());
     for (const auto& wider : fixed.extensions) std::printf("%s\n", extension_sentence(wider).c_str());
     if (replaced_after_decision(fixed)) std::printf("the before/after above are the plan applied last\n");
@@ -275,7 +276,11 @@ int run_residual(int argc, char** argv) {
                               "more candidate (after the screen's drift of its group, one holding a channel of it, beyond\n"
                               "K, when it lists one; last, beyond K, when it lists a load drift of another group); a\n"
                               "load drift of its group chosen on the training rows gives way to it when it gains there\n"
-                              "too and predicts the channels either changes better there", "5");
+                              "too and predicts the channels either changes better there; a calibration curve and a load\n"
+                              "drift of one group are rivals: when the one chosen has a rival that gained on those rows\n"
+                              "too, the best such rival is tested beside it on the held-out rows, the two at Holm's\n"
+                              "levels (the smaller p at half the level), and of two confirmed the one that predicts the\n"
+                              "channels either changes better is applied", "5");
   opt.value("fix-min-excess-null", "S",
             "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"
             "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"

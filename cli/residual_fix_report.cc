@@ -151,6 +151,32 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                                           {"p_value", a.gain.p_value}};
       j["richer"] = account;
     }
+    // The rival tested beside the selection's choice (FixResult::rival).
+    if (f.rival) {
+      const rs::FixResult::Rival& r = *f.rival;
+      json rival = {{"candidate", r.candidate},
+                    {"effect", r.effect},
+                    {"description", r.description},
+                    {"channels", r.channels},
+                    {"against", f.reference},
+                    {"mean_loss_difference", r.confirmation.mean},
+                    {"statistic", r.confirmation.stat},
+                    {"rows", r.confirmation.samples},
+                    {"p_value", r.confirmation.p_value},
+                    {"own_channels_mean_loss_difference", r.own_channels ? json(r.own_channels->mean) : json()},
+                    {"levels", "Holm for two: the smaller p at alpha / 2, the other at alpha"},
+                    {"confirmed", r.confirmed},
+                    {"chosen_effect", r.chosen_effect},
+                    {"chosen_p_value", r.chosen_confirmation.p_value},
+                    {"chosen_confirmed", r.chosen_confirmed},
+                    {"applied", r.applied}};
+      if (r.gain)
+        rival["gain_over_chosen"] = {{"channels", r.gain_channels},
+                                     {"mean_loss_difference", r.gain->mean},
+                                     {"statistic", r.gain->stat},
+                                     {"p_value", r.gain->p_value}};
+      j["rival"] = rival;
+    }
     json candidates = json::array();
     for (const auto& c : f.candidates)
       candidates.push_back({{"effect", c.effect},
@@ -264,6 +290,24 @@ std::string richer_sentence(const rs::FixResult::RicherAccount& r, const std::st
                         : "no significant gain, " + r.replaces + " kept");
 }
 
+std::string rival_sentence(const rs::FixResult::Rival& r, const std::string& reference) {
+  std::string m = "Rival of " + r.chosen_effect + ": " + r.effect + " (" + r.description +
+                  "), tested beside it against " + reference + " on the held-out rows of " +
+                  comma_separated(r.channels) + " (Diebold-Mariano, " + std::to_string(r.confirmation.samples) +
+                  " rows): mean loss difference " + num("%.3g", r.confirmation.mean) + ", p " +
+                  num("%.2g", r.confirmation.p_value);
+  if (r.own_channels) m += "; on its own channels mean loss difference " + num("%.3g", r.own_channels->mean);
+  m += "; " + r.chosen_effect + "'s p " + num("%.2g", r.chosen_confirmation.p_value) +
+       "; at Holm's levels for two (the smaller p at " + num("%.3g", r.alpha / 2) + ", the other at " +
+       num("%.3g", r.alpha) + "): " + r.effect + (r.confirmed ? " confirmed, " : " not confirmed, ") + r.chosen_effect +
+       (r.chosen_confirmed ? " confirmed" : " not confirmed");
+  if (r.gain)
+    m += "; " + r.chosen_effect + " against " + r.effect + " on " + comma_separated(r.gain_channels) +
+         ": mean loss difference " + num("%.3g", r.gain->mean);
+  if (r.applied) return m + ": " + r.effect + " applied in its place";
+  return m + (r.chosen_confirmed ? ": " + r.chosen_effect + " kept" : "");
+}
+
 std::string extension_sentence(const rs::FixResult::Extension& e) {
   std::string m = "Extension to " + e.what + ": ";
   m += comma_separated(e.channels);
@@ -322,6 +366,7 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
            (f.own_channels->mean > 0 ? " (it does)" : " (it does not)") + ".\n\n";
     }
     if (f.simpler) m += simpler_sentence(*f.simpler, f.reference) + ".\n\n";
+    if (f.rival) m += rival_sentence(*f.rival, f.reference) + ".\n\n";
     if (f.richer) m += richer_sentence(*f.richer, f.reference) + ".\n\n";
     for (const auto& e : f.extensions) m += extension_sentence(e) + ".\n\n";
     if (replaced_after_decision(f)) m += "The before/after below are the plan applied last.\n\n";

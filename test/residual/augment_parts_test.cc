@@ -940,6 +940,38 @@ TEST(DriftProbe, ALoadDriftOfItsGroupGivesWayToItsPlanAndNothingElseDoes) {
   EXPECT_FALSE(residual::gives_way_to_group_drift(unfixable, 1, probed));
 }
 
+// A curve's rivals are the load drifts of its group, a load drift's the
+// curves of its groups: the two the training rows cannot tell apart.
+TEST(DecisionRivals, ACurveAndALoadDriftOfOneGroupAreEachOthersRivalsAndNothingElseIs) {
+  const auto plan = planned_on;
+  using residual::EffectKind;
+  using Rivals = std::vector<std::size_t>;
+  const auto curve = plan(EffectKind::kSensorCurve, {"fc3", "fc1"});
+  const auto family = plan(EffectKind::kDriftLoad, {"fc1"});
+  const auto tendon_led = plan(EffectKind::kDriftLoad, {"f4", "fc4"});  // holds a loadcell
+  const auto tendon = plan(EffectKind::kDriftLoad, {"f4"});
+  const auto time_drift = plan(EffectKind::kDriftTime, {"fc3"});
+  const auto crosstalk = plan(EffectKind::kCrosstalk, {"fc3"});
+  const auto tendon_curve = plan(EffectKind::kSensorCurve, {"f2"});
+  const std::vector<residual::Augmentation> planned = {curve,      family,    tendon_led,  tendon,
+                                                       time_drift, crosstalk, tendon_curve};
+  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 2}));
+  EXPECT_EQ(residual::decision_rivals(planned, 1), (Rivals{0}));
+  // A drift of a tendon and a loadcell: the curves of either group.
+  EXPECT_EQ(residual::decision_rivals(planned, 2), (Rivals{0, 6}));
+  EXPECT_EQ(residual::decision_rivals(planned, 3), (Rivals{6}));
+  EXPECT_EQ(residual::decision_rivals(planned, 6), (Rivals{2, 3}));
+  // A drift with time, another effect, an index out of range: none.
+  EXPECT_TRUE(residual::decision_rivals(planned, 4).empty());
+  EXPECT_TRUE(residual::decision_rivals(planned, 5).empty());
+  EXPECT_TRUE(residual::decision_rivals(planned, planned.size()).empty());
+  // A plan that cannot be added is no rival, and has none.
+  auto unfixable = planned;
+  unfixable[1].not_fixable = "no level";
+  EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{2}));
+  EXPECT_TRUE(residual::decision_rivals(unfixable, 1).empty());
+}
+
 // A model of two y channels, a and b, of standard deviations 2 and 4.
 HadynetModel loss_model() {
   HadynetModel m;

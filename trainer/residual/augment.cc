@@ -389,6 +389,27 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
   return load_drift_of_group(planned[chosen], channel_group(probe.channels.front()));
 }
 
+std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planned, std::size_t chosen) {
+  std::vector<std::size_t> rivals;
+  if (chosen >= planned.size()) return rivals;
+  const Augmentation& a = planned[chosen];
+  const auto addable_curve = [](const Augmentation& p) {
+    return p.not_fixable.empty() && p.kind == EffectKind::kSensorCurve && !p.channels.empty();
+  };
+  const bool curve = addable_curve(a);
+  if (!curve && !addable_load_drift(a)) return rivals;
+  for (std::size_t k = 0; k < planned.size(); ++k) {
+    if (k == chosen || !(curve ? addable_load_drift(planned[k]) : addable_curve(planned[k]))) continue;
+    const bool shares_group = std::any_of(a.channels.begin(), a.channels.end(), [&](const std::string& name) {
+      const std::string group = channel_group(name);
+      return std::any_of(planned[k].channels.begin(), planned[k].channels.end(),
+                         [&](const std::string& other) { return channel_group(other) == group; });
+    });
+    if (shares_group) rivals.push_back(k);
+  }
+  return rivals;
+}
+
 bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k) {
   return k > 0 && k < planned.size() && !planned[k].group_extension && planned[k - 1].kind == planned[k].kind &&
          !planned[k - 1].extended_channels.empty();
@@ -725,6 +746,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // clearest gain (chosen_candidate). The held-out rows play no part, so
   // the decision below tests one candidate at the full alpha.
   std::size_t chosen = 0;
+  std::optional<std::size_t> rival;  // decision_rivals(): tested beside the choice
   for (std::size_t k = 0; k < planned.size(); ++k) {
     CandidateTrial c;
     c.effect = planned[k].effect;
@@ -802,6 +824,13 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
         chosen = *probed;
       }
     }
+    // A curve or a drift (decision_rivals): the best rival that gained on
+    // the selection's rows too is tested beside the choice.
+    for (const std::size_t k : decision_rivals(planned, chosen)) {
+      if (!judged_rows[k]) judge(k);
+      const CandidateTrial& c = result.candidates[k];
+      if (c.selection.mean > 0 && (!rival || c.selection.stat > result.candidates[*rival].selection.stat)) rival = k;
+    }
   }
   result.candidates[chosen].chosen = true;
 
@@ -812,53 +841,24 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   const HeldOutError& reference = result.control ? *result.control : result.before;
   result.reference = result.control ? "fine-tuning alone" : "the unchanged model";
 
-  // The decision: the chosen candidate, fine-tuned on the whole training
-  // part, against the reference on the held-out rows of the channels it was
-  // found on (the plan's found_on, of the model's own channels: the aligned,
-  // cleaned, clipped, drifting or friction channels; for an aux channel, the
-  // channels its significant hypotheses explain; for a calibration curve
-  // every channel: Augmentation::judged_on_every_channel).
-  const Augmentation tested = refined(planned[chosen], train_part, &result.fitted_rates);
-  if (!result.candidates[chosen].selected_by_training_rows) result.candidates[chosen].description = tested.description;
-  Tuned after = tune(&tested, train_part, &result.untuned);
-  result.augmentation = tested;
-  result.loss_history = after.loss_history;
-  result.train_windows = after.train_windows;
-  result.after = judged(after.model, held_out_part);
-  // The channels the re-estimated plan changes (a drift at rate 0 left out:
-  // BiasState::refine), the same for both folds.
-  result.candidates[chosen].channels = channels_of(tested);
-  result.confirmation_channels = result.candidates[chosen].channels;
-  Segments reference_loss = standardised_loss(model, reference, result.confirmation_channels, loss, levels);
-  Segments after_loss = standardised_loss(model, result.after, result.confirmation_channels, loss, levels);
-  result.first_fold = diebold_mariano(reference_loss, after_loss);
-  // The mirrored fold (FixOptions::folds 2): the same candidate and its
-  // reference fine-tuned on each log's last rows, [T - split, T), and judged
-  // on its first, [d + 2, T - split); its rows join the test.
+  // The mirrored fold (FixOptions::folds 2): each plan and the reference
+  // fine-tuned on each log's last rows, [T - split, T), and judged on its
+  // first, [d + 2, T - split); its rows join every test.
   if (options.folds == 2 && !mirrored_fold_fits) {
     result.folds_note = "the mirrored fold was not judged: a log is too short for it, or --train-fraction is below "
                         "4/7 (its rows would overlap the rows that chose the candidate)";
   }
-  // The applied plan's and the reference's rows of the mirrored fold
-  // (options.folds 2), kept for the tests after the confirmation.
-  std::optional<HeldOutError> mirrored_after, mirrored_reference;
-  if (options.folds == 2 && mirrored_fold_fits) {
-    const Augmentation mirrored = refined(planned[chosen], mirrored_train, nullptr);
-    mirrored_after = judged(tune(&mirrored, mirrored_train).model, mirrored_judged);
+  const bool mirrored = options.folds == 2 && mirrored_fold_fits;
+  std::optional<HeldOutError> mirrored_reference;
+  if (mirrored) {
     mirrored_reference = options.control ? judged(tune(nullptr, mirrored_train).model, mirrored_judged)
                                          : held_out_error(model, eval_rows(model, before_pbs, mirrored_judged),
                                                           HeldOutDetail::kErrorsOnly);
-    for (auto& segment : standardised_loss(model, *mirrored_reference, result.confirmation_channels, loss, levels))
-      reference_loss.push_back(std::move(segment));
-    for (auto& segment : standardised_loss(model, *mirrored_after, result.confirmation_channels, loss, levels))
-      after_loss.push_back(std::move(segment));
     result.folds = 2;
   }
-  result.confirmation = diebold_mariano(reference_loss, after_loss);
-  bool confirmed = result.confirmation.mean > 0 && result.confirmation.p_value < attribution.options.alpha;
 
-  // Another plan, re-estimated and fine-tuned as the tested candidate was,
-  // on each fold the decision judged (the mirrored fold's when it did).
+  // A plan re-estimated and fine-tuned on the training part of each fold
+  // judged (the mirrored fold's when it is).
   struct FoldTrial {
     Augmentation tested;
     std::vector<double> rates;
@@ -872,9 +872,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     t.tested = refined(plan, train_part, &t.rates);
     t.after = tune(&t.tested, train_part, &t.untuned);
     t.rows = judged(t.after.model, held_out_part);
-    if (mirrored_after) {
-      const Augmentation mirrored = refined(plan, mirrored_train, nullptr);
-      t.mirrored = judged(tune(&mirrored, mirrored_train).model, mirrored_judged);
+    if (mirrored) {
+      const Augmentation on_mirrored = refined(plan, mirrored_train, nullptr);
+      t.mirrored = judged(tune(&on_mirrored, mirrored_train).model, mirrored_judged);
     }
     return t;
   };
@@ -895,11 +895,6 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   const auto significant = [&](const DieboldMariano& t) {
     return t.mean > 0 && t.p_value < attribution.options.alpha;
   };
-  // A change judged on every channel (a calibration curve) must also predict
-  // its own channels better than the reference, on every fold judged (the
-  // mean loss difference there, no test): a curve that gains elsewhere
-  // while its own channels read worse is not their calibration
-  // (FixResult::own_channels).
   // The model's channels a plan changes (its found_on, once each).
   const auto own_channels_of = [&](const Augmentation& plan) {
     std::vector<std::string> own;
@@ -908,15 +903,94 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
         own.push_back(name);
     return own;
   };
-  if (result.augmentation->judged_on_every_channel) {
-    const std::vector<std::string> own = own_channels_of(*result.augmentation);
-    if (!own.empty()) {
-      result.own_channels = compare(reference, mirrored_reference, result.after, mirrored_after, own);
-      result.own_channel_names = own;
-      confirmed = confirmed && result.own_channels->mean > 0;
+
+  // The decision of one plan, planned[k]: fine-tuned on the whole training
+  // part and judged against the reference on the held-out rows of the
+  // channels it was found on (the plan's found_on, of the model's own
+  // channels: the aligned, cleaned, clipped, drifting or friction channels;
+  // for an aux channel, the channels its significant hypotheses explain;
+  // for a calibration curve every channel: Augmentation::judged_on_every_channel),
+  // as re-estimated (a drift at rate 0 left out: BiasState::refine). A
+  // change judged on every channel (a calibration curve) must also predict
+  // its own channels better than the reference, on every fold judged (the
+  // mean loss difference there, no test): a curve that gains elsewhere
+  // while its own channels read worse is not their calibration
+  // (FixResult::own_channels).
+  struct Decision {
+    FoldTrial trial;
+    std::vector<std::string> channels;
+    DieboldMariano first_fold, confirmation;  // the first fold alone; every fold
+    std::optional<DieboldMariano> own;        // a curve's own channels, every fold
+    std::vector<std::string> own_names;
+    // The test's p, or 1 when the plan gains nothing or its own channels read worse.
+    double p() const {
+      return confirmation.mean > 0 && (!own || own->mean > 0) ? confirmation.p_value : 1.0;
     }
+  };
+  const auto decide = [&](std::size_t k) {
+    Decision c;
+    c.trial = fold_trial(planned[k]);
+    c.channels = channels_of(c.trial.tested);
+    c.first_fold = compare(reference, std::nullopt, c.trial.rows, std::nullopt, c.channels);
+    c.confirmation = compare(reference, mirrored_reference, c.trial.rows, c.trial.mirrored, c.channels);
+    if (c.trial.tested.judged_on_every_channel) {
+      c.own_names = own_channels_of(c.trial.tested);
+      if (!c.own_names.empty())
+        c.own = compare(reference, mirrored_reference, c.trial.rows, c.trial.mirrored, c.own_names);
+    }
+    result.candidates[k].channels = c.channels;
+    if (!result.candidates[k].selected_by_training_rows) result.candidates[k].description = c.trial.tested.description;
+    return c;
+  };
+  const double alpha = attribution.options.alpha;
+  Decision decided = decide(chosen);
+  bool confirmed = decided.p() < alpha;
+  if (rival) {
+    // The choice and its rival at Holm's levels for two tests: the smaller
+    // p at alpha / 2, then the other at alpha.
+    Decision other = decide(*rival);
+    FixResult::Rival r;
+    r.candidate = *rival;
+    r.effect = planned[*rival].effect;
+    r.description = other.trial.tested.description;
+    r.channels = other.channels;
+    r.confirmation = other.confirmation;
+    r.own_channels = other.own;
+    r.chosen_effect = planned[chosen].effect;
+    r.alpha = alpha;
+    r.chosen_confirmation = decided.confirmation;
+    const bool either = std::min(decided.p(), other.p()) < alpha / 2;
+    r.chosen_confirmed = either && decided.p() < alpha;
+    r.confirmed = either && other.p() < alpha;
+    if (r.confirmed && r.chosen_confirmed) {
+      for (const auto& name : model.layout.y_names)  // in the model's order
+        if (std::find(decided.channels.begin(), decided.channels.end(), name) != decided.channels.end() ||
+            std::find(other.channels.begin(), other.channels.end(), name) != other.channels.end())
+          r.gain_channels.push_back(name);
+      r.gain = compare(decided.trial.rows, decided.trial.mirrored, other.trial.rows, other.trial.mirrored,
+                       r.gain_channels);
+      r.applied = r.gain->mean > 0;
+    } else {
+      r.applied = r.confirmed;
+    }
+    confirmed = r.confirmed || r.chosen_confirmed;
+    if (r.applied) {
+      decided = std::move(other);
+      chosen = *rival;  // the plan decided on, from here on
+    }
+    result.rival = std::move(r);
   }
+  result.confirmation_channels = decided.channels;
+  result.first_fold = decided.first_fold;
+  result.confirmation = decided.confirmation;
+  if (decided.own) {
+    result.own_channels = decided.own;
+    result.own_channel_names = decided.own_names;
+  }
+
   // The trial's plan becomes the applied one.
+  Tuned after;
+  std::optional<HeldOutError> mirrored_after;
   const auto apply = [&](FoldTrial& t) {
     result.augmentation = t.tested;
     result.fitted_rates = std::move(t.rates);
@@ -927,6 +1001,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     mirrored_after = std::move(t.mirrored);
     after = std::move(t.after);
   };
+  apply(decided.trial);
 
   // The simpler account (FixResult::simpler): a confirmed change that can
   // imitate a simpler effect on its lead channel stands only if it predicts
@@ -1105,12 +1180,20 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   std::snprintf(p, sizeof p, "%.2g", result.confirmation.p_value);
   if (!confirmed) {
     const auto& a = *result.augmentation;
-    const bool own_worse = result.confirmation.mean > 0 && result.confirmation.p_value < attribution.options.alpha;
+    const bool own_worse = result.own_channels && result.own_channels->mean <= 0 && significant(result.confirmation);
     result.status = "unexplained structure: adding " + a.effect + " (" + a.description + ") did not beat " +
                     result.reference + " on the held-out rows of " +
                     (own_worse ? "its own channels (it did on every channel, Diebold-Mariano p " + std::string(p) + ")"
                                : (a.judged_on_every_channel ? "every channel" : "the channels it was found on") +
                                      std::string(" (Diebold-Mariano p ") + p + ")");
+    if (result.rival) {
+      char rival_p[32], level[32];
+      std::snprintf(rival_p, sizeof rival_p, "%.2g", result.rival->confirmation.p_value);
+      std::snprintf(level, sizeof level, "%.3g", alpha / 2);
+      result.status += ", nor did its rival " + result.rival->effect + " (" + result.rival->description +
+                       ", Diebold-Mariano p " + rival_p + "; the two tested at Holm's levels, the smaller p at " +
+                       level + ")";
+    }
     return result;
   }
   result.model = std::move(after.model);

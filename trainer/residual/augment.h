@@ -428,6 +428,18 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
 // so much that one rate for the group predicts worse.
 bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::size_t chosen, std::size_t probed);
 
+// The plans the held-out rows decide between with the selection's choice
+// planned[chosen] (docs/residual.md, "A curve or a drift: the held-out rows
+// decide", stop 70): when planned[chosen] is a calibration curve, every load
+// drift that holds a channel of one of its groups; when it is a load drift,
+// every calibration curve that does; else none. In `planned`'s order. The
+// two explain much the same training rows (a bias that grows through a log
+// and a static curve of the level both follow the load), and only rows
+// after them, where a drift has grown and a curve has not, tell them apart:
+// fix() tests the best of them that gained on the selection's rows beside
+// planned[chosen], the two at Holm's levels (FixResult::rival).
+std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planned, std::size_t chosen);
+
 // Whether planned[k] of plan_candidates() is a family alone: the plan right
 // after the same plan extended to its group.
 bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k);
@@ -742,6 +754,31 @@ struct FixResult {
     DieboldMariano gain;                // the confirmed change's loss minus the richer plan's on gain_channels
   };
   std::optional<RicherAccount> richer;
+  // The rival tested beside the selection's choice (decision_rivals(): a
+  // calibration curve and a load drift of one group), when one gained on the
+  // selection's rows: the best of them by the selection's statistic. Both
+  // are judged as the decision judges (every fold, against `reference`, a
+  // curve also on its own channels), and each is confirmed at Holm's level
+  // for two tests (the smaller p at alpha / 2, the other then at alpha).
+  // Confirmed alone, it is the decision's plan: `augmentation`, `after`,
+  // `confirmation` and what follows are then its. Both confirmed: the one
+  // that predicts the channels either changes better (gain's mean) is.
+  struct Rival {
+    std::size_t candidate = 0;  // its index in `candidates`
+    std::string effect, description;
+    std::vector<std::string> channels;              // its test's channels
+    DieboldMariano confirmation;                    // reference's loss minus the rival's, every fold
+    std::optional<DieboldMariano> own_channels;     // a curve: the same on its own channels
+    bool confirmed = false;                         // at Holm's level
+    std::string chosen_effect;                      // the selection's choice ...
+    DieboldMariano chosen_confirmation;             // ... its test (reference's loss minus its)
+    bool chosen_confirmed = false;                  // ... at Holm's level
+    double alpha = 0;                               // the decision's level (Holm's: alpha / 2, then alpha)
+    std::optional<DieboldMariano> gain;             // both confirmed: the choice's loss minus the rival's
+    std::vector<std::string> gain_channels;         // ... on the channels either changes
+    bool applied = false;                           // the decision's plan is the rival's
+  };
+  std::optional<Rival> rival;
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
   // drift: the attribution's rate per channel, before refine() (0 for a
