@@ -276,11 +276,11 @@ int run_residual(int argc, char** argv) {
                               "more candidate (after the screen's drift of its group, one holding a channel of it, beyond\n"
                               "K, when it lists one; last, beyond K, when it lists a load drift of another group); a\n"
                               "load drift of its group chosen on the training rows gives way to it when it gains there\n"
-                              "too and predicts the channels either changes better there; a calibration curve and a load\n"
-                              "drift of one group are rivals: when the one chosen has a rival that gained on those rows\n"
-                              "too, the best such rival is tested beside it on the held-out rows, the two at Holm's\n"
-                              "levels (the smaller p at half the level), and of two confirmed the one that predicts the\n"
-                              "channels either changes better is applied", "5");
+                              "too and predicts the channels either changes better there; a load drift and a calibration\n"
+                              "curve or a drift with time of one group are rivals: when the one chosen has a rival that\n"
+                              "gained on those rows too, the best such rival is tested beside it on the held-out rows,\n"
+                              "the two at Holm's levels (the smaller p at half the level), and of two confirmed the one\n"
+                              "that predicts the channels either changes better is applied", "5");
   opt.value("fix-min-excess-null", "S",
             "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"
             "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"

@@ -393,13 +393,16 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
   std::vector<std::size_t> rivals;
   if (chosen >= planned.size()) return rivals;
   const Augmentation& a = planned[chosen];
-  const auto addable_curve = [](const Augmentation& p) {
-    return p.not_fixable.empty() && p.kind == EffectKind::kSensorCurve && !p.channels.empty();
+  // A load drift's rivals: a calibration curve or a drift with time; theirs: a load drift.
+  const auto addable_other_account = [](const Augmentation& p) {
+    return p.not_fixable.empty() && (p.kind == EffectKind::kSensorCurve || p.kind == EffectKind::kDriftTime) &&
+           !p.channels.empty();
   };
-  const bool curve = addable_curve(a);
-  if (!curve && !addable_load_drift(a)) return rivals;
+  const bool other_account = addable_other_account(a);
+  if (!other_account && !addable_load_drift(a)) return rivals;
   for (std::size_t k = 0; k < planned.size(); ++k) {
-    if (k == chosen || !(curve ? addable_load_drift(planned[k]) : addable_curve(planned[k]))) continue;
+    if (k == chosen || !(other_account ? addable_load_drift(planned[k]) : addable_other_account(planned[k])))
+      continue;
     const bool shares_group = std::any_of(a.channels.begin(), a.channels.end(), [&](const std::string& name) {
       const std::string group = channel_group(name);
       return std::any_of(planned[k].channels.begin(), planned[k].channels.end(),

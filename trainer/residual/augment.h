@@ -430,12 +430,14 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 
 // The plans the held-out rows decide between with the selection's choice
 // planned[chosen] (docs/residual.md, "A curve or a drift: the held-out rows
-// decide", stop 70): when planned[chosen] is a calibration curve, every load
-// drift that holds a channel of one of its groups; when it is a load drift,
-// every calibration curve that does; else none. In `planned`'s order. The
-// two explain much the same training rows (a bias that grows through a log
-// and a static curve of the level both follow the load), and only rows
-// after them, where a drift has grown and a curve has not, tell them apart:
+// decide", stop 70): when planned[chosen] is a calibration curve or a drift
+// with time, every load drift that holds a channel of one of its groups;
+// when it is a load drift, every calibration curve and drift with time that
+// does; else none. In `planned`'s order. They explain much the same
+// training rows (a bias that grows with the load a sensor has carried, a
+// static curve of the level and a bias that grows with time all follow a
+// grasp's load through a log), and only rows after them, where a load
+// drift has grown with the load and the others have not, tell them apart:
 // fix() tests the best of them that gained on the selection's rows beside
 // planned[chosen], the two at Holm's levels (FixResult::rival).
 std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planned, std::size_t chosen);
@@ -755,7 +757,8 @@ struct FixResult {
   };
   std::optional<RicherAccount> richer;
   // The rival tested beside the selection's choice (decision_rivals(): a
-  // calibration curve and a load drift of one group), when one gained on the
+  // load drift, and a calibration curve or a drift with time, of one
+  // group), when one gained on the
   // selection's rows: the best of them by the selection's statistic. Both
   // are judged as the decision judges (every fold, against `reference`, a
   // curve also on its own channels), and each is confirmed at Holm's level
