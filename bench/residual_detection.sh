@@ -270,8 +270,15 @@
 # every effect at its larger strength and drift=0.01, measured with the
 # rule's first version (2830-2849: clean sets); 2860-2879 drift=0.02
 # and 2880-2889 drift=0.02 at RESIDUAL_ROWS=600 measured with its final
-# version (2890-2909: clean sets at RESIDUAL_ROWS=600). Next unused:
-# 2910 on.
+# version (2890-2909: clean sets at RESIDUAL_ROWS=600). Stop 70 (a
+# load drift and a calibration curve or a drift with time of one group are
+# rivals, both tested on the held-out rows): stop 69's drift sets 2787,
+# 2810, 2818 and 2864-2866 and its curve sets 2850-2857 development;
+# 2910-2929 drift=0.02 and 2930-2939 every effect at its larger strength
+# measured with the curve's rivalry alone (2940-2959: clean sets), then
+# 2926 development of the time drift's; 2960-2979 drift=0.02 measured
+# with the final code, and 2919 and 2923 (time drifts among their
+# candidates) re-run with it. Next unused: 2980 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...
