@@ -155,7 +155,7 @@ void print_fix(const rs::FixResult& fixed) {
       std::printf("; on its own channels mean loss difference %.3g", fixed.own_channels->mean);
     std::printf(": %s\n", fixed.changed ? "confirmed" : "not confirmed, nothing applied");
     if (fixed.simpler) std::printf("%s\n", simpler_sentence(*fixed.simpler, fixed.reference).c_str());
-    if (fixed.rival) std::printf("%s\n", rival_sentence(*fixed.rival, fixed.reference).c_str());
+    if (fixed.rivals) std::printf("%s\n", rivals_sentence(*fixed.rivals, fixed.reference).c_str());
     if (fixed.richer) std::printf("%s\n", richer_sentence(*fixed.richer, fixed.reference).c_str());
     for (const auto& wider : fixed.extensions) std::printf("%s\n", extension_sentence(wider).c_str());
     if (replaced_after_decision(fixed)) std::printf("the before/after above are the plan applied last\n");
@@ -276,11 +276,11 @@ int run_residual(int argc, char** argv) {
                               "more candidate (after the screen's drift of its group, one holding a channel of it, beyond\n"
                               "K, when it lists one; last, beyond K, when it lists a load drift of another group); a\n"
                               "load drift of its group chosen on the training rows gives way to it when it gains there\n"
-                              "too and predicts the channels either changes better there; a load drift and a calibration\n"
-                              "curve or a drift with time of one group are rivals: when the one chosen has a rival that\n"
-                              "gained on those rows too, the best such rival is tested beside it on the held-out rows,\n"
-                              "the two at Holm's levels (the smaller p at half the level), and of two confirmed the one\n"
-                              "that predicts the channels either changes better is applied", "5");
+                              "too and predicts the channels either changes better there; the rivals of a chosen\n"
+                              "calibration curve (the other effects of its group), drift with time (the load drifts of its\n"
+                              "group) or load drift (the curves and drifts with time of its groups) that gained on those\n"
+                              "rows too are tested beside it on the held-out rows, all at Holm's levels, and of those\n"
+                              "confirmed the one that predicts the channels any of them changes best is applied", "5");
   opt.value("fix-min-excess-null", "S",
             "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"
             "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"

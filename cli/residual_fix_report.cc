@@ -151,31 +151,35 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                                           {"p_value", a.gain.p_value}};
       j["richer"] = account;
     }
-    // The rival tested beside the selection's choice (FixResult::rival).
-    if (f.rival) {
-      const rs::FixResult::Rival& r = *f.rival;
-      json rival = {{"candidate", r.candidate},
-                    {"effect", r.effect},
-                    {"description", r.description},
-                    {"channels", r.channels},
-                    {"against", f.reference},
-                    {"mean_loss_difference", r.confirmation.mean},
-                    {"statistic", r.confirmation.stat},
-                    {"rows", r.confirmation.samples},
-                    {"p_value", r.confirmation.p_value},
-                    {"own_channels_mean_loss_difference", r.own_channels ? json(r.own_channels->mean) : json()},
-                    {"levels", "Holm for two: the smaller p at alpha / 2, the other at alpha"},
-                    {"confirmed", r.confirmed},
-                    {"chosen_effect", r.chosen_effect},
-                    {"chosen_p_value", r.chosen_confirmation.p_value},
-                    {"chosen_confirmed", r.chosen_confirmed},
-                    {"applied", r.applied}};
-      if (r.gain)
-        rival["gain_over_chosen"] = {{"channels", r.gain_channels},
-                                     {"mean_loss_difference", r.gain->mean},
-                                     {"statistic", r.gain->stat},
-                                     {"p_value", r.gain->p_value}};
-      j["rival"] = rival;
+    // The rivals tested beside the selection's choice (FixResult::rivals).
+    if (f.rivals) {
+      const rs::FixResult::Rivals& r = *f.rivals;
+      json plans = json::array();
+      for (const auto& rv : r.plans) {
+        json plan = {{"candidate", rv.candidate},
+                     {"effect", rv.effect},
+                     {"description", rv.description},
+                     {"channels", rv.channels},
+                     {"mean_loss_difference", rv.confirmation.mean},
+                     {"statistic", rv.confirmation.stat},
+                     {"rows", rv.confirmation.samples},
+                     {"p_value", rv.confirmation.p_value},
+                     {"own_channels_mean_loss_difference", rv.own_channels ? json(rv.own_channels->mean) : json()},
+                     {"confirmed", rv.confirmed},
+                     {"applied", rv.applied}};
+        if (rv.gain)
+          plan["gain_over_chosen"] = {{"mean_loss_difference", rv.gain->mean},
+                                      {"statistic", rv.gain->stat},
+                                      {"p_value", rv.gain->p_value}};
+        plans.push_back(plan);
+      }
+      j["rivals"] = {{"against", f.reference},
+                     {"levels", "Holm for the choice and its rivals: the i-th smallest p at alpha / (m - i)"},
+                     {"chosen_effect", r.chosen_effect},
+                     {"chosen_p_value", r.chosen_confirmation.p_value},
+                     {"chosen_confirmed", r.chosen_confirmed},
+                     {"gain_channels", r.gain_channels},
+                     {"plans", plans}};
     }
     json candidates = json::array();
     for (const auto& c : f.candidates)
@@ -290,22 +294,29 @@ std::string richer_sentence(const rs::FixResult::RicherAccount& r, const std::st
                         : "no significant gain, " + r.replaces + " kept");
 }
 
-std::string rival_sentence(const rs::FixResult::Rival& r, const std::string& reference) {
-  std::string m = "Rival of " + r.chosen_effect + ": " + r.effect + " (" + r.description +
-                  "), tested beside it against " + reference + " on the held-out rows of " +
-                  comma_separated(r.channels) + " (Diebold-Mariano, " + std::to_string(r.confirmation.samples) +
-                  " rows): mean loss difference " + num("%.3g", r.confirmation.mean) + ", p " +
-                  num("%.2g", r.confirmation.p_value);
-  if (r.own_channels) m += "; on its own channels mean loss difference " + num("%.3g", r.own_channels->mean);
-  m += "; " + r.chosen_effect + "'s p " + num("%.2g", r.chosen_confirmation.p_value) +
-       "; at Holm's levels for two (the smaller p at " + num("%.3g", r.alpha / 2) + ", the other at " +
-       num("%.3g", r.alpha) + "): " + r.effect + (r.confirmed ? " confirmed, " : " not confirmed, ") + r.chosen_effect +
-       (r.chosen_confirmed ? " confirmed" : " not confirmed");
-  if (r.gain)
-    m += "; " + r.chosen_effect + " against " + r.effect + " on " + comma_separated(r.gain_channels) +
-         ": mean loss difference " + num("%.3g", r.gain->mean);
-  if (r.applied) return m + ": " + r.effect + " applied in its place";
-  return m + (r.chosen_confirmed ? ": " + r.chosen_effect + " kept" : "");
+std::string rivals_sentence(const rs::FixResult::Rivals& r, const std::string& reference) {
+  const std::size_t m = r.plans.size() + 1;
+  std::string m_ = "Rivals of " + r.chosen_effect + " (p " + num("%.2g", r.chosen_confirmation.p_value) +
+                   (r.chosen_confirmed ? ", confirmed" : ", not confirmed") + "), each tested beside it against " +
+                   reference + " on the held-out rows of its channels, at Holm's levels for " + std::to_string(m) +
+                   " tests (the smallest p at " + num("%.3g", r.alpha / static_cast<double>(m)) + "):";
+  bool applied = false;
+  for (const auto& rv : r.plans) {
+    m_ += " " + rv.effect + " (" + rv.description + "): mean loss difference " + num("%.3g", rv.confirmation.mean) +
+          ", p " + num("%.2g", rv.confirmation.p_value);
+    if (rv.own_channels) m_ += ", on its own channels " + num("%.3g", rv.own_channels->mean);
+    m_ += rv.confirmed ? ", confirmed" : ", not confirmed";
+    if (rv.gain) m_ += ", its gain over " + r.chosen_effect + " on the channels any confirmed one changes " +
+                       num("%.3g", rv.gain->mean);
+    if (rv.applied) {
+      m_ += ", applied in its place";
+      applied = true;
+    }
+    m_ += ";";
+  }
+  m_.pop_back();
+  if (!applied && r.chosen_confirmed) m_ += "; " + r.chosen_effect + " kept";
+  return m_;
 }
 
 std::string extension_sentence(const rs::FixResult::Extension& e) {
@@ -366,7 +377,7 @@ std::string fix_markdown(const rs::FixResult& f, const rs::FixOptions& o, const 
            (f.own_channels->mean > 0 ? " (it does)" : " (it does not)") + ".\n\n";
     }
     if (f.simpler) m += simpler_sentence(*f.simpler, f.reference) + ".\n\n";
-    if (f.rival) m += rival_sentence(*f.rival, f.reference) + ".\n\n";
+    if (f.rivals) m += rivals_sentence(*f.rivals, f.reference) + ".\n\n";
     if (f.richer) m += richer_sentence(*f.richer, f.reference) + ".\n\n";
     for (const auto& e : f.extensions) m += extension_sentence(e) + ".\n\n";
     if (replaced_after_decision(f)) m += "The before/after below are the plan applied last.\n\n";

@@ -36,8 +36,8 @@ std::string simpler_sentence(const trainer::residual::FixResult::SimplerAccount&
 // (FixResult::richer): its channels, its test against the reference (and on
 // its own channels), its gain over the confirmed change when tested, and
 // whether it was applied. For stdout and REPORT.md.
-// The rival tested beside the selection's choice, at Holm's levels for two.
-std::string rival_sentence(const trainer::residual::FixResult::Rival& r, const std::string& reference);
+// The rivals tested beside the selection's choice, at Holm's levels.
+std::string rivals_sentence(const trainer::residual::FixResult::Rivals& r, const std::string& reference);
 std::string richer_sentence(const trainer::residual::FixResult::RicherAccount& r, const std::string& reference);
 
 // Whether a plan other than the decision's was applied after the

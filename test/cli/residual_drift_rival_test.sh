@@ -8,14 +8,14 @@
 # the calibration curve that explains the same training rows. Until stop 69
 # the selection chose a curve of fc3, fc4 and fc1 (training rows p 0.025;
 # the drift probe's plan of the nine loadcells 0.47), and the decision
-# rejected it on the held-out rows (p 1). Since stop 70 a curve and a load
-# drift of one group are rivals (decision_rivals(); docs/residual.md, "A
-# curve or a drift: the held-out rows decide"): the drift probe's plan is
-# tested beside the curve at Holm's levels, and it is confirmed there (p
-# 2.2e-11 on the development VM) where the curve is not. On another CPU the
+# rejected it on the held-out rows (p 1). Since stop 70 a curve has the
+# other effects of its group as rivals (decision_rivals(); docs/residual.md,
+# "Rivals: the held-out rows decide"): the drift probe's plan is tested
+# beside the curve at Holm's levels, and it is confirmed there (p 2.2e-11
+# on the development VM) where the curve is not. On another CPU the
 # selection may choose the drift at once; either path passes, but a curve
-# chosen there must have its rival tested (fix.rival, which stop 69's code
-# lacks). Seed 2865 was a development seed of this step (a miss it mends).
+# chosen there must have its rivals tested (fix.rivals, which stop 69's
+# code lacks). Seed 2865 was a development seed of this step (a miss it mends).
 # About 60 s on the development VM.
 #   residual_drift_rival_test.sh HADYNET MODEL WORKDIR
 set -uo pipefail
@@ -23,7 +23,7 @@ hadynet=$1 model=$2 work=$3
 here=$(cd "$(dirname "$0")/../.." && pwd)
 source "$here/test/cli/plant_fix_run.sh"
 plant_fix_run "$hadynet" "$model" "$work" 2865 -- --effect drift=0.02 || exit 1
-grep -E "^(fix|decision|Rival)" "$work/out.txt" | cut -c1-400
+grep -E "^(fix|decision|Rivals)" "$work/out.txt" | cut -c1-400
 python3 - "$work/residual.json" "$here/bench" "$here/test/cli" <<'PY'
 import re
 import sys
@@ -37,6 +37,6 @@ check(re.search(r"named yes cut yes .*<control yes", line) is not None,
       "the drift not named with a cut of 30 % below fine-tuning alone")
 chosen = [c for c in fix.get("candidates", []) if c.get("chosen")]
 if chosen and chosen[0]["effect"] == "sensor-curve":
-    check(fix.get("rival") is not None, "a curve chosen and no rival tested beside it")
+    check(fix.get("rivals") is not None, "a curve chosen and no rival tested beside it")
 finish()
 PY

@@ -940,10 +940,10 @@ TEST(DriftProbe, ALoadDriftOfItsGroupGivesWayToItsPlanAndNothingElseDoes) {
   EXPECT_FALSE(residual::gives_way_to_group_drift(unfixable, 1, probed));
 }
 
-// A curve's or a time drift's rivals are the load drifts of its group, a
-// load drift's the curves and time drifts of its groups: the accounts of a
-// slow bias the training rows cannot tell apart.
-TEST(DecisionRivals, ALoadDriftAndACurveOrATimeDriftOfOneGroupAreRivalsAndNothingElseIs) {
+// A curve's rivals are the other effects of its group, a time drift's the
+// load drifts of its group, a load drift's the curves and time drifts of
+// its groups; another effect has none.
+TEST(DecisionRivals, ACurveAndATimeDriftHaveRivalsInTheirGroupAndALoadDriftIsEachsRival) {
   const auto plan = planned_on;
   using residual::EffectKind;
   using Rivals = std::vector<std::size_t>;
@@ -956,20 +956,20 @@ TEST(DecisionRivals, ALoadDriftAndACurveOrATimeDriftOfOneGroupAreRivalsAndNothin
   const auto tendon_curve = plan(EffectKind::kSensorCurve, {"f2"});
   const std::vector<residual::Augmentation> planned = {curve,      family,    tendon_led,  tendon,
                                                        time_drift, crosstalk, tendon_curve};
-  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 2}));
+  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 2, 4, 5}));
   EXPECT_EQ(residual::decision_rivals(planned, 1), (Rivals{0, 4}));
   // A drift of a tendon and a loadcell: the curves and time drifts of either group.
   EXPECT_EQ(residual::decision_rivals(planned, 2), (Rivals{0, 4, 6}));
   EXPECT_EQ(residual::decision_rivals(planned, 3), (Rivals{6}));
   EXPECT_EQ(residual::decision_rivals(planned, 4), (Rivals{1, 2}));
   EXPECT_EQ(residual::decision_rivals(planned, 6), (Rivals{2, 3}));
-  // Another effect, an index out of range: none.
+  // Another effect (whatever its group holds), an index out of range: none.
   EXPECT_TRUE(residual::decision_rivals(planned, 5).empty());
   EXPECT_TRUE(residual::decision_rivals(planned, planned.size()).empty());
   // A plan that cannot be added is no rival, and has none.
   auto unfixable = planned;
   unfixable[1].not_fixable = "no level";
-  EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{2}));
+  EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{2, 4, 5}));
   EXPECT_TRUE(residual::decision_rivals(unfixable, 1).empty());
 }
 

@@ -393,16 +393,21 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
   std::vector<std::size_t> rivals;
   if (chosen >= planned.size()) return rivals;
   const Augmentation& a = planned[chosen];
-  // A load drift's rivals: a calibration curve or a drift with time; theirs: a load drift.
-  const auto addable_other_account = [](const Augmentation& p) {
-    return p.not_fixable.empty() && (p.kind == EffectKind::kSensorCurve || p.kind == EffectKind::kDriftTime) &&
-           !p.channels.empty();
+  const auto addable = [](const Augmentation& p) { return p.not_fixable.empty() && !p.channels.empty(); };
+  // A curve's rivals: any other effect; a drift with time's: a load drift;
+  // a load drift's: a curve or a drift with time; any other effect's: none.
+  const auto is_rival = [&](const Augmentation& p) {
+    if (!addable(p)) return false;
+    switch (a.kind) {
+      case EffectKind::kSensorCurve: return p.kind != EffectKind::kSensorCurve;
+      case EffectKind::kDriftTime: return p.kind == EffectKind::kDriftLoad;
+      case EffectKind::kDriftLoad: return p.kind == EffectKind::kSensorCurve || p.kind == EffectKind::kDriftTime;
+      default: return false;
+    }
   };
-  const bool other_account = addable_other_account(a);
-  if (!other_account && !addable_load_drift(a)) return rivals;
+  if (!addable(a)) return rivals;
   for (std::size_t k = 0; k < planned.size(); ++k) {
-    if (k == chosen || !(other_account ? addable_load_drift(planned[k]) : addable_other_account(planned[k])))
-      continue;
+    if (k == chosen || !is_rival(planned[k])) continue;
     const bool shares_group = std::any_of(a.channels.begin(), a.channels.end(), [&](const std::string& name) {
       const std::string group = channel_group(name);
       return std::any_of(planned[k].channels.begin(), planned[k].channels.end(),
@@ -749,7 +754,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // clearest gain (chosen_candidate). The held-out rows play no part, so
   // the decision below tests one candidate at the full alpha.
   std::size_t chosen = 0;
-  std::optional<std::size_t> rival;  // decision_rivals(): tested beside the choice
+  std::vector<std::size_t> rivals;  // decision_rivals() that gained: tested beside the choice
   for (std::size_t k = 0; k < planned.size(); ++k) {
     CandidateTrial c;
     c.effect = planned[k].effect;
@@ -827,12 +832,11 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
         chosen = *probed;
       }
     }
-    // A curve or a drift (decision_rivals): the best rival that gained on
-    // the selection's rows too is tested beside the choice.
+    // Rivals (decision_rivals): those that gained on the selection's rows
+    // too are tested beside the choice.
     for (const std::size_t k : decision_rivals(planned, chosen)) {
       if (!judged_rows[k]) judge(k);
-      const CandidateTrial& c = result.candidates[k];
-      if (c.selection.mean > 0 && (!rival || c.selection.stat > result.candidates[*rival].selection.stat)) rival = k;
+      if (result.candidates[k].selection.mean > 0) rivals.push_back(k);
     }
   }
   result.candidates[chosen].chosen = true;
@@ -948,40 +952,71 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   const double alpha = attribution.options.alpha;
   Decision decided = decide(chosen);
   bool confirmed = decided.p() < alpha;
-  if (rival) {
-    // The choice and its rival at Holm's levels for two tests: the smaller
-    // p at alpha / 2, then the other at alpha.
-    Decision other = decide(*rival);
-    FixResult::Rival r;
-    r.candidate = *rival;
-    r.effect = planned[*rival].effect;
-    r.description = other.trial.tested.description;
-    r.channels = other.channels;
-    r.confirmation = other.confirmation;
-    r.own_channels = other.own;
+  if (!rivals.empty()) {
+    // The choice and its rivals at Holm's levels for m tests: the i-th
+    // smallest p at alpha / (m - i), until one is not below its level.
+    std::vector<Decision> others;
+    for (const std::size_t k : rivals) others.push_back(decide(k));
+    FixResult::Rivals r;
     r.chosen_effect = planned[chosen].effect;
-    r.alpha = alpha;
     r.chosen_confirmation = decided.confirmation;
-    const bool either = std::min(decided.p(), other.p()) < alpha / 2;
-    r.chosen_confirmed = either && decided.p() < alpha;
-    r.confirmed = either && other.p() < alpha;
-    if (r.confirmed && r.chosen_confirmed) {
-      for (const auto& name : model.layout.y_names)  // in the model's order
-        if (std::find(decided.channels.begin(), decided.channels.end(), name) != decided.channels.end() ||
-            std::find(other.channels.begin(), other.channels.end(), name) != other.channels.end())
+    r.alpha = alpha;
+    std::vector<double> p = {decided.p()};
+    for (const Decision& o : others) p.push_back(o.p());
+    std::vector<std::size_t> order(p.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return p[x] < p[y]; });
+    std::vector<bool> holm(p.size(), false);
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      if (!(p[order[i]] < alpha / static_cast<double>(p.size() - i))) break;
+      holm[order[i]] = true;
+    }
+    r.chosen_confirmed = holm[0];
+    // Of those confirmed, the one that predicts the channels any of them
+    // changes best on the held-out rows: the largest gain over the choice
+    // there (the choice's own is 0).
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (!holm[i]) continue;
+      const std::vector<std::string>& ch = i == 0 ? decided.channels : others[i - 1].channels;
+      for (const auto& name : ch)
+        if (std::find(r.gain_channels.begin(), r.gain_channels.end(), name) == r.gain_channels.end())
           r.gain_channels.push_back(name);
-      r.gain = compare(decided.trial.rows, decided.trial.mirrored, other.trial.rows, other.trial.mirrored,
-                       r.gain_channels);
-      r.applied = r.gain->mean > 0;
-    } else {
-      r.applied = r.confirmed;
     }
-    confirmed = r.confirmed || r.chosen_confirmed;
-    if (r.applied) {
-      decided = std::move(other);
-      chosen = *rival;  // the plan decided on, from here on
+    std::vector<std::string> in_order;  // the model's order
+    for (const auto& name : model.layout.y_names)
+      if (std::find(r.gain_channels.begin(), r.gain_channels.end(), name) != r.gain_channels.end())
+        in_order.push_back(name);
+    r.gain_channels = in_order;
+    std::optional<std::size_t> best;  // index into others; none: the choice
+    double best_gain = 0;
+    bool any = r.chosen_confirmed;
+    for (std::size_t i = 0; i < others.size(); ++i) {
+      FixResult::Rivals::Rival rv;
+      rv.candidate = rivals[i];
+      rv.effect = planned[rivals[i]].effect;
+      rv.description = others[i].trial.tested.description;
+      rv.channels = others[i].channels;
+      rv.confirmation = others[i].confirmation;
+      rv.own_channels = others[i].own;
+      rv.confirmed = holm[i + 1];
+      if (rv.confirmed) {
+        rv.gain = compare(decided.trial.rows, decided.trial.mirrored, others[i].trial.rows, others[i].trial.mirrored,
+                          r.gain_channels);
+        if ((!any && !best) || rv.gain->mean > best_gain) {
+          best = i;
+          best_gain = rv.gain->mean;
+        }
+        any = true;
+      }
+      r.plans.push_back(std::move(rv));
     }
-    result.rival = std::move(r);
+    confirmed = any;
+    if (best) {
+      r.plans[*best].applied = true;
+      decided = std::move(others[*best]);
+      chosen = rivals[*best];  // the plan decided on, from here on
+    }
+    result.rivals = std::move(r);
   }
   result.confirmation_channels = decided.channels;
   result.first_fold = decided.first_fold;
@@ -1189,13 +1224,15 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
                     (own_worse ? "its own channels (it did on every channel, Diebold-Mariano p " + std::string(p) + ")"
                                : (a.judged_on_every_channel ? "every channel" : "the channels it was found on") +
                                      std::string(" (Diebold-Mariano p ") + p + ")");
-    if (result.rival) {
-      char rival_p[32], level[32];
-      std::snprintf(rival_p, sizeof rival_p, "%.2g", result.rival->confirmation.p_value);
-      std::snprintf(level, sizeof level, "%.3g", alpha / 2);
-      result.status += ", nor did its rival " + result.rival->effect + " (" + result.rival->description +
-                       ", Diebold-Mariano p " + rival_p + "; the two tested at Holm's levels, the smaller p at " +
-                       level + ")";
+    if (result.rivals) {
+      char level[32];
+      std::snprintf(level, sizeof level, "%.3g", alpha / static_cast<double>(result.rivals->plans.size() + 1));
+      for (const auto& rv : result.rivals->plans) {
+        char rival_p[32];
+        std::snprintf(rival_p, sizeof rival_p, "%.2g", rv.confirmation.p_value);
+        result.status += ", nor did its rival " + rv.effect + " (" + rv.description + ", Diebold-Mariano p " + rival_p + ")";
+      }
+      result.status += std::string(" (tested at Holm's levels, the smallest p at ") + level + ")";
     }
     return result;
   }

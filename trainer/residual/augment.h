@@ -429,17 +429,19 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
 bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::size_t chosen, std::size_t probed);
 
 // The plans the held-out rows decide between with the selection's choice
-// planned[chosen] (docs/residual.md, "A curve or a drift: the held-out rows
-// decide", stop 70): when planned[chosen] is a calibration curve or a drift
-// with time, every load drift that holds a channel of one of its groups;
-// when it is a load drift, every calibration curve and drift with time that
-// does; else none. In `planned`'s order. They explain much the same
-// training rows (a bias that grows with the load a sensor has carried, a
-// static curve of the level and a bias that grows with time all follow a
-// grasp's load through a log), and only rows after them, where a load
-// drift has grown with the load and the others have not, tell them apart:
-// fix() tests the best of them that gained on the selection's rows beside
-// planned[chosen], the two at Holm's levels (FixResult::rival).
+// planned[chosen] (docs/residual.md, "Rivals: the held-out rows decide",
+// stop 70), each an addable plan that holds a channel of one of
+// planned[chosen]'s groups: when planned[chosen] is a calibration curve,
+// every plan of another effect; when it is a drift with time, every load
+// drift; when it is a load drift, every calibration curve and drift with
+// time; for any other effect none. In `planned`'s order. On the training
+// rows a curve of a channel's own level explains part of any effect's
+// residual on a channel that follows the load, and a load drift, a drift
+// with time and a curve all follow a grasp's load through a log; rows
+// after them tell them apart (a load drift has grown with the load, a
+// curve has not, a delay's or a leak's residual is not a static map):
+// fix() tests those that gained on the selection's rows beside
+// planned[chosen], all at Holm's levels (FixResult::rivals).
 std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planned, std::size_t chosen);
 
 // Whether planned[k] of plan_candidates() is a family alone: the plan right
@@ -756,32 +758,36 @@ struct FixResult {
     DieboldMariano gain;                // the confirmed change's loss minus the richer plan's on gain_channels
   };
   std::optional<RicherAccount> richer;
-  // The rival tested beside the selection's choice (decision_rivals(): a
-  // load drift, and a calibration curve or a drift with time, of one
-  // group), when one gained on the
-  // selection's rows: the best of them by the selection's statistic. Both
-  // are judged as the decision judges (every fold, against `reference`, a
-  // curve also on its own channels), and each is confirmed at Holm's level
-  // for two tests (the smaller p at alpha / 2, the other then at alpha).
-  // Confirmed alone, it is the decision's plan: `augmentation`, `after`,
-  // `confirmation` and what follows are then its. Both confirmed: the one
-  // that predicts the channels either changes better (gain's mean) is.
-  struct Rival {
-    std::size_t candidate = 0;  // its index in `candidates`
-    std::string effect, description;
-    std::vector<std::string> channels;              // its test's channels
-    DieboldMariano confirmation;                    // reference's loss minus the rival's, every fold
-    std::optional<DieboldMariano> own_channels;     // a curve: the same on its own channels
-    bool confirmed = false;                         // at Holm's level
-    std::string chosen_effect;                      // the selection's choice ...
-    DieboldMariano chosen_confirmation;             // ... its test (reference's loss minus its)
-    bool chosen_confirmed = false;                  // ... at Holm's level
-    double alpha = 0;                               // the decision's level (Holm's: alpha / 2, then alpha)
-    std::optional<DieboldMariano> gain;             // both confirmed: the choice's loss minus the rival's
-    std::vector<std::string> gain_channels;         // ... on the channels either changes
-    bool applied = false;                           // the decision's plan is the rival's
+  // The rivals tested beside the selection's choice (decision_rivals(): a
+  // curve and any other effect, a load drift and a curve or a drift with
+  // time, of one group), those that gained on the selection's rows too.
+  // Each is judged as the decision judges (every fold, against
+  // `reference`, a curve also on its own channels), and the choice and its
+  // m - 1 rivals are confirmed at Holm's levels for m tests (the i-th
+  // smallest p at alpha / (m - i), until one is not below its level). Of
+  // those confirmed, the one that predicts gain_channels (the channels any
+  // of them changes) best on the held-out rows is the decision's plan: a
+  // rival applied is then `augmentation`, `after`, `confirmation` and what
+  // follows; the choice wins a tie.
+  struct Rivals {
+    struct Rival {
+      std::size_t candidate = 0;  // its index in `candidates`
+      std::string effect, description;
+      std::vector<std::string> channels;           // its test's channels
+      DieboldMariano confirmation;                 // reference's loss minus the rival's, every fold
+      std::optional<DieboldMariano> own_channels;  // a curve: the same on its own channels
+      bool confirmed = false;                      // at Holm's level
+      std::optional<DieboldMariano> gain;          // confirmed: the choice's loss minus its on gain_channels
+      bool applied = false;                        // the decision's plan is this rival
+    };
+    std::string chosen_effect;           // the selection's choice ...
+    DieboldMariano chosen_confirmation;  // ... its test (reference's loss minus its)
+    bool chosen_confirmed = false;       // ... at Holm's level
+    double alpha = 0;                    // the decision's level
+    std::vector<std::string> gain_channels;
+    std::vector<Rival> plans;
   };
-  std::optional<Rival> rival;
+  std::optional<Rivals> rivals;
   std::optional<HeldOutError> control;  // fine-tuned without augmentation (options.control)
   std::vector<double> loss_history;     // fine-tuning loss per epoch (standardised)
   // drift: the attribution's rate per channel, before refine() (0 for a

@@ -33,9 +33,9 @@
 // the screen's candidates; it is judged on the training rows like them (a
 // load drift of its group chosen there gives way to it when it gains too
 // and predicts their channels better: gives_way_to_group_drift; a
-// calibration curve or a drift with time chosen there has it, or another
-// load drift of its group, as its rival on the held-out rows:
-// decision_rivals), and only
+// calibration curve or a drift with time chosen there has the load drifts
+// of its group among its rivals on the held-out rows: decision_rivals),
+// and only
 // the decision on the held-out rows, against fine-tuning alone, confirms it
 // (augment.h, fix()). The held-out rows play no part here. Nothing here
 // knows the hand: groups come from the model's channel names
