@@ -277,8 +277,12 @@
 # 2910-2929 drift=0.02 and 2930-2939 every effect at its larger strength
 # measured with the curve's rivalry alone (2940-2959: clean sets), then
 # 2926 development of the time drift's; 2960-2979 drift=0.02 measured
-# with the final code, and 2919 and 2923 (time drifts among their
-# candidates) re-run with it. Next unused: 2980 on.
+# with that step, and 2919 and 2923 (time drifts among their candidates)
+# re-run with it; then 2931 (sensor delay), 2852, 2853, 2857 and 2932
+# (curve), 2935 (rail), 2963 (drift) and stop 69's tension-leak set 2853
+# development of a curve's rivals in every effect; 2980-2989 every
+# effect at its larger strength and 2990-3009 drift=0.02 measured with
+# the final code (3010-3029: clean sets). Next unused: 3030 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

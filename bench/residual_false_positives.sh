@@ -114,9 +114,8 @@
 # 2790-2809 with its final code (the probe's place; 0 of 20). Stop 69 (a
 # drift family gives way to its group): 2830-2849 (its first version),
 # 2890-2909 at RESIDUAL_ROWS=600 (its final version). Stop 70 (rivals on
-# the held-out rows): 2940-2959 measured with its first version (0 of 20;
-# no time drift among their candidates, so the final code makes the same
-# runs). Next unused seed: 2980
+# the held-out rows): 2940-2959 measured with its first version (0 of 20),
+# 3010-3029 with its final code (0 of 20). Next unused seed: 3030
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
