@@ -953,8 +953,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   Decision decided = decide(chosen);
   bool confirmed = decided.p() < alpha;
   if (!rivals.empty()) {
-    // The choice and its rivals at Holm's levels for m tests: the i-th
-    // smallest p at alpha / (m - i), until one is not below its level.
+    // The choice and its rivals at Holm's levels for m tests (the i-th
+    // smallest p at alpha / (m - i), until one is not below its level):
+    // confirmed where the Holm-adjusted p is below alpha.
     std::vector<Decision> others;
     for (const std::size_t k : rivals) others.push_back(decide(k));
     FixResult::Rivals r;
@@ -963,14 +964,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     r.alpha = alpha;
     std::vector<double> p = {decided.p()};
     for (const Decision& o : others) p.push_back(o.p());
-    std::vector<std::size_t> order(p.size());
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return p[x] < p[y]; });
-    std::vector<bool> holm(p.size(), false);
-    for (std::size_t i = 0; i < order.size(); ++i) {
-      if (!(p[order[i]] < alpha / static_cast<double>(p.size() - i))) break;
-      holm[order[i]] = true;
-    }
+    const std::vector<double> adjusted = holm_adjust(p);
+    std::vector<bool> holm(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) holm[i] = adjusted[i] < alpha;
     r.chosen_confirmed = holm[0];
     // Of those confirmed, the one that predicts the channels any of them
     // changes best on the held-out rows: the largest gain over the choice
