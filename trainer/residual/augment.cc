@@ -737,6 +737,16 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     t.model.check_consistent();
     return t;
   };
+  // The model's channels that any of `sets` holds, in the model's order.
+  const auto in_model_order = [&](std::initializer_list<const std::vector<std::string>*> sets) {
+    std::vector<std::string> out;
+    for (const auto& name : model.layout.y_names)
+      if (std::any_of(sets.begin(), sets.end(), [&](const std::vector<std::string>* set) {
+            return std::find(set->begin(), set->end(), name) != set->end();
+          }))
+        out.push_back(name);
+    return out;
+  };
   auto channels_of = [&](const Augmentation& a) {
     if (a.judged_on_every_channel) return model.layout.y_names;
     std::vector<std::string> out;
@@ -752,7 +762,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // first 75 % of the training rows and compared on the rest (one-sided
   // Diebold-Mariano); the first significant at alpha is chosen, else the
   // clearest gain (chosen_candidate). The held-out rows play no part, so
-  // the decision below tests one candidate at the full alpha.
+  // the decision below tests one candidate at the full alpha (or, with its
+  // rivals, each at Holm's levels: decision_rivals).
   std::size_t chosen = 0;
   std::vector<std::size_t> rivals;  // decision_rivals() that gained: tested beside the choice
   for (std::size_t k = 0; k < planned.size(); ++k) {
@@ -820,11 +831,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       if (!judged_rows[*probed]) judge(*probed);
       CandidateTrial& family = result.candidates[chosen];
       const CandidateTrial& group = result.candidates[*probed];
-      std::vector<std::string> either;  // in the model's order
-      for (const auto& name : model.layout.y_names)
-        if (std::find(family.channels.begin(), family.channels.end(), name) != family.channels.end() ||
-            std::find(group.channels.begin(), group.channels.end(), name) != group.channels.end())
-          either.push_back(name);
+      const std::vector<std::string> either = in_model_order({&family.channels, &group.channels});
       family.group_drift_gain = diebold_mariano(standardised_loss(model, *judged_rows[chosen], either, loss),
                                                 standardised_loss(model, *judged_rows[*probed], either, loss));
       if (group.selection.mean > 0 && family.group_drift_gain->mean > 0) {
@@ -971,18 +978,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     // Of those confirmed, the one that predicts the channels any of them
     // changes best on the held-out rows: the largest gain over the choice
     // there (the choice's own is 0).
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      if (!holm[i]) continue;
-      const std::vector<std::string>& ch = i == 0 ? decided.channels : others[i - 1].channels;
-      for (const auto& name : ch)
-        if (std::find(r.gain_channels.begin(), r.gain_channels.end(), name) == r.gain_channels.end())
-          r.gain_channels.push_back(name);
-    }
-    std::vector<std::string> in_order;  // the model's order
-    for (const auto& name : model.layout.y_names)
-      if (std::find(r.gain_channels.begin(), r.gain_channels.end(), name) != r.gain_channels.end())
-        in_order.push_back(name);
-    r.gain_channels = in_order;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (holm[i])
+        r.gain_channels = in_model_order({&r.gain_channels, i == 0 ? &decided.channels : &others[i - 1].channels});
     std::optional<std::size_t> best;  // index into others; none: the choice
     double best_gain = 0;
     bool any = r.chosen_confirmed;
