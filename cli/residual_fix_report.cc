@@ -296,27 +296,27 @@ std::string richer_sentence(const rs::FixResult::RicherAccount& r, const std::st
 
 std::string rivals_sentence(const rs::FixResult::Rivals& r, const std::string& reference) {
   const std::size_t m = r.plans.size() + 1;
-  std::string m_ = "Rivals of " + r.chosen_effect + " (p " + num("%.2g", r.chosen_confirmation.p_value) +
+  std::string text = "Rivals of " + r.chosen_effect + " (p " + num("%.2g", r.chosen_confirmation.p_value) +
                    (r.chosen_confirmed ? ", confirmed" : ", not confirmed") + "), each tested beside it against " +
                    reference + " on the held-out rows of its channels, at Holm's levels for " + std::to_string(m) +
                    " tests (the smallest p at " + num("%.3g", r.alpha / static_cast<double>(m)) + "):";
   bool applied = false;
   for (const auto& rv : r.plans) {
-    m_ += " " + rv.effect + " (" + rv.description + "): mean loss difference " + num("%.3g", rv.confirmation.mean) +
+    text += " " + rv.effect + " (" + rv.description + "): mean loss difference " + num("%.3g", rv.confirmation.mean) +
           ", p " + num("%.2g", rv.confirmation.p_value);
-    if (rv.own_channels) m_ += ", on its own channels " + num("%.3g", rv.own_channels->mean);
-    m_ += rv.confirmed ? ", confirmed" : ", not confirmed";
-    if (rv.gain) m_ += ", its gain over " + r.chosen_effect + " on the channels any confirmed one changes " +
+    if (rv.own_channels) text += ", on its own channels " + num("%.3g", rv.own_channels->mean);
+    text += rv.confirmed ? ", confirmed" : ", not confirmed";
+    if (rv.gain) text += ", its gain over " + r.chosen_effect + " on the channels any confirmed one changes " +
                        num("%.3g", rv.gain->mean);
     if (rv.applied) {
-      m_ += ", applied in its place";
+      text += ", applied in its place";
       applied = true;
     }
-    m_ += ";";
+    text += ";";
   }
-  m_.pop_back();
-  if (!applied && r.chosen_confirmed) m_ += "; " + r.chosen_effect + " kept";
-  return m_;
+  text.pop_back();
+  if (!applied && r.chosen_confirmed) text += "; " + r.chosen_effect + " kept";
+  return text;
 }
 
 std::string extension_sentence(const rs::FixResult::Extension& e) {
