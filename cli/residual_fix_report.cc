@@ -297,17 +297,17 @@ std::string richer_sentence(const rs::FixResult::RicherAccount& r, const std::st
 std::string rivals_sentence(const rs::FixResult::Rivals& r, const std::string& reference) {
   const std::size_t m = r.plans.size() + 1;
   std::string text = "Rivals of " + r.chosen_effect + " (p " + num("%.2g", r.chosen_confirmation.p_value) +
-                   (r.chosen_confirmed ? ", confirmed" : ", not confirmed") + "), each tested beside it against " +
-                   reference + " on the held-out rows of its channels, at Holm's levels for " + std::to_string(m) +
-                   " tests (the smallest p at " + num("%.3g", r.alpha / static_cast<double>(m)) + "):";
+                     (r.chosen_confirmed ? ", confirmed" : ", not confirmed") + "), each tested beside it against " +
+                     reference + " on the held-out rows of its channels, at Holm's levels for " + std::to_string(m) +
+                     " tests (the smallest p at " + num("%.3g", r.alpha / static_cast<double>(m)) + "):";
   bool applied = false;
   for (const auto& rv : r.plans) {
     text += " " + rv.effect + " (" + rv.description + "): mean loss difference " + num("%.3g", rv.confirmation.mean) +
-          ", p " + num("%.2g", rv.confirmation.p_value);
+            ", p " + num("%.2g", rv.confirmation.p_value);
     if (rv.own_channels) text += ", on its own channels " + num("%.3g", rv.own_channels->mean);
     text += rv.confirmed ? ", confirmed" : ", not confirmed";
     if (rv.gain) text += ", its gain over " + r.chosen_effect + " on the channels any confirmed one changes " +
-                       num("%.3g", rv.gain->mean);
+                         num("%.3g", rv.gain->mean);
     if (rv.applied) {
       text += ", applied in its place";
       applied = true;
