@@ -833,6 +833,12 @@ TEST(DriftProbe, OneLoadDriftPerGroupAtOneRateTheBestGroupACandidate) {
   ASSERT_LT(p_b, p_a);
   EXPECT_NEAR(both[1].p_adjusted, std::min(1.0, 2 * p_b), 1e-12);
   EXPECT_NEAR(both[0].p_adjusted, std::min(1.0, std::max(2 * p_b, p_a)), 1e-12);
+  // Both candidates are proposed, the smaller adjusted p first (stop 71).
+  ASSERT_TRUE(both[0].candidate && both[1].candidate);
+  const std::vector<const residual::DriftProbe*> proposed = residual::candidate_drift_probes(both);
+  ASSERT_EQ(proposed.size(), 2u);
+  EXPECT_EQ(proposed[0]->group, "b");
+  EXPECT_EQ(proposed[1]->group, "a");
   rows.refined = [](residual::Augmentation a) {
     for (auto& d : std::get<residual::BiasState>(a.change).drifts) d.rate = d.channel[0] == 'a' ? 2 * d.rate : 0.0;
     return a;
@@ -840,11 +846,11 @@ TEST(DriftProbe, OneLoadDriftPerGroupAtOneRateTheBestGroupACandidate) {
   gain["b0"] = 0.5;
   EXPECT_EQ(probes[2].start_rate, 0.0);
   EXPECT_FALSE(probes[2].candidate);
-  ASSERT_NE(residual::best_drift_probe(probes), nullptr);
-  EXPECT_EQ(residual::best_drift_probe(probes)->group, "a");
+  ASSERT_EQ(residual::candidate_drift_probes(probes).size(), 1u);
+  EXPECT_EQ(residual::candidate_drift_probes(probes).front()->group, "a");
   // A loss that rises with the drift is no candidate.
   gain["a0"] = -0.5;
-  EXPECT_EQ(residual::best_drift_probe(residual::probe_drifts(model, data, rows, 0.01)), nullptr);
+  EXPECT_TRUE(residual::candidate_drift_probes(residual::probe_drifts(model, data, rows, 0.01)).empty());
   // A channel the sensor model already drifts is left out of its group; a
   // group it drifts whole is not probed.
   gain["a0"] = 0.5;
@@ -899,6 +905,11 @@ TEST(DriftProbe, ItsCandidateFollowsTheScreensDriftOfItsGroupElseComesLast) {
   EXPECT_EQ(place({mixed_drift, curve, crosstalk}, "fc"), std::make_pair(std::size_t{1}, false));
   EXPECT_EQ(place({mixed_drift, curve, crosstalk}, "f"), std::make_pair(std::size_t{1}, false));
   EXPECT_EQ(place({mixed_drift, curve, crosstalk}, "l"), std::make_pair(std::size_t{3}, false));
+  // A second candidate group (stop 71: every candidate group is proposed)
+  // always has a place once the first is in: last, beyond the count.
+  const auto fc_probe = plan(EffectKind::kDriftLoad, "fc2");
+  EXPECT_EQ(place({curve, crosstalk, fc_probe}, "th"), std::make_pair(std::size_t{3}, false));
+  EXPECT_EQ(place({curve, fc_drift, fc_probe, crosstalk}, "f"), std::make_pair(std::size_t{4}, false));
   // Nothing that can be added: the only one.
   auto unfixable = curve;
   unfixable.not_fixable = "no knots";
@@ -971,6 +982,18 @@ TEST(DecisionRivals, ACurveAndATimeDriftHaveRivalsInTheirGroupAndALoadDriftIsEac
   unfixable[1].not_fixable = "no level";
   EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{2, 4, 5}));
   EXPECT_TRUE(residual::decision_rivals(unfixable, 1).empty());
+  // The drift probe's plans (indices 2 and 3 here) are a load drift's
+  // rivals whatever their group, and of nothing else beyond the rules above.
+  const Rivals probed = {2, 3};
+  EXPECT_EQ(residual::decision_rivals(planned, 1, probed), (Rivals{0, 2, 3, 4}));
+  EXPECT_EQ(residual::decision_rivals(planned, 2, probed), (Rivals{0, 3, 4, 6}));
+  EXPECT_EQ(residual::decision_rivals(planned, 3, probed), (Rivals{2, 6}));
+  EXPECT_EQ(residual::decision_rivals(planned, 0, probed), (Rivals{1, 2, 4, 5}));
+  EXPECT_EQ(residual::decision_rivals(planned, 4, probed), (Rivals{1, 2}));
+  EXPECT_TRUE(residual::decision_rivals(planned, 5, probed).empty());
+  EXPECT_EQ(residual::decision_rivals(unfixable, 3, probed), (Rivals{2, 6}));
+  unfixable[2].not_fixable = "no level";
+  EXPECT_EQ(residual::decision_rivals(unfixable, 3, probed), (Rivals{6}));
 }
 
 // A model of two y channels, a and b, of standard deviations 2 and 4.

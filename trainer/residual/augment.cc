@@ -389,11 +389,13 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
   return load_drift_of_group(planned[chosen], channel_group(probe.channels.front()));
 }
 
-std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planned, std::size_t chosen) {
+std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planned, std::size_t chosen,
+                                         const std::vector<std::size_t>& probed) {
   std::vector<std::size_t> rivals;
   if (chosen >= planned.size()) return rivals;
   const Augmentation& a = planned[chosen];
   const auto addable = [](const Augmentation& p) { return p.not_fixable.empty() && !p.channels.empty(); };
+  const auto is_probe = [&](std::size_t k) { return std::find(probed.begin(), probed.end(), k) != probed.end(); };
   // A curve's rivals: any other effect; a drift with time's: a load drift;
   // a load drift's: a curve or a drift with time; any other effect's: none.
   const auto is_rival = [&](const Augmentation& p) {
@@ -407,7 +409,13 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
   };
   if (!addable(a)) return rivals;
   for (std::size_t k = 0; k < planned.size(); ++k) {
-    if (k == chosen || !is_rival(planned[k])) continue;
+    if (k == chosen) continue;
+    // A load drift's rivals also: the drift probe's plans, of any group.
+    if (a.kind == EffectKind::kDriftLoad && is_probe(k) && addable(planned[k])) {
+      rivals.push_back(k);
+      continue;
+    }
+    if (!is_rival(planned[k])) continue;
     const bool shares_group = std::any_of(a.channels.begin(), a.channels.end(), [&](const std::string& name) {
       const std::string group = channel_group(name);
       return std::any_of(planned[k].channels.begin(), planned[k].channels.end(),
@@ -673,10 +681,10 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // slow drift, and lists it on a family of one or two channels, so every
   // channel group is asked with the unchanged network whether a load drift
   // at one re-estimated rate predicts the selection's judged rows better.
-  // The best group that does is one more candidate, where
-  // drift_probe_place() puts it. The selection then chooses among them as
-  // among any.
-  std::optional<std::size_t> probed;  // its index in `planned`
+  // Every group that does is one more candidate, where drift_probe_place()
+  // puts it, the smallest adjusted p first (candidate_drift_probes). The
+  // selection then chooses among them as among any.
+  std::vector<std::size_t> probed;  // their indices in `planned`
   if (options.drift_probe_alpha > 0 && can_select && drift_probe_has_place(planned, options.candidates)) {
     DriftProbeRows rows;
     rows.refined = [&](const Augmentation& plan) { return refined(plan, selection_train, nullptr); };
@@ -692,12 +700,15 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       return standardised_loss(model, *unchanged, channels, loss);
     };
     result.drift_probes = probe_drifts(model, data, rows, options.drift_probe_alpha);
-    if (const DriftProbe* best = best_drift_probe(result.drift_probes)) {
-      const ProbePlace place = drift_probe_place(planned, best->group, options.candidates);
+    for (const DriftProbe* p : candidate_drift_probes(result.drift_probes)) {
+      // After the first, a place is always left: the first is a load drift.
+      const ProbePlace place = drift_probe_place(planned, p->group, options.candidates);
       if (place.replaces_all) planned.clear();
       planned.insert(planned.begin() + static_cast<std::ptrdiff_t>(place.at),
-                     group_drift_plan(best->channels, data.logs.front().dt_s, best->start_rate));
-      probed = place.at;
+                     group_drift_plan(p->channels, data.logs.front().dt_s, p->start_rate));
+      for (std::size_t& k : probed)
+        if (k >= place.at) ++k;
+      probed.push_back(place.at);
     }
   }
   // The earlier round's plans after this round's (a winner of this round
@@ -772,7 +783,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     c.description = planned[k].description;
     c.channels = channels_of(planned[k]);
     c.screen_statistic = planned[k].screen_statistic;
-    c.from_drift_probe = probed && *probed == k;
+    c.from_drift_probe = std::find(probed.begin(), probed.end(), k) != probed.end();
     c.from_earlier_round = k >= first_earlier;
     c.below_screen_floor = !c.from_drift_probe && !c.from_earlier_round && attribution.null &&
                            c.screen_statistic < attribution.options.min_excess_null;
@@ -827,21 +838,26 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     // A drift family gives way to the drift probe's plan of its group when
     // that plan gains on the selection's rows too and predicts the channels
     // either changes better there (gives_way_to_group_drift).
-    if (probed && judged_rows[chosen] && gives_way_to_group_drift(planned, chosen, *probed)) {
-      if (!judged_rows[*probed]) judge(*probed);
+    // (The probe of the family's first group that holds one of its channels.)
+    const auto group_probe = std::find_if(probed.begin(), probed.end(), [&](std::size_t k) {
+      return gives_way_to_group_drift(planned, chosen, k);
+    });
+    if (judged_rows[chosen] && group_probe != probed.end()) {
+      const std::size_t g = *group_probe;
+      if (!judged_rows[g]) judge(g);
       CandidateTrial& family = result.candidates[chosen];
-      const CandidateTrial& group = result.candidates[*probed];
+      const CandidateTrial& group = result.candidates[g];
       const std::vector<std::string> either = in_model_order({&family.channels, &group.channels});
       family.group_drift_gain = diebold_mariano(standardised_loss(model, *judged_rows[chosen], either, loss),
-                                                standardised_loss(model, *judged_rows[*probed], either, loss));
+                                                standardised_loss(model, *judged_rows[g], either, loss));
       if (group.selection.mean > 0 && family.group_drift_gain->mean > 0) {
         family.gave_way_to_group_drift = true;
-        chosen = *probed;
+        chosen = g;
       }
     }
     // Rivals (decision_rivals): those that gained on the selection's rows
     // too are tested beside the choice.
-    for (const std::size_t k : decision_rivals(planned, chosen)) {
+    for (const std::size_t k : decision_rivals(planned, chosen, probed)) {
       if (!judged_rows[k]) judge(k);
       if (result.candidates[k].selection.mean > 0) rivals.push_back(k);
     }

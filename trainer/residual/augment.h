@@ -434,7 +434,11 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 // planned[chosen]'s groups: when planned[chosen] is a calibration curve,
 // every plan of another effect; when it is a drift with time, every load
 // drift; when it is a load drift, every calibration curve and drift with
-// time; for any other effect none. In `planned`'s order. On the training
+// time, and the drift probe's plans (`probed`: their indices in `planned`),
+// of any group (stop 71: a family kept over its group's plan, or a
+// tendon's or joint's plan the probe ranked first, was not confirmed where
+// the loadcells' plan was never tested); for any other effect none. In
+// `planned`'s order. On the training
 // rows a curve of a channel's own level explains part of any effect's
 // residual on a channel that follows the load, and a load drift, a drift
 // with time and a curve all follow a grasp's load through a log; rows
@@ -442,7 +446,8 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 // curve has not, a delay's or a leak's residual is not a static map):
 // fix() tests those that gained on the selection's rows beside
 // planned[chosen], all at Holm's levels (FixResult::rivals).
-std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planned, std::size_t chosen);
+std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planned, std::size_t chosen,
+                                         const std::vector<std::size_t>& probed = {});
 
 // Whether planned[k] of plan_candidates() is a family alone: the plan right
 // after the same plan extended to its group.
@@ -666,9 +671,10 @@ struct FixResult {
   std::vector<Augmentation> candidate_plans;       // candidates[k]'s plan, before any re-estimation
   // The drift probes (drift_probe.h), run when the logs are long enough for
   // the selection's rows and the screen proposes a load drift or leaves a
-  // candidate's place (FixOptions::drift_probe_alpha > 0); the best
-  // candidate group follows the screen's load drifts of its group among
-  // `candidates`, or is the last of them (CandidateTrial::from_drift_probe).
+  // candidate's place (FixOptions::drift_probe_alpha > 0); each candidate
+  // group (the smallest adjusted p first: candidate_drift_probes) follows the
+  // screen's load drifts of its group among `candidates`, or comes last
+  // (CandidateTrial::from_drift_probe).
   // Empty: not run.
   std::vector<DriftProbe> drift_probes;
   // Wider plans tested after the confirmation, in order: a confirmed family

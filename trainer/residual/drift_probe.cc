@@ -93,11 +93,13 @@ std::vector<DriftProbe> probe_drifts(const HadynetModel& model, const ResidualDa
   return probes;
 }
 
-const DriftProbe* best_drift_probe(const std::vector<DriftProbe>& probes) {
-  const DriftProbe* best = nullptr;
+std::vector<const DriftProbe*> candidate_drift_probes(const std::vector<DriftProbe>& probes) {
+  std::vector<const DriftProbe*> out;
   for (const DriftProbe& p : probes)
-    if (p.candidate && (best == nullptr || p.p_adjusted < best->p_adjusted)) best = &p;
-  return best;
+    if (p.candidate) out.push_back(&p);
+  std::stable_sort(out.begin(), out.end(),
+                   [](const DriftProbe* a, const DriftProbe* b) { return a->p_adjusted < b->p_adjusted; });
+  return out;
 }
 
 }  // namespace hadynet::trainer::residual
