@@ -982,14 +982,16 @@ TEST(DecisionRivals, ACurveAndATimeDriftHaveRivalsInTheirGroupAndALoadDriftIsEac
   unfixable[1].not_fixable = "no level";
   EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{2, 4, 5}));
   EXPECT_TRUE(residual::decision_rivals(unfixable, 1).empty());
-  // The drift probe's plans (indices 2 and 3 here) are a load drift's
-  // rivals whatever their group, and of nothing else beyond the rules above.
+  // The drift probe's plans (indices 2 and 3 here) are a drift's rivals
+  // (a load drift's or a drift with time's) whatever their group, and of
+  // nothing else beyond the rules above.
   const Rivals probed = {2, 3};
   EXPECT_EQ(residual::decision_rivals(planned, 1, probed), (Rivals{0, 2, 3, 4}));
   EXPECT_EQ(residual::decision_rivals(planned, 2, probed), (Rivals{0, 3, 4, 6}));
   EXPECT_EQ(residual::decision_rivals(planned, 3, probed), (Rivals{2, 6}));
   EXPECT_EQ(residual::decision_rivals(planned, 0, probed), (Rivals{1, 2, 4, 5}));
-  EXPECT_EQ(residual::decision_rivals(planned, 4, probed), (Rivals{1, 2}));
+  EXPECT_EQ(residual::decision_rivals(planned, 4, probed), (Rivals{1, 2, 3}));
+  EXPECT_EQ(residual::decision_rivals(planned, 6, probed), (Rivals{2, 3}));
   EXPECT_TRUE(residual::decision_rivals(planned, 5, probed).empty());
   EXPECT_EQ(residual::decision_rivals(unfixable, 3, probed), (Rivals{2, 6}));
   unfixable[2].not_fixable = "no level";

@@ -410,8 +410,9 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
   if (!addable(a)) return rivals;
   for (std::size_t k = 0; k < planned.size(); ++k) {
     if (k == chosen) continue;
-    // A load drift's rivals also: the drift probe's plans, of any group.
-    if (a.kind == EffectKind::kDriftLoad && is_probe(k) && addable(planned[k])) {
+    // A drift's rivals also: the drift probe's plans, of any group.
+    const bool drift = a.kind == EffectKind::kDriftLoad || a.kind == EffectKind::kDriftTime;
+    if (drift && is_probe(k) && addable(planned[k])) {
       rivals.push_back(k);
       continue;
     }

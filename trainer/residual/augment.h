@@ -434,10 +434,11 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 // planned[chosen]'s groups: when planned[chosen] is a calibration curve,
 // every plan of another effect; when it is a drift with time, every load
 // drift; when it is a load drift, every calibration curve and drift with
-// time, and the drift probe's plans (`probed`: their indices in `planned`),
-// of any group (stop 71: a family kept over its group's plan, or a
-// tendon's or joint's plan the probe ranked first, was not confirmed where
-// the loadcells' plan was never tested); for any other effect none. In
+// time; and for either drift also the drift probe's plans (`probed`: their
+// indices in `planned`) of any group (stop 71: a family kept over its
+// group's plan was not confirmed, and a drift with time of one tendon was
+// confirmed, where the loadcells' plan was never tested beside them); for
+// any other effect none. In
 // `planned`'s order. On the training
 // rows a curve of a channel's own level explains part of any effect's
 // residual on a channel that follows the load, and a load drift, a drift

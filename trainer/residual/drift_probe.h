@@ -35,7 +35,7 @@
 // its group chosen there gives way to it when it gains too and predicts
 // their channels better: gives_way_to_group_drift; a calibration curve or a
 // drift with time chosen there has the load drifts of its group among its
-// rivals on the held-out rows, and a load drift chosen there every probe's
+// rivals on the held-out rows, and either drift chosen there every probe's
 // plan: decision_rivals), and only
 // the decision on the held-out rows, against fine-tuning alone, confirms it
 // (augment.h, fix()). The held-out rows play no part here. Nothing here
