@@ -1,6 +1,11 @@
 """Checks shared by the CLI tests of `hadynet residual --fix` on plant logs
 (residual_plant_delay_test.sh, residual_rail_simpler_test.sh,
-residual_leak_between_groups_test.sh).
+residual_leak_between_groups_test.sh, residual_drift_rival_test.sh,
+residual_drift_group_rival_test.sh).
+
+named_with_cut(case, seed, json_path, check): the detection bench's rule
+on one run (named with its parameter, cut by 30 %, below fine-tuning
+alone).
 
 lead_and_loadcells(fix, check): issue 12's bar on the fix's lead channel
 (the first of the applied plan's channels: held-out RMSE cut by 30 % and
@@ -45,3 +50,16 @@ def checked_fix(json_path):
         sys.exit(1 if failures else 0)
 
     return fix, fix.get("augmentation") or {}, check, finish
+
+
+def named_with_cut(case, seed, json_path, check):
+    """The detection bench's rule on one run (bench/residual_run_line.py,
+    which must be importable): the plant effect `case` ("drift=0.02") named
+    with its parameter, the held-out RMSE of the changed channels cut by
+    30 % and below fine-tuning alone. Prints the bench's line."""
+    import re
+    from residual_run_line import run_line
+    line = run_line(case, seed, json_path, "")
+    print(line)
+    check(re.search(r"named yes cut yes .*<control yes", line) is not None,
+          f"{case}: not named with a cut of 30 % below fine-tuning alone")

@@ -25,16 +25,11 @@ source "$here/test/cli/plant_fix_run.sh"
 plant_fix_run "$hadynet" "$model" "$work" 2865 -- --effect drift=0.02 || exit 1
 grep -E "^(fix|decision|Rivals)" "$work/out.txt" | cut -c1-400
 python3 - "$work/residual.json" "$here/bench" "$here/test/cli" <<'PY'
-import re
 import sys
 sys.path[:0] = sys.argv[2:4]
-from residual_run_line import run_line
-from plant_fix_checks import checked_fix
+from plant_fix_checks import checked_fix, named_with_cut
 fix, aug, check, finish = checked_fix(sys.argv[1])
-line = run_line("drift=0.02", 2865, sys.argv[1], "")
-print(line)
-check(re.search(r"named yes cut yes .*<control yes", line) is not None,
-      "the drift not named with a cut of 30 % below fine-tuning alone")
+named_with_cut("drift=0.02", 2865, sys.argv[1], check)
 chosen = [c for c in fix.get("candidates", []) if c.get("chosen")]
 if chosen and chosen[0]["effect"] == "sensor-curve":
     check(fix.get("rivals") is not None, "a curve chosen and no rival tested beside it")
