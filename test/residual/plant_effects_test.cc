@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iterator>
+#include <map>
 #include <set>
 #include <variant>
 
@@ -175,14 +176,15 @@ TEST(PlantEffects, CrosstalkIsNamedWithAPlantPairAndGain) {
   EXPECT_LT(w.parameter, 0.5) << w.label;
 
   // The plan removes the winner's pair and, the pair being within one group,
-  // the best significant plausible pair (ranking order) of each further
-  // target of the group whose source is in the group, unless it would chain
+  // for each further target of the group its source: of its significant
+  // plausible pairs with the source in the group, the one of the largest
+  // held-out t (stop 71), taken in ranking order, unless it would chain
   // with a pair taken (its target a source or a target, its source a target
   // of one): with no chain, removing each pair's measured source is exact.
   // Nor a pair whose reverse is significant too (a mutual pair, as the
   // plant's fc3 <-> fc4: each reads the other, so removing one side against
-  // its measured source is biased; docs/residual.md, stop 63), nor then
-  // any lesser pair of its target.
+  // its measured source is biased; docs/residual.md, stop 63). A target
+  // whose source is left out takes no lesser pair.
   const std::vector<Augmentation> two = plan_candidates(o.data, o.attribution, 2);
   ASSERT_EQ(two.size(), 2u);
   ASSERT_TRUE(std::holds_alternative<CrosstalkRemoval>(two[0].change)) << two[0].effect;
@@ -195,16 +197,25 @@ TEST(PlantEffects, CrosstalkIsNamedWithAPlantPairAndGain) {
     if (r.hypothesis.kind == EffectKind::kCrosstalk)
       significant.insert({name_of(o, r.hypothesis.source), name_of(o, r.hypothesis.target)});
   }
-  std::set<std::string> left_out;  // targets whose best pair is mutual
+  std::map<std::string, std::pair<std::string, double>> source_of;  // target -> (source, t)
   for (const auto& r : o.attribution.ranked) {
     if (!r.significant) break;
     if (r.hypothesis.kind != EffectKind::kCrosstalk) continue;
     const std::string source = name_of(o, r.hypothesis.source), target = name_of(o, r.hypothesis.target);
     if (channel_group(target) != "fc" || channel_group(source) != "fc") continue;
+    if (!source_of.count(target) || r.t_stat > source_of[target].second) source_of[target] = {source, r.t_stat};
+  }
+  std::set<std::string> left_out;  // targets whose source forms a mutual pair
+  for (const auto& r : o.attribution.ranked) {
+    if (!r.significant) break;
+    if (r.hypothesis.kind != EffectKind::kCrosstalk) continue;
+    const std::string source = name_of(o, r.hypothesis.source), target = name_of(o, r.hypothesis.target);
+    if (channel_group(target) != "fc" || channel_group(source) != "fc") continue;
+    if (source_of[target].first != source) continue;  // not the target's source
     const bool chained = std::any_of(expected.begin(), expected.end(), [&](const auto& x) {
       return x.second == target || x.first == target || x.second == source;
     });
-    if (chained || left_out.count(target)) continue;
+    if (chained) continue;
     if (significant.count({target, source})) {  // mutual: the target takes no pair
       left_out.insert(target);
       continue;
