@@ -282,7 +282,18 @@
 # (curve), 2935 (rail), 2963 (drift) and stop 69's tension-leak set 2853
 # development of a curve's rivals in every effect; 2980-2989 every
 # effect at its larger strength and 2990-3009 drift=0.02 measured with
-# the final code (3010-3029: clean sets). Next unused: 3030 on.
+# the final code (3010-3029: clean sets). Stop 71 (every group the drift
+# probe finds is a candidate; a chosen drift has the probe's plans as
+# rivals; a cross-talk's further target takes the source of its clearest
+# held-out t): 2981, 3000, 2778, 2878, 2504 and 2857 (drift) development
+# of the first two; 3030-3049 drift=0.02 and 3050-3059 every effect at its
+# larger strength measured with them (3060-3079: clean sets); then 3054
+# (a drift with time chosen) development of the time drift's rivals, and
+# 3050, 3052, 3056 (this stop's), 2933, 2938 and 2989 (stop 70's)
+# cross-talk sets development of the cross-talk's source; 3080-3099
+# drift=0.02 measured with the drift rules; 3100-3119 crosstalk=0.35 and
+# 3130-3139 every effect at its larger strength measured with the final
+# code (3140-3159: clean sets). Next unused: 3160 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

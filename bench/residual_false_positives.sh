@@ -115,7 +115,11 @@
 # drift family gives way to its group): 2830-2849 (its first version),
 # 2890-2909 at RESIDUAL_ROWS=600 (its final version). Stop 70 (rivals on
 # the held-out rows): 2940-2959 measured with its first version (0 of 20),
-# 3010-3029 with its final code (0 of 20). Next unused seed: 3030
+# 3010-3029 with its final code (0 of 20). Stop 71 (every group the drift
+# probe finds; its plans as a drift's rivals; a cross-talk's source by
+# its t): 3060-3079 measured with its drift rules alone (1 of 20: 3077, a
+# curve stop 70's code confirms too), 3140-3159 with its final code (1 of
+# 20: 3156, likewise). Next unused seed: 3160
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

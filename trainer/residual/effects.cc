@@ -1463,7 +1463,8 @@ const std::vector<EffectInfo>& effect_library() {
        "leaking into the target, and what the network carries over of it from x_{t-1}",
        "gain: the fraction of y_s the target picks up (the coefficient of y_s(t))",
        "removal: train on y_c - k y_s (in y and x); the sensor model adds k times the predicted y_s back; "
-       "within one group also the group's further significant pairs that form no chain",
+       "within one group also each further target's source (its significant pair of the clearest held-out t) "
+       "when that pair forms no chain",
        SourceKind::kObserved, crosstalk::enumerate, crosstalk::features, first_coefficient, crosstalk::fraction,
        crosstalk::describe, crosstalk::plan, nullptr, nullptr, nullptr, std::nullopt, crosstalk::richer},
       {EffectKind::kAuxChannel, "aux-channel", "an aux_* column's value at t: a logged channel the model does not use",
