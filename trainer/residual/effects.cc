@@ -1185,10 +1185,10 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
 
 // The winner's pair; when its source is in its target's group (and the
 // plan may extend: Augmentation::group_extension), also, in ranking order,
-// each further target's source (since stop 71 the one pair of it with the
-// clearest held-out t; below) when that pair is significant in the group (target and source in it; significant
-// at the floors `attribution` has: fix() plans at the candidates' floor,
-// --fix-min-excess-null) that forms no chain (forms_chain) with a pair
+// each further target's source (since stop 71 its one pair of the clearest
+// held-out t; below): a significant pair of the group (target and source
+// in it; significant at the floors `attribution` has: fix() plans at the
+// candidates' floor, --fix-min-excess-null) that forms no chain (forms_chain) with a pair
 // taken or with one of the model's own (data.crosstalk: an earlier
 // round's), and whose reverse pair is not significant too: of a mutual
 // pair (the plant's ring and little fingertips read each other) each
