@@ -408,10 +408,10 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
     }
   };
   if (!addable(a)) return rivals;
+  // A drift's rivals also: the drift probe's plans, of any group.
+  const bool drift = a.kind == EffectKind::kDriftLoad || a.kind == EffectKind::kDriftTime;
   for (std::size_t k = 0; k < planned.size(); ++k) {
     if (k == chosen) continue;
-    // A drift's rivals also: the drift probe's plans, of any group.
-    const bool drift = a.kind == EffectKind::kDriftLoad || a.kind == EffectKind::kDriftTime;
     if (drift && is_probe(k) && addable(planned[k])) {
       rivals.push_back(k);
       continue;

@@ -251,9 +251,10 @@ struct TimeAlignment : ModelChange {
 
 // crosstalk: removal of the winner's pair and, within one group, each
 // further target's source (its significant pair of the clearest held-out t)
-// when that pair forms no chain (crosstalk::plan, forms_chain): each target picks up `gain` times its source (the fitted
-// gain); the model is fine-tuned on y'_c = y_c - k y_s (in y and x); the
-// measured y_c is y'_c + k y'_s (exact without chains: y_s is then y'_s).
+// when that pair forms no chain (crosstalk::plan, forms_chain): each
+// target picks up `gain` times its source (the fitted gain); the model is
+// fine-tuned on y'_c = y_c - k y_s (in y and x); the measured y_c is
+// y'_c + k y'_s (exact without chains: y_s is then y'_s).
 struct CrosstalkRemoval : ModelChange {
   // target, source, gain (target units per source unit); the winner's pair
   // first, then one per further target (a.extended_channels), none twice.
@@ -438,10 +439,9 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 // indices in `planned`) of any group (stop 71: a family kept over its
 // group's plan was not confirmed, and a drift with time of one tendon was
 // confirmed, where the loadcells' plan was never tested beside them); for
-// any other effect none. In
-// `planned`'s order. On the training
-// rows a curve of a channel's own level explains part of any effect's
-// residual on a channel that follows the load, and a load drift, a drift
+// any other effect none. In `planned`'s order. On the training rows a
+// curve of a channel's own level explains part of any effect's residual on
+// a channel that follows the load, and a load drift, a drift
 // with time and a curve all follow a grasp's load through a log; rows
 // after them tell them apart (a load drift has grown with the load, a
 // curve has not, a delay's or a leak's residual is not a static map):

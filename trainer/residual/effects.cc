@@ -1188,9 +1188,9 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
 // each further target's source (since stop 71 its one pair of the clearest
 // held-out t; below): a significant pair of the group (target and source
 // in it; significant at the floors `attribution` has: fix() plans at the
-// candidates' floor, --fix-min-excess-null) that forms no chain (forms_chain) with a pair
-// taken or with one of the model's own (data.crosstalk: an earlier
-// round's), and whose reverse pair is not significant too: of a mutual
+// candidates' floor, --fix-min-excess-null) that forms no chain
+// (forms_chain) with a pair taken or with one of the model's own
+// (data.crosstalk: an earlier round's), and whose reverse pair is not significant too: of a mutual
 // pair (the plant's ring and little fingertips read each other) each
 // side's source holds its target, so removing one side against the
 // measured source is biased. On development cross-talk sets 2321 and 2327
