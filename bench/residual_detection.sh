@@ -296,8 +296,7 @@
 # code (3140-3159: clean sets). Next unused: 3160 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
-#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R]
-#          [--fix-derived-input-lr-scale X] [--case EFFECT=STRENGTH]...
+#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...
 #   defaults: models/hand.safetensors, build/residual-detection, 10, 231, the tool's --candidates (5), every case
 #   (--case: only those; repeatable), the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
@@ -308,8 +307,6 @@
 #   --decision-loss L: passed to `hadynet residual --fix` (squared, its default, or absolute: its default in stop 59)
 #   --decision-scale S: passed to `hadynet residual --fix` (std or residual: each channel's error in its clean residual level)
 #   --fix-selection R: passed to `hadynet residual --fix` (screen-order or every-channel)
-#   --fix-derived-input-lr-scale X: passed to `hadynet residual --fix` (1: stop 71's fine-tuning of a fix's
-#   derived inputs)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
 set -euo pipefail
@@ -335,7 +332,6 @@ while (($#)); do
     --decision-loss) candidates+=(--decision-loss "$2"); shift 2 ;;
     --decision-scale) candidates+=(--decision-scale "$2"); shift 2 ;;
     --fix-selection) candidates+=(--fix-selection "$2"); shift 2 ;;
-    --fix-derived-input-lr-scale) candidates+=(--fix-derived-input-lr-scale "$2"); shift 2 ;;
     --case) only_cases+=("$2"); shift 2 ;;
     --rezeroed-first-init) rezeroed_first_init=$2; shift 2 ;;
     *) echo "residual_detection: unknown argument $1" >&2; exit 2 ;;

@@ -124,8 +124,7 @@
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
-#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R]
-#          [--fix-derived-input-lr-scale X] [SEED...]
+#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [SEED...]
 #   defaults: models/hand.safetensors, build/residual-false-positives, 161..180,
 #   no rated range (the plant's datasheet: --rated-range fc=0..50 --rated-range f=0..200),
 #   the null of `hadynet residual`'s default: the held-out logs stored in the model
@@ -136,8 +135,6 @@
 #   --decision-loss L: passed to `hadynet residual --fix` (squared, its default, or absolute: its default in stop 59)
 #   --decision-scale S: passed to `hadynet residual --fix` (std or residual: each channel's error in its clean residual level)
 #   --fix-selection R: passed to `hadynet residual --fix` (screen-order or every-channel)
-#   --fix-derived-input-lr-scale X: passed to `hadynet residual --fix` (1: stop 71's fine-tuning of a fix's
-#   derived inputs)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per seed with an ETA, then the counts; OUT/summary.txt.
 set -euo pipefail
@@ -160,7 +157,6 @@ while (($#)); do
     --decision-loss) ranges+=(--decision-loss "$2"); shift 2 ;;
     --decision-scale) ranges+=(--decision-scale "$2"); shift 2 ;;
     --fix-selection) ranges+=(--fix-selection "$2"); shift 2 ;;
-    --fix-derived-input-lr-scale) ranges+=(--fix-derived-input-lr-scale "$2"); shift 2 ;;
     --rezeroed-first-init) rezeroed_first_init=$2; shift 2 ;;
     -*) echo "residual_false_positives: unknown option $1" >&2; exit 2 ;;
     *) seeds+=("$1"); shift ;;

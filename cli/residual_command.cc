@@ -253,10 +253,6 @@ int run_residual(int argc, char** argv) {
                            "something was fixed)");
   opt.value("fix-epochs", "N", "with --fix: fine-tuning epochs", "20");
   opt.value("fix-lr", "X", "with --fix: Adam learning rate", "0.001");
-  opt.value("fix-derived-input-lr-scale", "X",
-            "with --fix: the learning rate of the input weights a fix adds at zero (friction's sign and\n"
-            "hysteresis inputs, a lag input of a command added in the same change), as a multiple of\n"
-            "--fix-lr; the weights the model had keep --fix-lr", "3");
   opt.value("fix-seed", "N", "with --fix: seed of the window order", "1");
   opt.value("candidates", "K", "with --fix: how many of the screen's candidates may be tried (the best of each effect;\n"
                               "a delay, curve, rail or cross-talk extended to its group also on its family alone,\n"
@@ -364,7 +360,6 @@ int run_residual(int argc, char** argv) {
   }
   const auto fix_epochs = opt.get_int("fix-epochs", 1, 100000);
   const auto fix_lr = opt.get_double("fix-lr", 1e-12, 10.0);
-  const auto derived_input_lr_scale = opt.get_double("fix-derived-input-lr-scale", 1e-6, 1e6);
   const auto fix_seed = opt.get_int("fix-seed", 0, (1ll << 62));
   const auto rounds = opt.get_int("rounds", 1, 20);
   const auto candidates = opt.get_int("candidates", 1, 20);
@@ -393,7 +388,7 @@ int run_residual(int argc, char** argv) {
     fix_min_excess = opt.get_double("fix-min-excess-null", 0.0, 1e6);
     if (!fix_min_excess) return 2;
   }
-  if (!fix_epochs || !fix_lr || !derived_input_lr_scale || !fix_seed || !rounds || !candidates || !folds || !drift_probe_alpha) return 2;
+  if (!fix_epochs || !fix_lr || !fix_seed || !rounds || !candidates || !folds || !drift_probe_alpha) return 2;
   if (opt.has("fix-min-excess-null") && !opt.has("fix")) {
     std::fprintf(stderr, "hadynet residual: --fix-min-excess-null needs --fix\n");
     return 2;
@@ -475,7 +470,6 @@ int run_residual(int argc, char** argv) {
     fo.train_fraction = *fraction;
     fo.epochs = static_cast<int>(*fix_epochs);
     fo.lr = *fix_lr;
-    fo.derived_input_lr_scale = *derived_input_lr_scale;
     fo.seed = static_cast<std::uint64_t>(*fix_seed);
     fo.control = !opt.has("no-control");
     fo.candidates = static_cast<int>(*candidates);

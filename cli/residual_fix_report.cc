@@ -60,7 +60,6 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
             {"train_fraction", o.train_fraction},
             {"epochs", o.epochs},
             {"lr", o.lr},
-            {"derived_input_lr_scale", o.derived_input_lr_scale},
             {"seed", o.seed},
             {"min_excess_null", o.min_excess_null ? json(*o.min_excess_null) : json(nullptr)},
             {"candidates_floor", f.candidates_floor ? json(*f.candidates_floor) : json(nullptr)},

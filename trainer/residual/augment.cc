@@ -563,24 +563,6 @@ HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
   return m;
 }
 
-namespace {
-
-// The u columns of `augmented` that `model` does not have and whose input
-// weights start at zero (a derived input whose base command's weights were
-// not moved to it: DerivedCommandInputs::add_to_network).
-std::vector<int> zero_added_u_columns(const HadynetModel& model, const HadynetModel& augmented) {
-  std::vector<int> out;
-  const auto& before = model.layout.u_names;
-  const auto& after = augmented.layout.u_names;
-  for (std::size_t c = 0; c < after.size(); ++c)
-    if (std::find(before.begin(), before.end(), after[c]) == before.end() &&
-        augmented.params.lstm_weight_ih.col(static_cast<Eigen::Index>(c)).isZero(0))
-      out.push_back(static_cast<int>(c));
-  return out;
-}
-
-}  // namespace
-
 Attribution candidates_view(const Attribution& attribution, const FixOptions& options) {
   if (!options.min_excess_null || *options.min_excess_null >= attribution.options.min_excess_null) return attribution;
   return with_null_floor(attribution, *options.min_excess_null);
@@ -668,7 +650,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     const HeldOutDetail detail = &rows == &held_out_part ? HeldOutDetail::kWithDiagnostics : HeldOutDetail::kErrorsOnly;
     return held_out_error(m, eval_rows(m, state_pbs(m), rows), detail);
   };
-  const FineTuneOptions tuning{options.epochs, options.batch, options.lr, options.seed, {}, 1.0};
+  const FineTuneOptions tuning{options.epochs, options.batch, options.lr, options.seed};
   std::vector<Eigen::VectorXf> before_pbs;
   for (const auto& log : data.logs) before_pbs.push_back(log.pb);
   result.before = held_out_error(model, eval_logs(model, before_pbs));
@@ -763,11 +745,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     t.model = a != nullptr ? augmented_model(model, *a, seqs) : model;
     const auto states = ensure_states(t.model, seqs, before_pbs);
     if (untuned != nullptr) *untuned = t.model;
-    // The input weights the augmentation added at zero learn at derived_input_lr_scale times lr.
-    FineTuneOptions o = tuning;
-    o.added_u_columns = zero_added_u_columns(model, t.model);
-    o.added_input_lr_scale = options.derived_input_lr_scale;
-    t.loss_history = fine_tune(t.model, seqs, states, o, &t.train_windows);
+    t.loss_history = fine_tune(t.model, seqs, states, tuning, &t.train_windows);
     t.model.check_consistent();
     return t;
   };

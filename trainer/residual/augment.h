@@ -111,11 +111,6 @@ struct FixOptions {
   int epochs = 20;              // fine-tuning epochs from the current weights (batch norm frozen)
   int batch = 100;
   double lr = 1e-3;             // Adam
-  // The learning rate of the input weights an augmentation adds (its derived
-  // inputs' columns, which start at zero), as a multiple of lr
-  // (FineTuneOptions::added_input_lr_scale; chosen on development sets,
-  // docs/residual.md). The weights the model had keep lr.
-  double derived_input_lr_scale = 3.0;
   std::uint64_t seed = 1;       // window order
   bool control = true;          // also fine-tune without the augmentation (same data, epochs, seed)
   // 2: the decision also judges a mirrored fold: the tested candidate and

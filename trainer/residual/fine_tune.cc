@@ -32,41 +32,12 @@ std::vector<int> ensure_states(HadynetModel& model, const std::vector<LogSequenc
   return rows;
 }
 
-namespace {
-
-// One Adam step, with the added input columns' update scaled by
-// o.added_input_lr_scale: Adam's moments do not depend on the weights, so
-// scaling a column's update is the same as scaling its learning rate.
-void step(Adam<float>& adam, HadynetParams<float>& params, const HadynetParams<float>& grads,
-          const FineTuneOptions& o) {
-  const auto& columns = o.added_u_columns;
-  if (columns.empty() || o.added_input_lr_scale == 1.0) {
-    adam.step(params, grads);
-    return;
-  }
-  const auto rows = params.lstm_weight_ih.rows();
-  Matrix<float> before(rows, static_cast<Eigen::Index>(columns.size()));
-  for (std::size_t k = 0; k < columns.size(); ++k)
-    before.col(static_cast<Eigen::Index>(k)) = params.lstm_weight_ih.col(columns[k]);
-  adam.step(params, grads);
-  const auto scale = static_cast<float>(o.added_input_lr_scale);
-  for (std::size_t k = 0; k < columns.size(); ++k) {
-    auto w = params.lstm_weight_ih.col(columns[k]);
-    const auto w0 = before.col(static_cast<Eigen::Index>(k));
-    w = w0 + scale * (w - w0);
-  }
-}
-
-}  // namespace
-
 std::vector<double> fine_tune(HadynetModel& model, const std::vector<LogSequence>& seqs,
                               const std::vector<int>& state_rows, const FineTuneOptions& o, long* windows) {
   const WindowDataset data(seqs, state_rows, model.layout, model.norm, model.train_steps);
   std::vector<int> ids(static_cast<std::size_t>(data.size()));
   std::iota(ids.begin(), ids.end(), 0);
   if (ids.size() < 2) throw std::runtime_error("--fix: the training part of the logs holds fewer than 2 windows");
-  for (const int c : o.added_u_columns)
-    if (c < 0 || c >= model.params.dims.u) throw std::invalid_argument("fine_tune: an added u column is not a u column");
   Adam<float> adam(Adam<float>::Options{o.lr, 0.9, 0.999, 1e-8}, GroupSet::all().without(ParamGroup::kEncoderBn));
   HadynetNetwork<float> net;
   HadynetGrads<float> grads;
@@ -87,7 +58,7 @@ std::vector<double> fine_tune(HadynetModel& model, const std::vector<LogSequence
       sum += static_cast<double>(mse_loss(y_hat, y, &d_y));
       clip_standardised(model, y_hat, &d_y);  // zero gradient where clipped
       net.backward(model.params, d_y, grads);
-      step(adam, model.params, grads.params, o);
+      adam.step(model.params, grads.params);
       ++batches;
     }
     history.push_back(sum / batches);
