@@ -879,21 +879,19 @@ TEST(DriftProbe, ItsCandidateFollowsTheScreensDriftOfItsGroupElseComesLast) {
   const auto f_drift = plan(EffectKind::kDriftLoad, "f4");
   const auto crosstalk = plan(EffectKind::kCrosstalk, "fc1");
   const auto place = [](const std::vector<residual::Augmentation>& planned, const std::string& group) {
-    const residual::ProbePlace p = residual::drift_probe_place(planned, group, 3);
+    const residual::ProbePlace p = residual::drift_probe_place(planned, group);
     return std::make_pair(p.at, p.replaces_all);
   };
-  // A place left (2 of 3): last.
-  EXPECT_TRUE(residual::drift_probe_has_place({curve, crosstalk}, 3));
+  // A place left (2 of 3, --candidates 3): last.
   EXPECT_EQ(place({curve, crosstalk}, "fc"), std::make_pair(std::size_t{2}, false));
-  // Every place taken and no load drift: no place, whatever the group.
-  EXPECT_FALSE(residual::drift_probe_has_place({curve, crosstalk, curve}, 3));
-  EXPECT_THROW(residual::drift_probe_place({curve, crosstalk, curve}, "fc", 3), std::logic_error);
+  // Every place taken and no load drift (drift sets 2986, 2995 and 3161):
+  // last, beyond the count. Before stop 72 the probe did not run there.
+  EXPECT_EQ(place({curve, crosstalk, curve}, "fc"), std::make_pair(std::size_t{3}, false));
   // The screen's drift of the group: right after it, beyond the count.
   EXPECT_EQ(place({curve, fc_drift, crosstalk}, "fc"), std::make_pair(std::size_t{2}, false));
   // A drift of another group only, every place taken (drift set 2461 of
   // stop 64: a tendon's drift, curves and cross-talks): last, beyond the
   // count. Before stop 65 it had no place there.
-  EXPECT_TRUE(residual::drift_probe_has_place({f_drift, curve, crosstalk}, 3));
   EXPECT_EQ(place({f_drift, curve, crosstalk}, "fc"), std::make_pair(std::size_t{3}, false));
   EXPECT_EQ(place({f_drift, curve, crosstalk}, "f"), std::make_pair(std::size_t{1}, false));
   // A drift family led by a tendon's tension that holds a loadcell (drift
@@ -915,10 +913,10 @@ TEST(DriftProbe, ItsCandidateFollowsTheScreensDriftOfItsGroupElseComesLast) {
   unfixable.not_fixable = "no knots";
   EXPECT_EQ(place({unfixable}, "fc"), std::make_pair(std::size_t{0}, true));
   EXPECT_EQ(place({}, "fc"), std::make_pair(std::size_t{0}, true));
-  // A drift that cannot be added counts as none.
+  // A drift that cannot be added counts as none: last.
   auto unfixable_drift = f_drift;
   unfixable_drift.not_fixable = "no level";
-  EXPECT_FALSE(residual::drift_probe_has_place({curve, unfixable_drift, crosstalk}, 3));
+  EXPECT_EQ(place({curve, unfixable_drift, crosstalk}, "f"), std::make_pair(std::size_t{3}, false));
 }
 
 // Which choice of the selection gives way to the drift probe's plan of its

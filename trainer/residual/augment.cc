@@ -368,17 +368,11 @@ bool none_addable(const std::vector<Augmentation>& planned) {
 }
 }  // namespace
 
-bool drift_probe_has_place(const std::vector<Augmentation>& planned, int candidates) {
-  return none_addable(planned) || static_cast<int>(planned.size()) < candidates ||
-         std::any_of(planned.begin(), planned.end(), addable_load_drift);
-}
-
-ProbePlace drift_probe_place(const std::vector<Augmentation>& planned, const std::string& group, int candidates) {
+ProbePlace drift_probe_place(const std::vector<Augmentation>& planned, const std::string& group) {
   if (none_addable(planned)) return {0, true};
   const auto last = std::find_if(planned.rbegin(), planned.rend(),
                                  [&](const Augmentation& a) { return load_drift_of_group(a, group); });
   if (last != planned.rend()) return {static_cast<std::size_t>(planned.rend() - last), false};
-  if (!drift_probe_has_place(planned, candidates)) throw std::logic_error("drift_probe_place: the probe has no place");
   return {planned.size(), false};
 }
 
@@ -686,7 +680,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // puts it, the smallest adjusted p first (candidate_drift_probes). The
   // selection then chooses among them as among any.
   std::vector<std::size_t> probed;  // their indices in `planned`
-  if (options.drift_probe_alpha > 0 && can_select && drift_probe_has_place(planned, options.candidates)) {
+  if (options.drift_probe_alpha > 0 && can_select) {
     DriftProbeRows rows;
     rows.refined = [&](const Augmentation& plan) { return refined(plan, selection_train, nullptr); };
     // The unchanged network without a drift is every group's reference: judged once.
@@ -702,8 +696,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     };
     result.drift_probes = probe_drifts(model, data, rows, options.drift_probe_alpha);
     for (const DriftProbe* p : candidate_drift_probes(result.drift_probes)) {
-      // After the first, a place is always left: the first is a load drift.
-      const ProbePlace place = drift_probe_place(planned, p->group, options.candidates);
+      const ProbePlace place = drift_probe_place(planned, p->group);
       if (place.replaces_all) planned.clear();
       planned.insert(planned.begin() + static_cast<std::ptrdiff_t>(place.at),
                      group_drift_plan(p->channels, data.logs.front().dt_s, p->start_rate));

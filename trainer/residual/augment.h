@@ -156,9 +156,8 @@ struct FixOptions {
   // another effect; since stop 51 a family alone takes one of them. The
   // drift probe (drift_probe.h) takes a place left when the screen proposes
   // no load drift of its group (or the only place, when no screened
-  // candidate can be added), and is one beyond it when it follows the
-  // screen's load drift of its group or, last, one of another group
-  // (drift_probe_place).
+  // candidate can be added), and is one beyond it otherwise: after the
+  // screen's load drift of its group, else last (drift_probe_place).
   int candidates = 5;
   // With a calibrated null: the floor of excess_share (in units of the
   // channel's clean residual level) of the candidates fix() may try
@@ -459,23 +458,19 @@ bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k);
 // right after the screen's last load drift of the probe's group when it
 // lists one (a drift's third plan, beside its family and the family alone,
 // beyond `candidates`; a drift of the group holds a channel of it, whichever
-// channel leads it: since stop 68); else last: where a place is left, or beyond
-// `candidates` when the screen lists a load drift of another group (the
-// probe then names the group the screen's drift missed: on the loadcells'
-// drift set 2461 of stop 64 the screen proposed a drift of one tendon and
-// filled every place, and the probe's loadcell drift was dropped); the
-// only one (replaces_all) when the screen has no plan that can be added.
+// channel leads it: since stop 68); else last, where a place is left or
+// beyond `candidates`: when the screen lists a load drift of another group
+// (the probe then names the group the screen's drift missed: drift set
+// 2461 of stop 64), and since stop 72 also when it fills every place with
+// no load drift (on drift sets 2986, 2995 and 3161 the probe did not run
+// there, and a cross-talk of two loadcells was chosen: confirmed on 2986
+// and 3161); the only one (replaces_all) when the screen has no plan that
+// can be added. fix() runs the probe whenever it can select.
 struct ProbePlace {
   std::size_t at = 0;         // the candidate's index once inserted
   bool replaces_all = false;  // `planned` is cleared first
 };
-// Whether the probe's candidate has a place whatever its group: the screen
-// has no plan that can be added, a place is left, or it lists a load
-// drift. fix() runs the probe only then.
-bool drift_probe_has_place(const std::vector<Augmentation>& planned, int candidates);
-// Throws std::logic_error when drift_probe_has_place() is false and the
-// screen lists no load drift of `group`.
-ProbePlace drift_probe_place(const std::vector<Augmentation>& planned, const std::string& group, int candidates);
+ProbePlace drift_probe_place(const std::vector<Augmentation>& planned, const std::string& group);
 
 // The plans fix() tries as the simpler account of a confirmed planned[k]
 // (its effect's EffectInfo::simpler), fewest channels first: the plans of
