@@ -293,7 +293,14 @@
 # cross-talk sets development of the cross-talk's source; 3080-3099
 # drift=0.02 measured with the drift rules; 3100-3119 crosstalk=0.35 and
 # 3130-3139 every effect at its larger strength measured with the final
-# code (3140-3159: clean sets). Next unused: 3160 on.
+# code (3140-3159: clean sets). Stop 72: 3160-3169 every effect at its
+# larger strength and 3190-3199 friction=4 and sensor-curve=0.7 measured
+# with the derived inputs' learning-rate scale 3 and 1 (stop 71's code;
+# the scale not kept; 3130-3139 friction=4 its development, also at 5 and
+# 10; 3170-3189: clean sets); 2986, 2995 and 3161 drift=0.02 development
+# of the drift probe behind a full screen; 3200-3209 every effect at its
+# larger strength and 3230-3249 drift=0.02 measured with it (3210-3229:
+# clean sets). Next unused: 3250 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -119,7 +119,10 @@
 # probe finds; its plans as a drift's rivals; a cross-talk's source by
 # its t): 3060-3079 measured with its drift rules alone (1 of 20: 3077, a
 # curve stop 70's code confirms too), 3140-3159 with its final code (1 of
-# 20: 3156, likewise). Next unused seed: 3160
+# 20: 3156, likewise). Stop 72: 3170-3189 measured with the derived
+# inputs' learning-rate scale (not kept; 0 of 20, no candidate with derived
+# inputs tried), 3210-3229 with its final code (the drift probe behind a
+# full screen; 0 of 20). Next unused seed: 3250
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
