@@ -299,8 +299,9 @@
 # the scale not kept; 3130-3139 friction=4 its development, also at 5 and
 # 10; 3170-3189: clean sets); 2986, 2995 and 3161 drift=0.02 development
 # of the drift probe behind a full screen; 3200-3209 every effect at its
-# larger strength and 3230-3249 drift=0.02 measured with it (3210-3229:
-# clean sets). Next unused: 3250 on.
+# larger strength, 3230-3249 drift=0.02 and 3250-3259 every effect at its
+# larger strength measured with it (3210-3229: clean sets). Next unused:
+# 3260 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...
