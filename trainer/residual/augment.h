@@ -458,14 +458,12 @@ bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k);
 // right after the screen's last load drift of the probe's group when it
 // lists one (a drift's third plan, beside its family and the family alone,
 // beyond `candidates`; a drift of the group holds a channel of it, whichever
-// channel leads it: since stop 68); else last, where a place is left or
-// beyond `candidates`: when the screen lists a load drift of another group
-// (the probe then names the group the screen's drift missed: drift set
-// 2461 of stop 64), and since stop 72 also when it fills every place with
-// no load drift (on drift sets 2986, 2995 and 3161 the probe did not run
-// there, and a cross-talk of two loadcells was chosen: confirmed on 2986
-// and 3161); the only one (replaces_all) when the screen has no plan that
-// can be added. fix() runs the probe whenever it can select.
+// channel leads it: since stop 68); else last, beyond `candidates` when
+// every place is taken (behind a load drift of another group since stop
+// 65, drift set 2461; behind any full screen since stop 72, drift sets
+// 2986, 2995 and 3161, where a cross-talk of two loadcells was chosen in
+// its absence); the only one (replaces_all) when the screen has no plan
+// that can be added. fix() runs the probe whenever it can select.
 struct ProbePlace {
   std::size_t at = 0;         // the candidate's index once inserted
   bool replaces_all = false;  // `planned` is cleared first

@@ -1190,8 +1190,9 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
 // in it; significant at the floors `attribution` has: fix() plans at the
 // candidates' floor, --fix-min-excess-null) that forms no chain
 // (forms_chain) with a pair taken or with one of the model's own
-// (data.crosstalk: an earlier round's), and whose reverse pair is not significant too: of a mutual
-// pair (the plant's ring and little fingertips read each other) each
+// (data.crosstalk: an earlier round's), and whose reverse pair is not
+// significant too: of a mutual pair (the plant's ring and little
+// fingertips read each other) each
 // side's source holds its target, so removing one side against the
 // measured source is biased. On development cross-talk sets 2321 and 2327
 // the extension took fc3 -> fc4 against a significant fc4 -> fc3, the two
