@@ -996,6 +996,43 @@ TEST(DecisionRivals, ACurveAndATimeDriftHaveRivalsInTheirGroupAndALoadDriftIsEac
   EXPECT_EQ(residual::decision_rivals(unfixable, 3, probed), (Rivals{6}));
 }
 
+// A cross-talk within a group stands in for the group's calibration curve
+// (its richer account): its rivals are the curves and load drifts of its
+// group, not the drift probe's plans of another group. A cross-talk between
+// groups (a tension leaking into a loadcell) has none.
+TEST(DecisionRivals, ACrosstalkWithinAGroupHasItsGroupsCurvesAndLoadDriftsAsRivals) {
+  const auto plan = planned_on;
+  using residual::EffectKind;
+  using Rivals = std::vector<std::size_t>;
+  const auto removal = [&](std::vector<SensorCrosstalk> pairs) {
+    auto a = plan(EffectKind::kCrosstalk, {pairs.front().target});
+    residual::CrosstalkRemoval change;
+    change.pairs = std::move(pairs);
+    a.change = change;
+    return a;
+  };
+  const auto within = removal({{"fc1", "fc2", 0.3}, {"fc3", "fc4", 0.2}});
+  const auto between = removal({{"fc6", "f5", 0.1}});
+  const auto mixed = removal({{"fc1", "fc2", 0.3}, {"fc6", "f5", 0.1}});
+  const std::vector<residual::Augmentation> planned = {
+      within,
+      plan(EffectKind::kSensorCurve, {"fc1", "fc4"}),
+      plan(EffectKind::kDriftLoad, {"fc0", "fc1"}),
+      plan(EffectKind::kDriftTime, {"fc1"}),
+      plan(EffectKind::kFriction, {"fc1"}),
+      plan(EffectKind::kSensorCurve, {"f2"}),
+      plan(EffectKind::kDriftLoad, {"th0"}),
+      between,
+      mixed,
+  };
+  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 2}));
+  EXPECT_EQ(residual::decision_rivals(planned, 0, {6}), (Rivals{1, 2}));
+  EXPECT_TRUE(residual::decision_rivals(planned, 7).empty());
+  EXPECT_TRUE(residual::decision_rivals(planned, 8).empty());
+  // A curve's rivals hold the cross-talks of its group, as before.
+  EXPECT_EQ(residual::decision_rivals(planned, 1), (Rivals{0, 2, 3, 4, 7, 8}));
+}
+
 // A model of two y channels, a and b, of standard deviations 2 and 4.
 HadynetModel loss_model() {
   HadynetModel m;

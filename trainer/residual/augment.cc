@@ -391,13 +391,19 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
   const auto addable = [](const Augmentation& p) { return p.not_fixable.empty() && !p.channels.empty(); };
   const auto is_probe = [&](std::size_t k) { return std::find(probed.begin(), probed.end(), k) != probed.end(); };
   // A curve's rivals: any other effect; a drift with time's: a load drift;
-  // a load drift's: a curve or a drift with time; any other effect's: none.
+  // a load drift's: a curve or a drift with time; a cross-talk within a
+  // group's (one that stands in for the group's curve: its richer account):
+  // a curve or a load drift; any other effect's: none.
+  const auto richer = effect_info(a.kind).richer;
+  const bool stands_in_for_curve = richer && richer(a) == EffectKind::kSensorCurve;
   const auto is_rival = [&](const Augmentation& p) {
     if (!addable(p)) return false;
     switch (a.kind) {
       case EffectKind::kSensorCurve: return p.kind != EffectKind::kSensorCurve;
       case EffectKind::kDriftTime: return p.kind == EffectKind::kDriftLoad;
       case EffectKind::kDriftLoad: return p.kind == EffectKind::kSensorCurve || p.kind == EffectKind::kDriftTime;
+      case EffectKind::kCrosstalk:
+        return stands_in_for_curve && (p.kind == EffectKind::kSensorCurve || p.kind == EffectKind::kDriftLoad);
       default: return false;
     }
   };

@@ -437,8 +437,12 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 // time; and for either drift also the drift probe's plans (`probed`: their
 // indices in `planned`) of any group (stop 71: a family kept over its
 // group's plan was not confirmed, and a drift with time of one tendon was
-// confirmed, where the loadcells' plan was never tested beside them); for
-// any other effect none. In `planned`'s order. On the training rows a
+// confirmed, where the loadcells' plan was never tested beside them); when
+// it is a cross-talk within a group (every pair reads a channel of its
+// target's group: it stands in for the group's calibration curve,
+// EffectInfo::richer), every calibration curve and load drift (stop 73: a
+// cross-talk chosen on a curve's or a drift's logs was the only plan
+// tested); for any other effect none. In `planned`'s order. On the training rows a
 // curve of a channel's own level explains part of any effect's residual on
 // a channel that follows the load, and a load drift, a drift
 // with time and a curve all follow a grasp's load through a log; rows
