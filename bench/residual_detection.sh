@@ -305,9 +305,9 @@
 # sensor-curve=0.7 sets 3201, 3206, 3207, 3258 and 3259 development, with
 # stop 70's and 71's drift sets 2991, 2963, 3000, 2878, 2910 and rail set
 # 2980 for a rival filter not kept; 3260-3279 sensor-curve=0.7 and
-# crosstalk=0.35, 3280-3289 and 3310-3319 every effect at its larger
-# strength measured with the final code (3290-3309: clean sets). Next
-# unused: 3320 on.
+# crosstalk=0.35 (and 3320-3339), 3280-3289 and 3310-3319 every effect
+# at its larger strength measured with the final code (3290-3309: clean
+# sets). Next unused: 3340 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

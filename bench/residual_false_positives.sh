@@ -123,7 +123,7 @@
 # inputs' learning-rate scale (not kept; 0 of 20, no candidate with derived
 # inputs tried), 3210-3229 with its final code (the drift probe behind a
 # full screen; 0 of 20). Stop 73: 3290-3309 with its final code (a
-# cross-talk's rivals; 0 of 20). Next unused seed: 3320
+# cross-talk's rivals; 0 of 20). Next unused seed: 3340
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
