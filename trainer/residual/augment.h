@@ -442,11 +442,11 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 // target's group: it stands in for the group's calibration curve,
 // EffectInfo::richer), every calibration curve and load drift (stop 73: a
 // cross-talk chosen on a curve's or a drift's logs was the only plan
-// tested); for any other effect none. In `planned`'s order. On the training rows a
-// curve of a channel's own level explains part of any effect's residual on
-// a channel that follows the load, and a load drift, a drift
-// with time and a curve all follow a grasp's load through a log; rows
-// after them tell them apart (a load drift has grown with the load, a
+// tested); for any other effect none. In `planned`'s order. On the
+// training rows a curve of a channel's own level explains part of any
+// effect's residual on a channel that follows the load, and a load drift,
+// a drift with time and a curve all follow a grasp's load through a log;
+// rows after them tell them apart (a load drift has grown with the load, a
 // curve has not, a delay's or a leak's residual is not a static map):
 // fix() tests those that gained on the selection's rows beside
 // planned[chosen], all at Holm's levels (FixResult::rivals).
