@@ -279,9 +279,9 @@ int run_residual(int argc, char** argv) {
                               "too and predicts the channels either changes better there; the rivals of a chosen\n"
                               "calibration curve (the other effects of its group), drift with time (the load drifts of its\n"
                               "group) or load drift (the curves and drifts with time of its groups), and of either drift\n"
-                              "the drift probe's plans of any group, or cross-talk within a group (the curves and load\n"
-                              "drifts of its group), that gained on those rows too are tested beside it on the held-out\n"
-                              "rows, all at Holm's levels, and of those\n"
+                              "the drift probe's plans of any group, cross-talk within a group (the curves and load\n"
+                              "drifts of its group) or friction (the curves of its groups), that gained on those rows\n"
+                              "too are tested beside it on the held-out rows, all at Holm's levels, and of those\n"
                               "confirmed the one that predicts the channels any of them changes best is applied", "5");
   opt.value("fix-min-excess-null", "S",
             "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"

@@ -1029,8 +1029,41 @@ TEST(DecisionRivals, ACrosstalkWithinAGroupHasItsGroupsCurvesAndLoadDriftsAsRiva
   EXPECT_EQ(residual::decision_rivals(planned, 0, {6}), (Rivals{1, 2}));
   EXPECT_TRUE(residual::decision_rivals(planned, 7).empty());
   EXPECT_TRUE(residual::decision_rivals(planned, 8).empty());
+  // A friction's rivals are the curves of its group (stop 74).
+  EXPECT_EQ(residual::decision_rivals(planned, 4), (Rivals{1}));
   // A curve's rivals hold the cross-talks of its group, as before.
   EXPECT_EQ(residual::decision_rivals(planned, 1), (Rivals{0, 2, 3, 4, 7, 8}));
+}
+
+// Friction has the calibration curves of its groups as rivals (stop 74:
+// on curve logs friction of a tendon's command on its loadcell was chosen
+// where the curves' gain on the selection's rows was larger but noisier),
+// and nothing else: not a drift, a cross-talk or a curve of another group.
+TEST(DecisionRivals, AFrictionHasTheCurvesOfItsGroupsAsRivals) {
+  const auto plan = planned_on;
+  using residual::EffectKind;
+  using Rivals = std::vector<std::size_t>;
+  const std::vector<residual::Augmentation> planned = {
+      plan(EffectKind::kFriction, {"fc4"}),
+      plan(EffectKind::kSensorCurve, {"fc1", "fc3"}),
+      plan(EffectKind::kSensorCurve, {"f2"}),
+      plan(EffectKind::kDriftLoad, {"fc4"}),
+      plan(EffectKind::kCrosstalk, {"fc4"}),
+      plan(EffectKind::kSensorCurve, {"fc4"}),
+      plan(EffectKind::kFriction, {"f0", "th0"}),
+      plan(EffectKind::kSensorCurve, {"th1"}),
+  };
+  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 5}));
+  // Of each group it holds.
+  EXPECT_EQ(residual::decision_rivals(planned, 6), (Rivals{2, 7}));
+  // The drift probe's plans are a drift's rivals only.
+  EXPECT_EQ(residual::decision_rivals(planned, 0, {3}), (Rivals{1, 5}));
+  // A curve that cannot be added is no rival.
+  auto unfixable = planned;
+  unfixable[5].not_fixable = "no level";
+  EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{1}));
+  // A curve's rivals hold the frictions of its group, as before.
+  EXPECT_EQ(residual::decision_rivals(planned, 5), (Rivals{0, 3, 4}));
 }
 
 // A model of two y channels, a and b, of standard deviations 2 and 4.

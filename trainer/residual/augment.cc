@@ -393,7 +393,8 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
   // A curve's rivals: any other effect; a drift with time's: a load drift;
   // a load drift's: a curve or a drift with time; a cross-talk within a
   // group's (one that stands in for the group's curve: its richer account):
-  // a curve or a load drift; any other effect's: none.
+  // a curve or a load drift; a friction's: a curve; any other effect's:
+  // none.
   const auto richer = effect_info(a.kind).richer;
   const bool stands_in_for_curve = richer && richer(a) == EffectKind::kSensorCurve;
   const auto is_rival = [&](const Augmentation& p) {
@@ -404,6 +405,7 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
       case EffectKind::kDriftLoad: return p.kind == EffectKind::kSensorCurve || p.kind == EffectKind::kDriftTime;
       case EffectKind::kCrosstalk:
         return stands_in_for_curve && (p.kind == EffectKind::kSensorCurve || p.kind == EffectKind::kDriftLoad);
+      case EffectKind::kFriction: return p.kind == EffectKind::kSensorCurve;
       default: return false;
     }
   };

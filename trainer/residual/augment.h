@@ -442,7 +442,12 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 // target's group: it stands in for the group's calibration curve,
 // EffectInfo::richer), every calibration curve and load drift (stop 73: a
 // cross-talk chosen on a curve's or a drift's logs was the only plan
-// tested); for any other effect none. In `planned`'s order. On the
+// tested); when it is friction, every calibration curve (stop 74: on curve
+// logs friction of one tendon's command on its loadcell was chosen because
+// its gain on the selection's rows was significant and the curves' larger,
+// noisier gain was not, and friction's simpler account, the curve of its
+// lead channel, was often not planned); for any other effect none. In
+// `planned`'s order. On the
 // training rows a curve of a channel's own level explains part of any
 // effect's residual on a channel that follows the load, and a load drift,
 // a drift with time and a curve all follow a grasp's load through a log;
