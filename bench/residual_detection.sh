@@ -307,7 +307,11 @@
 # 2980 for a rival filter not kept; 3260-3279 sensor-curve=0.7 and
 # crosstalk=0.35 (and 3320-3339), 3280-3289 and 3310-3319 every effect
 # at its larger strength measured with the final code (3290-3309: clean
-# sets). Next unused: 3340 on.
+# sets). Stop 74 (friction's rivals): stop 73's sensor-curve=0.7 sets
+# 3262, 3263, 3275, 3310, 3319, 3329, 3331 and 3338 and friction=4 sets
+# 3280-3289 and 3310-3319 development; 3340-3359 sensor-curve=0.7 and
+# friction=4 measured with the final code (3360-3379: clean sets). Next
+# unused: 3380 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...
