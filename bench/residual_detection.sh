@@ -309,9 +309,12 @@
 # at its larger strength measured with the final code (3290-3309: clean
 # sets). Stop 74 (friction's rivals): stop 73's sensor-curve=0.7 sets
 # 3262, 3263, 3275, 3310, 3319, 3329, 3331 and 3338 and friction=4 sets
-# 3280-3289 and 3310-3319 development; 3340-3359 sensor-curve=0.7 and
-# friction=4 measured with the final code (3360-3379: clean sets). Next
-# unused: 3380 on.
+# 3280-3289 and 3310-3319 development for the rivals, stop 73's
+# sensor-curve=0.7 sets 3320-3339 for the curve's shape; 3340-3359
+# sensor-curve=0.7 and friction=4 measured with the rivals alone
+# (3360-3379: clean sets), 3380-3399 sensor-curve=0.7 and 3400-3409
+# every effect at its larger strength with the final code (3410-3429:
+# clean sets). Next unused: 3430 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -362,6 +362,65 @@ TEST(SensorFrame, ThePlansCurvesAreFittedAsOneOnTheUnionOfTheirKnots) {
   EXPECT_NE(a.description.find("one curve, 5 knots"), std::string::npos) << a.description;
 }
 
+// The curve bends one way (CalibrationCurves::refine): its segment slopes
+// are fitted non-increasing (compressive) and non-decreasing (expansive),
+// and the lower loss is kept. A faked probe of the unchanged network whose
+// loss is the squared distance of fc0's readings at its knots from a
+// target: a compressive target (slopes 2, 1, 0.5, 0.5) is reached with
+// slopes in order and called compressive; a target that zigzags (slopes 2, 0.5, 2, 0.5),
+// which a search without the order would reach, gives slopes in order.
+TEST(SensorFrame, TheCurveBendsOneWay) {
+  const auto fitted_slopes = [](const std::vector<double>& target_slopes, std::string* description) {
+    residual::Augmentation a;
+    a.kind = residual::EffectKind::kSensorCurve;
+    a.channels = {"fc0"};
+    auto& change = a.change.emplace<residual::CalibrationCurves>();
+    change.curves = {{"fc0", {0, 1, 2, 3, 4}, {0, 1, 2, 3, 4}}};
+    std::vector<double> target = {0};
+    for (double s : target_slopes) target.push_back(target.back() + s);
+    residual::TrainingRmse rmse;
+    rmse.y_names = {"fc0", "l0"};
+    rmse.all = [target](const SensorModel& s) {
+      Eigen::VectorXd e = Eigen::VectorXd::Ones(2);
+      if (const SensorCurve* c = s.curve_of("fc0"))
+        for (std::size_t k = 0; k < c->level.size(); ++k) e(1) += std::pow(c->reading[k] - target[k], 2);
+      return e;
+    };
+    std::vector<double> fitted;
+    change.refine(a, SensorModel{}, rmse, fitted);
+    const SensorCurve& c = change.curves.front();
+    std::vector<double> slopes;
+    for (std::size_t k = 1; k < c.level.size(); ++k)
+      slopes.push_back((c.reading[k] - c.reading[k - 1]) / (c.level[k] - c.level[k - 1]));
+    if (description != nullptr) *description = a.description;
+    return slopes;
+  };
+  std::string description;
+  const std::vector<double> compressive = fitted_slopes({2, 1, 0.5, 0.5}, &description);
+  ASSERT_EQ(compressive.size(), 4u);
+  // Near the target at every knot: the coordinate search moves one slope
+  // at a time by factors of 0.5..2 for at most 6 sweeps, and a reading sums
+  // every slope below it, so it stops near the minimum, not on it.
+  const std::vector<double> target = {2, 3, 3.5, 4};  // readings at knots 1..4
+  double reading = 0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    reading += compressive[k];
+    EXPECT_NEAR(reading, target[k], 0.15) << k;
+    if (k > 0) {
+      EXPECT_LE(compressive[k], compressive[k - 1] + 1e-9) << k;
+    }
+  }
+  EXPECT_NE(description.find("(compressive)"), std::string::npos) << description;
+  const std::vector<double> zigzag = fitted_slopes({2, 0.5, 2, 0.5}, nullptr);
+  ASSERT_EQ(zigzag.size(), 4u);
+  bool non_increasing = true, non_decreasing = true;  // up to the readings' rounding
+  for (std::size_t k = 1; k < zigzag.size(); ++k) {
+    non_increasing = non_increasing && zigzag[k] <= zigzag[k - 1] + 1e-9;
+    non_decreasing = non_decreasing && zigzag[k] >= zigzag[k - 1] - 1e-9;
+  }
+  EXPECT_TRUE(non_increasing || non_decreasing) << zigzag[0] << " " << zigzag[1] << " " << zigzag[2] << " " << zigzag[3];
+}
+
 // A drift re-estimated at rate 0 changes nothing, so it leaves the change,
 // the affected channels and the channels the models are compared on
 // (found_on).

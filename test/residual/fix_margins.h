@@ -100,15 +100,18 @@ struct SensorCurve {
   const char* why;
 };
 inline constexpr SensorCurve kSensorCurve{
-    .winner_vs_before = {0.5, 0.34},
-    .winner_vs_control = {0.95, 0.78},
-    .family_vs_before = {0.9, 0.82},
-    .winner_reading_error = {0.1, 0.001},
+    .winner_vs_before = {0.5, 0.44},
+    .winner_vs_control = {1.1, 1.004},
+    .family_vs_before = {0.95, 0.90},
+    .winner_reading_error = {0.15, 0.095},
     .why = "against the model's stored null, as `hadynet residual` by default; fine-tuning alone cuts fc3 to "
            "0.44×, and the identity curve (no fit) would leave the control's error (1.0×) and read 26 % low at "
            "the top knot; since stop 57 one curve for the six loadcells (a curve per channel read 22 % low, "
-           "and measured 0.37× before and 0.85× the control); the family channels measured 0.62-0.82× (fc5 "
-           "the worst)"};
+           "and measured 0.37× before and 0.85× the control); since stop 74 the curve bends one way "
+           "(compressive): it reads 9.5 % above the plant's at the top knot (0.1 % before), fc3 measures "
+           "1.004× fine-tuning alone's (0.85×) on these logs of the model's training seed, where fine-tuning "
+           "alone does best, and the family channels 0.69-0.90× before (fc5 the worst; 0.62-0.82×); on fresh "
+           "curve sets the shape names 10 of 20 against 7 (docs/residual.md, \"A curve that bends one way\")"};
 
 // Plant: fingertip loadcell i adds 0.35 x its neighbour's force (crosstalk).
 struct Crosstalk {
@@ -290,7 +293,7 @@ inline std::vector<std::string> margins_table() {
        kDrift.why},
       {"drift probe (seed 1713)", "summed loadcells " + text(kDriftProbe.group_vs_before),
        "summed loadcells " + text(kDriftProbe.group_vs_control),
-       "the probe's candidate chosen and confirmed (decision p " + text(kDriftProbe.decision_p) +
+       "the probe's candidate chosen (or, since stop 74, applied as the chosen curve's rival) and confirmed (decision p " + text(kDriftProbe.decision_p) +
            "); all nine loadcells at one rate, re-estimated rate / the plant's " + text(kDriftProbe.rate_vs_plant),
        kDriftProbe.why},
       {"default drift, 1 000 steps", text(kDefaultDriftLongLogs.winner_vs_before), none,

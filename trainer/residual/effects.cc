@@ -1066,7 +1066,15 @@ bool CalibrationCurves::flat_at_end(const SensorCurve& curve, int side) {
 // channel has rows), within 1e-4 of their range merged. Its segment slopes
 // by coordinate search (each slope times 0.5, 0.7, 0.85, 0.93, 1/0.93,
 // 1/0.85, 1/0.7 or 2 within 1/4..4, kept where the loss falls; sweeps until
-// one changes nothing, at most 6). The curve stays anchored at its lowest
+// one changes nothing, at most 6), twice from the identity: once with the
+// slopes non-increasing (a compressive curve: concave) and once
+// non-decreasing (an expansive one: convex); the lower loss is kept. A
+// sensor's static nonlinearity bends one way over its range (a strain
+// gauge's or a loadcell's compression, a thermistor's exponential), and an
+// unconstrained search followed the noise of a loadcell at rest: flat at
+// 0 N, then steep (stop 73's curve sets 3320-3339, development: named on 12
+// of 20 unconstrained, 14 of 20 with the shape; docs/residual.md, "A curve
+// that bends one way"). The curve stays anchored at its lowest
 // knot. The loss is the unchanged network's 1-step error of every channel in
 // the measured frame, each relative to its error before the curve:
 // sum_c (rmse_c / rmse_c,before)^2. The channel's own error alone is no
@@ -1101,28 +1109,54 @@ void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const
   };
   set_slopes();
   const auto loss = [&] { return (training_rmse.all(sensor_after(before, a)).array() / rmse_before).square().sum(); };
-  double best = loss();
-  bool changed = true;
-  for (int sweep = 0; sweep < 6 && changed; ++sweep) {
-    changed = false;
-    for (std::size_t k = 0; k < slopes.size(); ++k) {
-      const double kept = slopes[k];
-      double best_slope = kept;
-      for (double f : kSlopeFactors) {
-        slopes[k] = kept * f;
-        if (slopes[k] < kMinSlope || slopes[k] > kMaxSlope) continue;
+  // One search from the identity with the segment slopes kept in order:
+  // `shape` -1 non-increasing (a compressive curve, concave), +1
+  // non-decreasing (an expansive one, convex). Returns the loss reached.
+  const auto search = [&](int shape) {
+    std::fill(slopes.begin(), slopes.end(), 1.0);
+    set_slopes();
+    double best = loss();
+    const auto in_order = [&](std::size_t k, double s) {
+      const bool below_left = k == 0 || shape * (s - slopes[k - 1]) >= 0;
+      const bool above_right = k + 1 == slopes.size() || shape * (slopes[k + 1] - s) >= 0;
+      return below_left && above_right;
+    };
+    bool changed = true;
+    for (int sweep = 0; sweep < 6 && changed; ++sweep) {
+      changed = false;
+      for (std::size_t k = 0; k < slopes.size(); ++k) {
+        const double kept = slopes[k];
+        double best_slope = kept;
+        for (double f : kSlopeFactors) {
+          const double s = kept * f;
+          if (s < kMinSlope || s > kMaxSlope || !in_order(k, s)) continue;
+          slopes[k] = s;
+          set_slopes();
+          const double l = loss();
+          if (l < best) best = l, best_slope = s, changed = true;
+        }
+        slopes[k] = best_slope;
         set_slopes();
-        const double l = loss();
-        if (l < best) best = l, best_slope = slopes[k], changed = true;
       }
-      slopes[k] = best_slope;
-      set_slopes();
     }
+    return best;
+  };
+  const double compressive = search(-1);
+  const std::vector<double> compressive_slopes = slopes;
+  const double expansive = search(+1);
+  if (compressive <= expansive) {
+    slopes = compressive_slopes;
+    set_slopes();
   }
   const std::size_t n = knots.size();
-  char text[160];
-  std::snprintf(text, sizeof text, "; re-estimated: one curve, %zu knots, slope %.3g at %.4g .. %.3g at %.4g, reads %.4g at %.4g",
-                n, slopes.front(), knots.front(), slopes.back(), knots[n - 1], curves.front().reading.back(), knots[n - 1]);
+  const char* shape = slopes.front() > slopes.back()   ? "compressive"
+                      : slopes.front() < slopes.back() ? "expansive"
+                                                       : "straight";
+  char text[192];
+  std::snprintf(text, sizeof text,
+                "; re-estimated: one curve, %zu knots, slope %.3g at %.4g .. %.3g at %.4g, reads %.4g at %.4g (%s)", n,
+                slopes.front(), knots.front(), slopes.back(), knots[n - 1], curves.front().reading.back(), knots[n - 1],
+                shape);
   a.description += text;
 }
 
