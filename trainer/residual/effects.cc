@@ -1109,13 +1109,14 @@ void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const
   };
   set_slopes();
   const auto loss = [&] { return (training_rmse.all(sensor_after(before, a)).array() / rmse_before).square().sum(); };
+  const double at_identity = loss();  // each search's start: one probe of the network, not two
   // One search from the identity with the segment slopes kept in order:
   // `shape` -1 non-increasing (a compressive curve, concave), +1
   // non-decreasing (an expansive one, convex). Returns the loss reached.
   const auto search = [&](int shape) {
     std::fill(slopes.begin(), slopes.end(), 1.0);
     set_slopes();
-    double best = loss();
+    double best = at_identity;
     const auto in_order = [&](std::size_t k, double s) {
       const bool below_left = k == 0 || shape * (s - slopes[k - 1]) >= 0;
       const bool above_right = k + 1 == slopes.size() || shape * (slopes[k + 1] - s) >= 0;
