@@ -4,13 +4,16 @@
 // tests use fixed seeds and state their bounds where they appear.
 #include "trainer/residual/statistics.h"
 
+#include <Eigen/Dense>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <numbers>
 #include <random>
+#include <vector>
 
 namespace hadynet::trainer::residual {
 namespace {
@@ -87,6 +90,72 @@ TEST(Whiteness, Ar1FailsAndItsAutocorrelationIsPhi) {
   EXPECT_EQ(choose_ar_order(logs, 10), 1);
   // The whitened series is white.
   EXPECT_GT(ljung_box(ar_filter(logs, fit_ar(logs, 1)), 25).p_value, 0.01);
+}
+
+// choose_ar_order's BIC with every order fitted on its own (one
+// column-pivoting QR per order on the rows t >= max_order of each centred
+// segment): what choose_ar_order computed before its one factorisation.
+int ar_order_fitted_per_order(const Segments& x, int max_order) {
+  std::vector<double> y;
+  std::vector<std::vector<double>> lags;
+  for (const Eigen::VectorXd& raw : x) {
+    const Eigen::VectorXd s = raw.array() - raw.mean();
+    for (Eigen::Index t = max_order; t < s.size(); ++t) {
+      y.push_back(s(t));
+      std::vector<double> row;
+      for (int i = 1; i <= max_order; ++i) row.push_back(s(t - i));
+      lags.push_back(row);
+    }
+  }
+  const auto n = static_cast<Eigen::Index>(y.size());
+  const Eigen::VectorXd Y = Eigen::Map<const Eigen::VectorXd>(y.data(), n);
+  int best = 0;
+  double best_bic = std::numeric_limits<double>::infinity();
+  for (int p = 0; p <= max_order; ++p) {
+    Eigen::MatrixXd X(n, p);
+    for (Eigen::Index r = 0; r < n; ++r)
+      for (int i = 0; i < p; ++i) X(r, i) = lags[static_cast<std::size_t>(r)][static_cast<std::size_t>(i)];
+    const double rss = p == 0 ? Y.squaredNorm() : (Y - X * X.colPivHouseholderQr().solve(Y)).squaredNorm();
+    const double bic = static_cast<double>(n) * std::log(std::max(rss / static_cast<double>(n), 1e-300)) +
+                       p * std::log(static_cast<double>(n));
+    if (bic < best_bic) best_bic = bic, best = p;
+  }
+  return best;
+}
+
+// An AR(2) with coefficients phi1, phi2 (stationary for the values used).
+Eigen::VectorXd ar2(int n, double phi1, double phi2, std::uint64_t seed) {
+  Eigen::VectorXd e = white_noise(n, seed), v(n);
+  for (int i = 0; i < n; ++i) v(i) = e(i) + (i >= 1 ? phi1 * v(i - 1) : 0) + (i >= 2 ? phi2 * v(i - 2) : 0);
+  return v;
+}
+
+// The order from one factorisation is the order every order fitted on its
+// own gives: exactly (an integer), on series of orders 0, 1 and 2, short
+// and long, and on a periodic series whose lags are collinear (lag 2 = -lag
+// 1: the per-order fits take it).
+TEST(Whiteness, TheArOrderIsTheOneEveryOrderFittedOnItsOwnGives) {
+  std::vector<Segments> cases;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    cases.push_back({white_noise(300, seed)});
+    cases.push_back({ar1(120, 0.7, seed), ar1(80, 0.7, seed + 100)});
+    cases.push_back({ar2(400, 0.5, -0.3, seed), ar2(250, 0.5, -0.3, seed + 200)});
+    cases.push_back({ar2(60, 1.2, -0.5, seed)});
+  }
+  Eigen::VectorXd alternating(40);
+  for (int i = 0; i < 40; ++i) alternating(i) = i % 2 ? -1.0 : 1.0;
+  cases.push_back({alternating});
+  std::vector<int> seen(11, 0);
+  for (const Segments& x : cases) {
+    const int order = choose_ar_order(x, 10);
+    EXPECT_EQ(order, ar_order_fitted_per_order(x, 10));
+    ++seen[static_cast<std::size_t>(order)];
+  }
+  EXPECT_EQ(choose_ar_order({alternating}, 10), 1);  // x_t = -x_{t-1} exactly
+  // The cases reach orders 0, 1 and 2 (the comparison is not of one order).
+  EXPECT_GT(seen[0], 0);
+  EXPECT_GT(seen[1], 0);
+  EXPECT_GT(seen[2], 0);
 }
 
 TEST(Whiteness, NoProductAcrossLogBoundaries) {
