@@ -47,7 +47,11 @@
 # stop 67, nothing chosen on them): 8 of 10 confirmed, 7 pass (the patch
 # moved to stop 68's augment.cc); and --oracle drift:0.02:fc on the
 # 300-row drift=0.02 sets 2720-2729 and 2760-2769 (measured with stop 68's
-# tool first): 20 of 20 pass.
+# tool first): 20 of 20 pass. Stop 75: the patch moved to stop 75's
+# augment.cc; --oracle curve:0.7:fc on the sensor-curve=0.7 sets 3380-3399
+# (measured with stop 74's tool first, nothing chosen on them): 19 of 20
+# confirmed and named, 12 pass (the cut is judged on every loadcell the
+# oracle curves, fc0-fc8, the tool's plans on the loadcells it found).
 set -euo pipefail
 usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
 model=models/hand-4seeds.safetensors

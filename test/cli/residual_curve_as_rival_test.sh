@@ -29,6 +29,18 @@
 #                   stop 74 ("Friction's rivals") the curve of fc0, fc3, fc1,
 #                   fc7 and fc2 is confirmed beside it (p 1.2e-07 against
 #                   6.8e-06) and applied.
+#   3320 saturation until stop 75 a chosen rail had no rivals: the selection
+#                   took a lower rail of the finger lengths l3 and l4 (no
+#                   candidate significant on the selection's rows; the
+#                   rail's the largest statistic, p 0.13, with a gain of
+#                   0.0018; the loadcells' curve gained 0.0084 there), and
+#                   the decision confirmed it (a wrong class: a length's
+#                   contact stop the network overshoots on curved loadcell
+#                   readings). Since stop 75 ("A rail's rivals") the curve
+#                   of fc3, fc4, fc2 and fc7, another group's, is
+#                   confirmed beside it (p 1.7e-08 against 0.0093) and
+#                   applied. (3320 was measured in stop 73; a development
+#                   set of stop 75.)
 # About 40 s each on the development VM.
 #   residual_curve_as_rival_test.sh HADYNET MODEL WORKDIR SEED CHOSEN
 set -uo pipefail

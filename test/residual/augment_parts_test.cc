@@ -1125,6 +1125,40 @@ TEST(DecisionRivals, AFrictionHasTheCurvesOfItsGroupsAsRivals) {
   EXPECT_EQ(residual::decision_rivals(planned, 5), (Rivals{0, 3, 4}));
 }
 
+// A rail's rivals are the calibration curves of the groups it does not hold
+// (stop 75: a lower rail of the finger lengths chosen on curve logs), and
+// they must have gained more than the rail on the selection's rows; every
+// other choice's rivals need only have gained.
+TEST(DecisionRivals, ARailHasTheCurvesOfOtherGroupsAsRivalsThatGainedMoreThanIt) {
+  const auto plan = planned_on;
+  using residual::EffectKind;
+  using Rivals = std::vector<std::size_t>;
+  const std::vector<residual::Augmentation> planned = {
+      plan(EffectKind::kSaturation, {"l3", "l4"}),
+      plan(EffectKind::kSensorCurve, {"fc1", "fc3"}),
+      plan(EffectKind::kSensorCurve, {"l3"}),
+      plan(EffectKind::kCrosstalk, {"fc1"}),
+      plan(EffectKind::kSensorCurve, {"f2", "fc0"}),
+      plan(EffectKind::kSaturation, {"fc3"}),
+      plan(EffectKind::kDriftLoad, {"fc1"}),
+  };
+  // Curves of other groups only: not the lengths' own curve, no other effect.
+  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 4}));
+  // A curve that holds a group of the rail's is no rival: the loadcells' rail.
+  EXPECT_EQ(residual::decision_rivals(planned, 5), (Rivals{2}));
+  auto unfixable = planned;
+  unfixable[1].not_fixable = "no level";
+  EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{4}));
+  // A curve's rivals still hold the rails of its group.
+  EXPECT_EQ(residual::decision_rivals(planned, 2), (Rivals{0}));
+  // The gain a rival must exceed: the rail's own; 0 for any other choice,
+  // and never below 0 (a rail that lost on the selection's rows).
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[0], 0.0045), 0.0045);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[0], -0.2), 0.0);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[1], 0.12), 0.0);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[6], 0.3), 0.0);
+}
+
 // A model of two y channels, a and b, of standard deviations 2 and 4.
 HadynetModel loss_model() {
   HadynetModel m;

@@ -393,8 +393,8 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
   // A curve's rivals: any other effect; a drift with time's: a load drift;
   // a load drift's: a curve or a drift with time; a cross-talk within a
   // group's (one that stands in for the group's curve: its richer account):
-  // a curve or a load drift; a friction's: a curve; any other effect's:
-  // none.
+  // a curve or a load drift; a friction's: a curve; a rail's: a curve of
+  // a group the rail does not hold; any other effect's: none.
   const auto richer = effect_info(a.kind).richer;
   const bool stands_in_for_curve = richer && richer(a) == EffectKind::kSensorCurve;
   const auto is_rival = [&](const Augmentation& p) {
@@ -406,9 +406,19 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
       case EffectKind::kCrosstalk:
         return stands_in_for_curve && (p.kind == EffectKind::kSensorCurve || p.kind == EffectKind::kDriftLoad);
       case EffectKind::kFriction: return p.kind == EffectKind::kSensorCurve;
+      case EffectKind::kSaturation: return p.kind == EffectKind::kSensorCurve;
       default: return false;
     }
   };
+  const auto groups_shared = [&](const Augmentation& p) {
+    return std::any_of(a.channels.begin(), a.channels.end(), [&](const std::string& name) {
+      const std::string group = channel_group(name);
+      return std::any_of(p.channels.begin(), p.channels.end(),
+                         [&](const std::string& other) { return channel_group(other) == group; });
+    });
+  };
+  // A rail's rivals are of the other groups; every other choice's share one of its groups.
+  const bool other_groups = a.kind == EffectKind::kSaturation;
   if (!addable(a)) return rivals;
   // A drift's rivals also: the drift probe's plans, of any group.
   const bool drift = a.kind == EffectKind::kDriftLoad || a.kind == EffectKind::kDriftTime;
@@ -419,14 +429,13 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
       continue;
     }
     if (!is_rival(planned[k])) continue;
-    const bool shares_group = std::any_of(a.channels.begin(), a.channels.end(), [&](const std::string& name) {
-      const std::string group = channel_group(name);
-      return std::any_of(planned[k].channels.begin(), planned[k].channels.end(),
-                         [&](const std::string& other) { return channel_group(other) == group; });
-    });
-    if (shares_group) rivals.push_back(k);
+    if (groups_shared(planned[k]) != other_groups) rivals.push_back(k);
   }
   return rivals;
+}
+
+double rival_gain_floor(const Augmentation& chosen, double chosen_gain) {
+  return chosen.kind == EffectKind::kSaturation ? std::max(chosen_gain, 0.0) : 0.0;
 }
 
 bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k) {
@@ -858,10 +867,11 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       }
     }
     // Rivals (decision_rivals): those that gained on the selection's rows
-    // too are tested beside the choice.
+    // too (more than rival_gain_floor) are tested beside the choice.
+    const double gain_floor = rival_gain_floor(planned[chosen], result.candidates[chosen].selection.mean);
     for (const std::size_t k : decision_rivals(planned, chosen, probed)) {
       if (!judged_rows[k]) judge(k);
-      if (result.candidates[k].selection.mean > 0) rivals.push_back(k);
+      if (result.candidates[k].selection.mean > gain_floor) rivals.push_back(k);
     }
   }
   result.candidates[chosen].chosen = true;

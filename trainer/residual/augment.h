@@ -431,7 +431,8 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 // The plans the held-out rows decide between with the selection's choice
 // planned[chosen] (docs/residual.md, "Rivals: the held-out rows decide",
 // stop 70), each an addable plan that holds a channel of one of
-// planned[chosen]'s groups: when planned[chosen] is a calibration curve,
+// planned[chosen]'s groups (a rail's: of none of them, below): when
+// planned[chosen] is a calibration curve,
 // every plan of another effect; when it is a drift with time, every load
 // drift; when it is a load drift, every calibration curve and drift with
 // time; and for either drift also the drift probe's plans (`probed`: their
@@ -446,7 +447,14 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 // logs friction of one tendon's command on its loadcell was chosen because
 // its gain on the selection's rows was significant and the curves' larger,
 // noisier gain was not, and friction's simpler account, the curve of its
-// lead channel, was often not planned); for any other effect none. In
+// lead channel, was often not planned); when it is a rail, every
+// calibration curve of a group the rail does not hold (stop 75: on curve
+// logs a lower rail of the finger lengths was chosen for the consistency
+// of its small gain, a length's contact stop that the network overshoots
+// once the loadcells it reads are curved, and applied without the
+// loadcells' curve, which gained 4-54 times more on the selection's rows,
+// ever being tested; a rail's rivals must also gain more than it:
+// rival_gain_floor); for any other effect none. In
 // `planned`'s order. On the
 // training rows a curve of a channel's own level explains part of any
 // effect's residual on a channel that follows the load, and a load drift,
@@ -457,6 +465,16 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 // planned[chosen], all at Holm's levels (FixResult::rivals).
 std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planned, std::size_t chosen,
                                          const std::vector<std::size_t>& probed = {});
+
+// The mean loss difference on the selection's rows (CandidateTrial::
+// selection) a rival of `chosen` must exceed to be tested beside it, given
+// chosen's own (`chosen_gain`): for a rail, its own gain (a rail clips the
+// rows at its level alone, a small and consistent gain; a curve elsewhere
+// that gained less is no larger account of the residual, and on rail logs
+// the tendons' curves gained 1e-4 where the rail gained 0.004-0.085,
+// stop 70-74's 91 saturation=2 sets);
+// for any other choice 0 (a rival that gained at all).
+double rival_gain_floor(const Augmentation& chosen, double chosen_gain);
 
 // Whether planned[k] of plan_candidates() is a family alone: the plan right
 // after the same plan extended to its group.
