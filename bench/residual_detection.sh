@@ -319,8 +319,9 @@
 # stop 73's sensor-curve=0.7 sets 3320, 3273 and 3281, stop 72's 3253,
 # 3209 and 3169, stop 74's 3380-3399 and stop 73's saturation=2 sets
 # 3280-3289; 3450-3469 sensor-curve=0.7 and saturation=2, 3490-3529
-# sensor-curve=0.7 measured with the final code (3470-3489: clean sets),
-# and stop 74's saturation=2 sets of 3400-3409 re-run. Next unused: 3530 on.
+# sensor-curve=0.7 and 3530-3539 every effect at its larger strength
+# measured with the final code (3470-3489: clean sets), and stop 74's
+# saturation=2 sets of 3400-3409 re-run. Next unused: 3540 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...
