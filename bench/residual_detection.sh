@@ -321,7 +321,13 @@
 # 3280-3289; 3450-3469 sensor-curve=0.7 and saturation=2, 3490-3529
 # sensor-curve=0.7 and 3530-3539 every effect at its larger strength
 # measured with the final code (3470-3489: clean sets), and stop 74's
-# saturation=2 sets of 3400-3409 re-run. Next unused: 3540 on.
+# saturation=2 sets of 3400-3409 re-run. Stop 76 (a target's source of
+# two fitted together; the curve's criterion with the predicted change's
+# scale, not kept): development stop 73's sensor-curve=0.7 and
+# crosstalk=0.35 sets 3320-3339 and the crosstalk=0.35 sets 2933, 2938,
+# 2989, 3050, 3052, 3112, 3164, 3265, 3280, 3530 and 3537; 3540-3549 every
+# effect at its larger strength measured with the final code (3550-3569:
+# clean sets). Next unused: 3570 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -127,8 +127,9 @@
 # (friction's rivals; 1 of 20: 3374, the fingertips' cross-talk fc2 -> fc1
 # at p 0.0094, which stop 73's code confirms too) with the rivals alone,
 # 3410-3429 with its final code (the curve's shape too; 0 of 20). Stop
-# 75: 3470-3489 with its final code (a rail's rivals; 0 of 20). Next
-# unused seed: 3540
+# 75: 3470-3489 with its final code (a rail's rivals; 0 of 20). Stop 76:
+# 3550-3569 with its final code (a target's source of two fitted
+# together; 0 of 20). Next unused seed: 3570
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

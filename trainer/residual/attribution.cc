@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -79,33 +80,103 @@ Explained explained(const Part& part, const Eigen::VectorXd& beta) {
 
 }  // namespace
 
-HypothesisResult test_hypothesis(const ResidualData& data, const Hypothesis& h, const AttributionOptions& options) {
-  HypothesisResult res;
-  res.hypothesis = h;
-  res.effect = effect_info(h.kind).name;
-  const auto c = static_cast<Eigen::Index>(h.target);
-  const int min_rows = options.max_ar_order + 5;
+namespace {
 
+// Target c's residual and the regressors `feature_of` gives each log, split
+// in time at options.train_fraction into a training and a held-out part,
+// each centred on the training part's means; a log with fewer than
+// max_ar_order + 5 rows in either part is left out. `support` counts the
+// training rows where each regressor is non-zero.
+struct SplitParts {
   Part train, held;
   Eigen::Index k = 0;
-  Eigen::VectorXi support;  // training samples where each regressor is non-zero
+  Eigen::VectorXi support;
+};
+template <class FeatureOf>
+SplitParts split_parts(const ResidualData& data, Eigen::Index c, const FeatureOf& feature_of,
+                       const AttributionOptions& options) {
+  const int min_rows = options.max_ar_order + 5;
+  SplitParts s;
   for (const auto& log : data.logs) {
-    const Features f = features(h, log);
-    k = f.z.cols();
+    const Features f = feature_of(log);
+    s.k = f.z.cols();
     const int n = log.size();
     const int split = static_cast<int>(options.train_fraction * n);
     const int t0 = f.first_valid, t1 = split, h0 = std::max(split, f.first_valid), h1 = n;
     if (t1 - t0 < min_rows || h1 - h0 < min_rows) continue;
     const Eigen::VectorXd r = log.r.row(c).transpose();
-    if (support.size() != k) support = Eigen::VectorXi::Zero(k);
-    support += (f.z.middleRows(t0, t1 - t0).array().abs() > 1e-12).cast<int>().matrix().colwise().sum().transpose();
+    if (s.support.size() != s.k) s.support = Eigen::VectorXi::Zero(s.k);
+    s.support += (f.z.middleRows(t0, t1 - t0).array().abs() > 1e-12).cast<int>().matrix().colwise().sum().transpose();
     const double mr = r.segment(t0, t1 - t0).mean();
     const Eigen::RowVectorXd mz = f.z.middleRows(t0, t1 - t0).colwise().mean();
-    train.r.push_back(r.segment(t0, t1 - t0).array() - mr);
-    train.z.push_back(f.z.middleRows(t0, t1 - t0).rowwise() - mz);
-    held.r.push_back(r.segment(h0, h1 - h0).array() - mr);
-    held.z.push_back(f.z.middleRows(h0, h1 - h0).rowwise() - mz);
+    s.train.r.push_back(r.segment(t0, t1 - t0).array() - mr);
+    s.train.z.push_back(f.z.middleRows(t0, t1 - t0).rowwise() - mz);
+    s.held.r.push_back(r.segment(h0, h1 - h0).array() - mr);
+    s.held.z.push_back(f.z.middleRows(h0, h1 - h0).rowwise() - mz);
   }
+  return s;
+}
+
+// Cochrane-Orcutt on the training part: OLS, AR(p) on its residual (p by
+// BIC), whitened OLS; twice. Returns the coefficients; `a` the AR filter,
+// `ar_order` its order.
+Eigen::VectorXd cochrane_orcutt(const Part& train, Eigen::Index k, const AttributionOptions& options,
+                                Eigen::VectorXd& a, int& ar_order) {
+  Eigen::VectorXd beta = least_squares(stack(train.z, k), stack(train.r));
+  for (int pass = 0; pass < 2; ++pass) {
+    Segments e;
+    for (std::size_t i = 0; i < train.r.size(); ++i) e.push_back(train.r[i] - train.z[i] * beta);
+    ar_order = choose_ar_order(e, options.max_ar_order);
+    a = fit_ar(e, ar_order);
+    beta = least_squares(stack(filter_columns(train.z, a), k), stack(ar_filter(train.r, a)));
+  }
+  return beta;
+}
+
+// The held-out test of a fixed prediction: the (whitened) residual `r_w`
+// regressed on the (whitened) prediction `p_w`, an intercept per log. t of
+// the slope (0 where the prediction is flat) and the rows used.
+struct HeldOutSlope {
+  double t = 0, p = 1;
+  long n = 0;
+};
+HeldOutSlope held_out_slope(const Segments& r_w, const Segments& p_w) {
+  double sxy = 0, sxx = 0, syy = 0;
+  long n = 0;
+  for (std::size_t i = 0; i < r_w.size(); ++i) {
+    if (r_w[i].size() < 2) continue;
+    const Eigen::VectorXd pc = p_w[i].array() - p_w[i].mean();
+    const Eigen::VectorXd rc = r_w[i].array() - r_w[i].mean();
+    sxy += pc.dot(rc);
+    sxx += pc.squaredNorm();
+    syy += rc.squaredNorm();
+    n += static_cast<long>(rc.size());
+  }
+  HeldOutSlope out;
+  out.n = n;
+  const double dof = static_cast<double>(n) - static_cast<double>(r_w.size()) - 1.0;
+  if (sxx > 1e-12 * std::max(1.0, syy) && syy > 0 && dof > 0) {
+    const double slope = sxy / sxx;
+    const double ss_res = std::max(syy - slope * sxy, 1e-300);
+    const double se = std::sqrt(ss_res / dof / sxx);
+    out.t = slope / se;
+    out.p = student_t_sf(out.t, dof);
+  }
+  return out;
+}
+
+}  // namespace
+
+HypothesisResult test_hypothesis(const ResidualData& data, const Hypothesis& h, const AttributionOptions& options) {
+  HypothesisResult res;
+  res.hypothesis = h;
+  res.effect = effect_info(h.kind).name;
+  const auto c = static_cast<Eigen::Index>(h.target);
+  SplitParts parts = split_parts(data, c, [&](const ResidualLog& log) { return features(h, log); }, options);
+  const Part& train = parts.train;
+  const Part& held = parts.held;
+  const Eigen::Index k = parts.k;
+  const Eigen::VectorXi& support = parts.support;
   res.coef = Eigen::VectorXd::Zero(k);
   if (train.r.empty()) {
     res.testable = false;
@@ -132,16 +203,8 @@ HypothesisResult test_hypothesis(const ResidualData& data, const Hypothesis& h, 
     return res;
   }
 
-  // Cochrane-Orcutt: OLS, AR(p) on its residual, whitened OLS; twice.
-  Eigen::VectorXd beta = least_squares(stack(train.z, k), stack(train.r));
   Eigen::VectorXd a;
-  for (int pass = 0; pass < 2; ++pass) {
-    Segments e;
-    for (std::size_t i = 0; i < train.r.size(); ++i) e.push_back(train.r[i] - train.z[i] * beta);
-    res.ar_order = choose_ar_order(e, options.max_ar_order);
-    a = fit_ar(e, res.ar_order);
-    beta = least_squares(stack(filter_columns(train.z, a), k), stack(ar_filter(train.r, a)));
-  }
+  const Eigen::VectorXd beta = cochrane_orcutt(train, k, options, a, res.ar_order);
   res.coef = beta;
   res.parameter = main_parameter(h, beta);
   res.plausible = plausible(h, beta);
@@ -155,31 +218,52 @@ HypothesisResult test_hypothesis(const ResidualData& data, const Hypothesis& h, 
   // Held-out test: whitened residual against the whitened fixed prediction, an intercept per log.
   const Segments r_w = ar_filter(held.r, a);
   const std::vector<Eigen::MatrixXd> z_w = filter_columns(held.z, a);
-  double sxy = 0, sxx = 0, syy = 0;
-  long n = 0;
-  for (std::size_t i = 0; i < r_w.size(); ++i) {
-    if (r_w[i].size() < 2) continue;
-    const Eigen::VectorXd p = z_w[i] * beta;
-    const Eigen::VectorXd pc = p.array() - p.mean();
-    const Eigen::VectorXd rc = r_w[i].array() - r_w[i].mean();
-    sxy += pc.dot(rc);
-    sxx += pc.squaredNorm();
-    syy += rc.squaredNorm();
-    n += static_cast<long>(rc.size());
-  }
+  Segments p_w;
+  for (const auto& z : z_w) p_w.push_back(z * beta);
   long n_train = 0;
   for (const auto& s : ar_filter(train.r, a)) n_train += static_cast<long>(s.size());
   res.n_train = n_train;
-  res.n_held_out = n;
-  const double dof = static_cast<double>(n) - static_cast<double>(r_w.size()) - 1.0;
-  if (sxx > 1e-12 * std::max(1.0, syy) && syy > 0 && dof > 0) {
-    const double slope = sxy / sxx;
-    const double ss_res = std::max(syy - slope * sxy, 1e-300);
-    const double se = std::sqrt(ss_res / dof / sxx);
-    res.t_stat = slope / se;
-    res.p_value = student_t_sf(res.t_stat, dof);
-  }
+  const HeldOutSlope slope = held_out_slope(r_w, p_w);
+  res.n_held_out = slope.n;
+  res.t_stat = slope.t;
+  res.p_value = slope.p;
   return res;
+}
+
+std::array<double, 2> partial_held_out_t(const ResidualData& data, const Hypothesis& first, const Hypothesis& second,
+                                         const AttributionOptions& options) {
+  if (first.target != second.target) throw std::logic_error("partial_held_out_t: two targets");
+  Eigen::Index k_first = 0;
+  const SplitParts parts = split_parts(
+      data, static_cast<Eigen::Index>(first.target),
+      [&](const ResidualLog& log) {
+        const Features a = features(first, log), b = features(second, log);
+        k_first = a.z.cols();
+        Features f;
+        f.z.resize(a.z.rows(), a.z.cols() + b.z.cols());
+        f.z << a.z, b.z;
+        f.first_valid = std::max(a.first_valid, b.first_valid);
+        return f;
+      },
+      options);
+  if (parts.train.r.empty()) return {0.0, 0.0};
+  Eigen::VectorXd a;
+  int ar_order = 0;
+  const Eigen::VectorXd beta = cochrane_orcutt(parts.train, parts.k, options, a, ar_order);
+  const Segments r_w = ar_filter(parts.held.r, a);
+  const std::vector<Eigen::MatrixXd> z_w = filter_columns(parts.held.z, a);
+  std::array<double, 2> t{};
+  for (int side = 0; side < 2; ++side) {
+    const Eigen::Index from = side == 0 ? 0 : k_first, cols = side == 0 ? k_first : parts.k - k_first;
+    const Eigen::Index other_from = side == 0 ? k_first : 0, other_cols = parts.k - cols;
+    Segments own, rest;
+    for (std::size_t i = 0; i < z_w.size(); ++i) {
+      own.push_back(z_w[i].middleCols(from, cols) * beta.segment(from, cols));
+      rest.push_back(r_w[i] - z_w[i].middleCols(other_from, other_cols) * beta.segment(other_from, other_cols));
+    }
+    t[static_cast<std::size_t>(side)] = held_out_slope(rest, own).t;
+  }
+  return t;
 }
 
 std::optional<HypothesisResult> Attribution::winner() const {

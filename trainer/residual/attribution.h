@@ -38,6 +38,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -124,6 +125,14 @@ struct Attribution {
 
 // Fits and tests one hypothesis (steps 1-3; p_adjusted and significant are left for step 4).
 HypothesisResult test_hypothesis(const ResidualData& data, const Hypothesis& h, const AttributionOptions& options);
+
+// Two hypotheses of one target fitted together (Cochrane-Orcutt on the
+// training part, as test_hypothesis): the held-out t of each one's part of
+// the joint prediction against the residual less the other's part. Which of
+// two correlated sources holds what neither explains without the other.
+// {0, 0} when the logs are too short.
+std::array<double, 2> partial_held_out_t(const ResidualData& data, const Hypothesis& first, const Hypothesis& second,
+                                         const AttributionOptions& options);
 
 // The null of `hypotheses` on `reference` (clean logs of the same model and
 // channels; never its training data nor the logs under test). Throws

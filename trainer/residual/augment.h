@@ -248,9 +248,10 @@ struct TimeAlignment : ModelChange {
   bool carried_before_tuning() const { return true; }
 };
 
-// crosstalk: removal of the winner's pair and, within one group, each
-// further target's source (its significant pair of the clearest held-out t)
-// when that pair forms no chain (crosstalk::plan, forms_chain): each
+// crosstalk: removal of the winner's target's pair and, within one group,
+// each further target's (each its source of the clearest held-out t; of
+// its two clearest, the one that keeps its part when the two are fitted
+// together) when that pair forms no chain (crosstalk::plan, forms_chain): each
 // target picks up `gain` times its source (the fitted gain); the model is
 // fine-tuned on y'_c = y_c - k y_s (in y and x); the measured y_c is
 // y'_c + k y'_s (exact without chains: y_s is then y'_s).

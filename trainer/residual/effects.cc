@@ -1218,7 +1218,24 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
   return "crosstalk " + source_name(h, data) + " -> " + y_name(data, h.target) + ": gain" + fmt(" %.3g", p);
 }
 
-// The winner's pair; when its source is in its target's group (and the
+// Of two significant sources of one target (`first` the clearer by its own
+// held-out t), the one whose part of the two fitted together follows the
+// held-out residual more clearly (partial_held_out_t): `second` only when
+// its partial t is larger. Neighbouring sensors read correlated loads (the
+// plant's ring and little fingertips each other's), so each alone explains
+// much of a target the other's cross-talk reaches; fitted together, the
+// source the target really picks up keeps it.
+const HypothesisResult* clearer_of_two(const ResidualData& data, const Attribution& attribution,
+                                       const HypothesisResult& first, const HypothesisResult& second) {
+  const std::array<double, 2> t = partial_held_out_t(data, first.hypothesis, second.hypothesis, attribution.options);
+  return t[1] > t[0] ? &second : &first;
+}
+
+// The winner's target and its source (the winner's, or of its target's
+// significant pairs in the group the clearer, as for every further target
+// below: on fresh cross-talk set 3530 the winner was fc4 -> fc2, t 25.4,
+// beside the plant's fc3 -> fc2, t 26.5; stop 76); when that source is in
+// its target's group (and the
 // plan may extend: Augmentation::group_extension), also, in ranking order,
 // each further target's source (since stop 71 its one pair of the clearest
 // held-out t; below): a significant pair of the group (target and source
@@ -1253,10 +1270,33 @@ std::string describe(const Hypothesis& h, const ResidualData& data, double p) {
 // logs), and fc1 got worse than before (docs/residual.md).
 void plan(const ResidualData& data, const Attribution& attribution, const HypothesisResult& w, Augmentation& a) {
   auto& change = a.change.emplace<CrosstalkRemoval>();
-  const std::string target = y_name(data, w.hypothesis.target), source = source_name(w.hypothesis, data);
-  a.channels = {target};
-  change.pairs = {{target, source, w.parameter}};
+  const std::string target = y_name(data, w.hypothesis.target);
   const std::string group = channel_group(target);
+  // Each target's source: of its significant pairs in the group, the one
+  // whose prediction follows the target's held-out residual most clearly
+  // (HypothesisResult::t_stat, stop 71), unless the next one holds more of
+  // what the two explain together (clearer_of_two, stop 76).
+  std::map<std::string, const HypothesisResult*> source_of;
+  {
+    std::map<std::string, std::vector<const HypothesisResult*>> sources;
+    for (const HypothesisResult& r : attribution.ranked) {
+      if (!r.significant) break;
+      if (r.hypothesis.kind != EffectKind::kCrosstalk) continue;
+      const std::string t = y_name(data, r.hypothesis.target), s = source_name(r.hypothesis, data);
+      if (channel_group(t) == group && channel_group(s) == group) sources[t].push_back(&r);
+    }
+    for (auto& [t, list] : sources) {
+      std::stable_sort(list.begin(), list.end(),
+                       [](const HypothesisResult* x, const HypothesisResult* y) { return x->t_stat > y->t_stat; });
+      source_of[t] = list.size() < 2 ? list.front() : clearer_of_two(data, attribution, *list[0], *list[1]);
+    }
+  }
+  // The winner's own target likewise, when its source is in the group.
+  const HypothesisResult* lead = &w;
+  if (channel_group(source_name(w.hypothesis, data)) == group && source_of.count(target) != 0) lead = source_of[target];
+  const std::string source = source_name(lead->hypothesis, data);
+  a.channels = {target};
+  change.pairs = {{target, source, lead->parameter}};
   if (a.group_extension && channel_group(source) == group) {
     std::vector<SensorCrosstalk> taken = data.crosstalk;
     taken.push_back(change.pairs.front());
@@ -1270,24 +1310,13 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
       return std::find(significant.begin(), significant.end(), std::make_pair(pair.source, pair.target)) !=
              significant.end();
     };
-    // Each target's source (stop 71): of its significant pairs in the group,
-    // the one whose prediction follows the target's held-out residual most
-    // clearly (HypothesisResult::t_stat). Neighbours along a finger chain
-    // read each other's load, and what they explain of a target beyond the
-    // null differs by less than its noise: on cross-talk set 3050 fc2 from
-    // fc4 0.552 and from the plant's fc3 0.546 (excess 12.13 and 12.00, t
-    // 25.7 and 25.9); t named the plant's source on each of the six
-    // development sets, the ranking on three. A target whose source forms a
-    // chain or a mutual pair takes no lesser pair either.
-    std::map<std::string, const HypothesisResult*> source_of;
-    for (const HypothesisResult& r : attribution.ranked) {
-      if (!r.significant) break;
-      if (r.hypothesis.kind != EffectKind::kCrosstalk) continue;
-      const std::string t = y_name(data, r.hypothesis.target), s = source_name(r.hypothesis, data);
-      if (channel_group(t) != group || channel_group(s) != group) continue;
-      const HypothesisResult*& best = source_of[t];
-      if (best == nullptr || r.t_stat > best->t_stat) best = &r;
-    }
+    // source_of (above): neighbours along a finger chain read each other's
+    // load, and what they explain of a target beyond the null differs by
+    // less than its noise: on cross-talk set 3050 fc2 from fc4 0.552 and
+    // from the plant's fc3 0.546 (excess 12.13 and 12.00, t 25.7 and 25.9);
+    // t named the plant's source on each of the six development sets of
+    // stop 71, the ranking on three. A target whose source forms a chain or
+    // a mutual pair takes no lesser pair either.
     for (const HypothesisResult& r : attribution.ranked) {
       if (!r.significant) break;  // ranked: the significant (plausible among them) first
       if (r.hypothesis.kind != EffectKind::kCrosstalk) continue;
@@ -1499,8 +1528,9 @@ const std::vector<EffectInfo>& effect_library() {
        "leaking into the target, and what the network carries over of it from x_{t-1}",
        "gain: the fraction of y_s the target picks up (the coefficient of y_s(t))",
        "removal: train on y_c - k y_s (in y and x); the sensor model adds k times the predicted y_s back; "
-       "within one group also each further target's source (its significant pair of the clearest held-out t) "
-       "when that pair forms no chain",
+       "within one group the winner's target and each further one take their source of the clearest held-out "
+       "t (of its two clearest, the one that keeps its part when the two are fitted together), a further pair "
+       "when it forms no chain",
        SourceKind::kObserved, crosstalk::enumerate, crosstalk::features, first_coefficient, crosstalk::fraction,
        crosstalk::describe, crosstalk::plan, nullptr, nullptr, nullptr, std::nullopt, crosstalk::richer},
       {EffectKind::kAuxChannel, "aux-channel", "an aux_* column's value at t: a logged channel the model does not use",
