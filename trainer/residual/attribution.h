@@ -128,9 +128,9 @@ HypothesisResult test_hypothesis(const ResidualData& data, const Hypothesis& h, 
 
 // Two hypotheses of one target fitted together (Cochrane-Orcutt on the
 // training part, as test_hypothesis): the held-out t of each one's part of
-// the joint prediction against the residual less the other's part. Which of
-// two correlated sources holds what neither explains without the other.
-// {0, 0} when the logs are too short.
+// the joint prediction against the residual less the other's part. Of two
+// correlated sources, it tells which one explains what the other does not.
+// {0, 0} when the logs are too short; std::logic_error for two targets.
 std::array<double, 2> partial_held_out_t(const ResidualData& data, const Hypothesis& first, const Hypothesis& second,
                                          const AttributionOptions& options);
 
