@@ -78,10 +78,6 @@ Explained explained(const Part& part, const Eigen::VectorXd& beta) {
   return e;
 }
 
-}  // namespace
-
-namespace {
-
 // Target c's residual and the regressors `feature_of` gives each log, split
 // in time at options.train_fraction into a training and a held-out part,
 // each centred on the training part's means; a log with fewer than
