@@ -1276,8 +1276,11 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   // whose prediction follows the target's held-out residual most clearly
   // (HypothesisResult::t_stat, stop 71), unless the next one holds more of
   // what the two explain together (clearer_of_two, stop 76).
+  // Only a source in the target's group uses them (the lead's and the
+  // extension's): a cross-talk between groups is its own pair alone.
   std::map<std::string, const HypothesisResult*> source_of;
-  {
+  const bool in_group = channel_group(source_name(w.hypothesis, data)) == group;
+  if (in_group) {
     std::map<std::string, std::vector<const HypothesisResult*>> sources;
     for (const HypothesisResult& r : attribution.ranked) {
       if (!r.significant) break;
@@ -1293,7 +1296,7 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
   }
   // The winner's own target likewise, when its source is in the group.
   const HypothesisResult* lead = &w;
-  if (channel_group(source_name(w.hypothesis, data)) == group && source_of.count(target) != 0) lead = source_of[target];
+  if (in_group && source_of.count(target) != 0) lead = source_of[target];
   const std::string source = source_name(lead->hypothesis, data);
   a.channels = {target};
   change.pairs = {{target, source, lead->parameter}};
