@@ -327,7 +327,11 @@
 # crosstalk=0.35 sets 3320-3339 and the crosstalk=0.35 sets 2933, 2938,
 # 2989, 3050, 3052, 3112, 3164, 3265, 3280, 3530 and 3537; 3540-3549 every
 # effect at its larger strength and 3570-3589 crosstalk=0.35 measured with
-# the final code (3550-3569: clean sets). Next unused: 3590 on.
+# the final code (3550-3569: clean sets). Stop 77 (each log in its own level in the
+# held-out tests): 3540-3549 re-run as development (with stop 76's 3541, 3545,
+# 3573, 3574 and 3581, read for the diagnosis), 3590-3599 every effect at its
+# larger strength measured with this code and stop 76's (the same logs),
+# 3600-3619 clean sets. Next unused: 3620 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...

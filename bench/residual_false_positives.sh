@@ -129,7 +129,8 @@
 # 3410-3429 with its final code (the curve's shape too; 0 of 20). Stop
 # 75: 3470-3489 with its final code (a rail's rivals; 0 of 20). Stop 76:
 # 3550-3569 with its final code (a target's source of two fitted
-# together; 0 of 20). Next unused seed: 3590
+# together; 0 of 20). Stop 77 (each log in its own level): 3600-3619 measured
+# with its final code (0 of 20). Next unused seed: 3620
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

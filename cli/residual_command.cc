@@ -240,8 +240,8 @@ int run_residual(int argc, char** argv) {
                   "delay: the commands d steps earlier as inputs; aux channel: an observed channel), fine-tune\n"
                   "on the first --train-fraction of each log and report before/after on the rest; the effect is\n"
                   "confirmed (and the model kept) only when it beats fine-tuning alone on the held-out rows of\n"
-                  "the channels it changes (one-sided Diebold-Mariano test at --alpha; with --fix-folds 2 also on\n"
-                  "the mirrored fold's), else 'unexplained structure'");
+                  "the channels it changes (one-sided Diebold-Mariano test at --alpha, each log of each fold in its\n"
+                  "own level; with --fix-folds 2 also on the mirrored fold's), else 'unexplained structure'");
   opt.value("rounds", "N",
             "with --fix: repeat analysis and fix until nothing is confirmed, at most N rounds (so that two\n"
             "effects at once are both found); the next round analyses the confirmed change on the network\n"

@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <numbers>
 #include <random>
+#include <utility>
 #include <vector>
 
 namespace hadynet::trainer::residual {
@@ -229,6 +230,75 @@ TEST(DieboldMariano, FindsTheBetterModelOneSided) {
   EXPECT_GT(better.bandwidth, 0);
   EXPECT_LE(better.bandwidth, 400);
   EXPECT_THROW(diebold_mariano(a, {a[0]}), std::invalid_argument);
+}
+
+// Two models' squared errors on four logs of different size (scales 1, 0.5,
+// 0.3 and 3: a hard grasp's errors are ten times an easy one's), sharing
+// most of their error (AR(1), phi 0.8, 120 rows per log, as a fold's
+// held-out rows). `gain` scales the shared error of B on the first three
+// logs; the fourth, largest, has none.
+std::pair<Segments, Segments> two_models_on_four_logs(double gain, std::uint64_t seed) {
+  const double scales[] = {1, 0.5, 0.3, 3};
+  Segments a, b;
+  for (int k = 0; k < 4; ++k) {
+    const std::uint64_t s = seed * 16 + static_cast<std::uint64_t>(k) * 4;
+    const Eigen::VectorXd shared = ar1(120, 0.8, s);
+    const double g = k < 3 ? gain : 1.0;
+    a.push_back((scales[k] * (shared + 0.5 * ar1(120, 0.8, s + 1))).array().square().matrix());
+    b.push_back((scales[k] * (g * shared + 0.5 * ar1(120, 0.8, s + 2))).array().square().matrix());
+  }
+  return {a, b};
+}
+
+int rejections_at_1_percent(double gain, int trials, std::uint64_t first_seed, bool relative) {
+  int rejected = 0;
+  for (int trial = 0; trial < trials; ++trial) {
+    auto [a, b] = two_models_on_four_logs(gain, first_seed + static_cast<std::uint64_t>(trial));
+    if (relative) relative_to_segment_level(a, b);
+    rejected += diebold_mariano(a, b).p_value < 0.01;
+  }
+  return rejected;
+}
+
+// Equal accuracy on every log: with each log in its own level the test
+// still rejects at 1 % in about 1 % of 400 trials (5 of 400 here).
+// Tolerance: at most 16 (binomial 400 x 1 %: P(> 16) < 0.001), as the
+// plain test's above.
+TEST(DieboldMariano, EachLogInItsOwnLevelKeepsTheNullsLevel) {
+  const int rejected = rejections_at_1_percent(1.0, 400, 20000, true);
+  std::printf("null rejections at 1 %% with each log in its own level: %d / 400\n", rejected);
+  EXPECT_LE(rejected, 16);
+}
+
+// B's shared error is 0.7 of A's on three logs and the same on the largest:
+// with each log in its own level the test finds B better in most of 100
+// trials (72 here), the rows as they come almost never (5 here: the
+// largest log's noise carries the test). Tolerances: at least 50 and at
+// most 15 (binomial 100 x 0.72: P(< 50) < 1e-5; 100 x 0.05: P(> 15) <
+// 1e-3).
+TEST(DieboldMariano, EachLogInItsOwnLevelFindsAGainTheLargestLogHides) {
+  const int relative = rejections_at_1_percent(0.7, 100, 30000, true);
+  const int as_they_come = rejections_at_1_percent(0.7, 100, 30000, false);
+  std::printf("gain found at 1 %%: each log in its own level %d / 100, the rows as they come %d / 100\n", relative,
+              as_they_come);
+  EXPECT_GE(relative, 50);
+  EXPECT_LE(as_they_come, 15);
+}
+
+// Each segment is divided by the pair's mean there; a segment of level 0
+// stays; segments that do not pair are refused.
+TEST(DieboldMariano, EachLogInItsOwnLevelDividesBySegmentPairsMean) {
+  Segments a = {Eigen::Vector2d(2, 4), Eigen::Vector2d(0, 0)};
+  Segments b = {Eigen::Vector2d(1, 1), Eigen::Vector2d(0, 0)};
+  relative_to_segment_level(a, b);  // level of the first pair: (3 + 1) / 2 = 2
+  EXPECT_DOUBLE_EQ(a[0](0), 1.0);
+  EXPECT_DOUBLE_EQ(a[0](1), 2.0);
+  EXPECT_DOUBLE_EQ(b[0](0), 0.5);
+  EXPECT_DOUBLE_EQ(a[1](0), 0.0);
+  Segments one = {Eigen::Vector2d(1, 1)};
+  Segments other_size = {Eigen::Vector3d(1, 1, 1)};
+  EXPECT_THROW(relative_to_segment_level(one, other_size), std::invalid_argument);
+  EXPECT_THROW(relative_to_segment_level(one, a), std::invalid_argument);
 }
 
 }  // namespace

@@ -921,7 +921,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     return t;
   };
   // One-sided Diebold-Mariano on `channels`, on every fold judged: the loss
-  // of `a` (first fold, mirrored fold) minus that of `b`.
+  // of `a` (first fold, mirrored fold) minus that of `b`, each log of each
+  // fold in its own level (relative_to_segment_level; since stop 77).
   const auto compare = [&](const HeldOutError& a, const std::optional<HeldOutError>& a_mirrored, const HeldOutError& b,
                            const std::optional<HeldOutError>& b_mirrored, const std::vector<std::string>& channels) {
     Segments a_loss = standardised_loss(model, a, channels, loss, levels);
@@ -932,6 +933,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       for (auto& segment : standardised_loss(model, *b_mirrored, channels, loss, levels))
         b_loss.push_back(std::move(segment));
     }
+    relative_to_segment_level(a_loss, b_loss);
     return diebold_mariano(a_loss, b_loss);
   };
   const auto significant = [&](const DieboldMariano& t) {

@@ -252,6 +252,19 @@ DieboldMariano diebold_mariano(const Segments& loss_a, const Segments& loss_b, i
   return r;
 }
 
+void relative_to_segment_level(Segments& loss_a, Segments& loss_b) {
+  if (loss_a.size() != loss_b.size()) throw std::invalid_argument("relative_to_segment_level: segment counts differ");
+  for (std::size_t i = 0; i < loss_a.size(); ++i) {
+    if (loss_a[i].size() != loss_b[i].size())
+      throw std::invalid_argument("relative_to_segment_level: segment sizes differ");
+    if (loss_a[i].size() == 0) continue;
+    const double level = 0.5 * (loss_a[i].mean() + loss_b[i].mean());
+    if (!(level > 0)) continue;
+    loss_a[i] /= level;
+    loss_b[i] /= level;
+  }
+}
+
 std::vector<double> holm_adjust(const std::vector<double>& p) {
   const std::size_t m = p.size();
   std::vector<std::size_t> order(m);

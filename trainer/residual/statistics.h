@@ -76,6 +76,18 @@ struct DieboldMariano {
 };
 DieboldMariano diebold_mariano(const Segments& loss_a, const Segments& loss_b, int bandwidth = -1);
 
+// Each log's losses in that log's own level: divides segment i of two
+// models' per-row losses on the same rows by the pair's mean loss there,
+// (mean a_i + mean b_i) / 2, so that a Diebold-Mariano test of the results
+// weighs every log (and fold) by its relative difference, not by its size.
+// Without it the log with the largest errors carries the test: a hard
+// grasp's squared errors are ten times another's and heavy-tailed, and its
+// fine-tuning noise hides a gain every log shows (docs/residual.md, "Each
+// log in its own level (stop 77)"). Equal accuracy within each log stays
+// equal accuracy. A segment of level 0 (or empty) is left as it is.
+// Throws std::invalid_argument when the segments do not pair.
+void relative_to_segment_level(Segments& loss_a, Segments& loss_b);
+
 // Holm's step-down correction of a family of p-values: adjusted p-values
 // (monotone, capped at 1) in the input order. Controls the family-wise error
 // rate under any dependence between the tests.
