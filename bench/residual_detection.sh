@@ -327,14 +327,15 @@
 # crosstalk=0.35 sets 3320-3339 and the crosstalk=0.35 sets 2933, 2938,
 # 2989, 3050, 3052, 3112, 3164, 3265, 3280, 3530 and 3537; 3540-3549 every
 # effect at its larger strength and 3570-3589 crosstalk=0.35 measured with
-# the final code (3550-3569: clean sets). Stop 77 (each log in its own level in the
-# held-out tests): 3540-3549 re-run as development (with stop 76's 3541, 3545,
-# 3573, 3574 and 3581, read for the diagnosis), 3590-3599 every effect at its
-# larger strength measured with this code and stop 76's (the same logs),
-# 3600-3619 clean sets. Next unused: 3620 on.
+# the final code (3550-3569: clean sets). Stop 77 (--decision-pooling logs, not
+# kept as the default): 3540-3549 re-run as development (with stop 76's 3541,
+# 3545, 3573, 3574 and 3581, read for the diagnosis), 3590-3599 every effect at
+# its larger strength and 3630-3649 cross-talk measured with both poolings (the
+# same logs), 3600-3619 clean sets, 3620-3629 the gain wobble
+# (bench/residual_unknown_effect.sh). Next unused: 3650 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
-#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [--case EFFECT=STRENGTH]...
+#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...
 #   defaults: models/hand.safetensors, build/residual-detection, 10, 231, the tool's --candidates (5), every case
 #   (--case: only those; repeatable), the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
@@ -344,6 +345,7 @@
 #   never saw, and keep the trained state names (a re-zeroed hand; bench/residual_grasps.sh)
 #   --decision-loss L: passed to `hadynet residual --fix` (squared, its default, or absolute: its default in stop 59)
 #   --decision-scale S: passed to `hadynet residual --fix` (std or residual: each channel's error in its clean residual level)
+#   --decision-pooling P: passed to `hadynet residual --fix` (rows, its default, or logs: each log in its own level)
 #   --fix-selection R: passed to `hadynet residual --fix` (screen-order or every-channel)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
@@ -369,6 +371,7 @@ while (($#)); do
     --fix-min-excess-null) candidates+=(--fix-min-excess-null "$2"); shift 2 ;;
     --decision-loss) candidates+=(--decision-loss "$2"); shift 2 ;;
     --decision-scale) candidates+=(--decision-scale "$2"); shift 2 ;;
+    --decision-pooling) candidates+=(--decision-pooling "$2"); shift 2 ;;
     --fix-selection) candidates+=(--fix-selection "$2"); shift 2 ;;
     --case) only_cases+=("$2"); shift 2 ;;
     --rezeroed-first-init) rezeroed_first_init=$2; shift 2 ;;

@@ -129,13 +129,14 @@
 # 3410-3429 with its final code (the curve's shape too; 0 of 20). Stop
 # 75: 3470-3489 with its final code (a rail's rivals; 0 of 20). Stop 76:
 # 3550-3569 with its final code (a target's source of two fitted
-# together; 0 of 20). Stop 77 (each log in its own level): 3600-3619 measured
-# with its final code (0 of 20). Next unused seed: 3620
+# together; 0 of 20). Stop 77: 3600-3619 with --decision-pooling logs (0 of 20;
+# the screen proposed nothing, so the default gives the same). Next unused
+# seed: 3650
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
-#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--fix-selection R] [SEED...]
+#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [SEED...]
 #   defaults: models/hand.safetensors, build/residual-false-positives, 161..180,
 #   no rated range (the plant's datasheet: --rated-range fc=0..50 --rated-range f=0..200),
 #   the null of `hadynet residual`'s default: the held-out logs stored in the model
@@ -145,6 +146,7 @@
 #   model never saw, and keeps the trained state names (a re-zeroed hand; bench/residual_grasps.sh)
 #   --decision-loss L: passed to `hadynet residual --fix` (squared, its default, or absolute: its default in stop 59)
 #   --decision-scale S: passed to `hadynet residual --fix` (std or residual: each channel's error in its clean residual level)
+#   --decision-pooling P: passed to `hadynet residual --fix` (rows, its default, or logs: each log in its own level)
 #   --fix-selection R: passed to `hadynet residual --fix` (screen-order or every-channel)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per seed with an ETA, then the counts; OUT/summary.txt.
@@ -167,6 +169,7 @@ while (($#)); do
     --fix-min-excess-null) ranges+=(--fix-min-excess-null "$2"); shift 2 ;;
     --decision-loss) ranges+=(--decision-loss "$2"); shift 2 ;;
     --decision-scale) ranges+=(--decision-scale "$2"); shift 2 ;;
+    --decision-pooling) ranges+=(--decision-pooling "$2"); shift 2 ;;
     --fix-selection) ranges+=(--fix-selection "$2"); shift 2 ;;
     --rezeroed-first-init) rezeroed_first_init=$2; shift 2 ;;
     -*) echo "residual_false_positives: unknown option $1" >&2; exit 2 ;;

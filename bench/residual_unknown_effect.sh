@@ -45,14 +45,16 @@
 # --decision-loss absolute); 2180-2189 (stop 60: the cross-talk group's
 # pairs, the squared loss; 0 of 10 confirmed); 2270-2279 (stop 61: the
 # residual's unit in the held-out tests); 2355-2364 (stop 62: a cross-talk
-# between groups a candidate of its own).
+# between groups a candidate of its own); 3620-3629 (stop 77,
+# --decision-pooling logs: 0 of 10 confirmed).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
-#          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--fix-selection R]
+#          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R]
 #   defaults: models/hand.safetensors, build/residual-unknown-effect, 10, 221, the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
 #   --decision-loss L: passed to `hadynet residual --fix` (squared, its default, or absolute: its default in stop 59)
 #   --decision-scale S: passed to `hadynet residual --fix` (std or residual: each channel's error in its clean residual level)
+#   --decision-pooling P: passed to `hadynet residual --fix` (rows, its default, or logs: each log in its own level)
 #   --fix-selection R: passed to `hadynet residual --fix` (screen-order or every-channel)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per log set with an ETA, then the counts (OUT/summary.txt).
@@ -76,6 +78,7 @@ while (($#)); do
     --effect-kind) kind=$2; shift 2 ;;
     --decision-loss) fix_args+=(--decision-loss "$2"); shift 2 ;;
     --decision-scale) fix_args+=(--decision-scale "$2"); shift 2 ;;
+    --decision-pooling) fix_args+=(--decision-pooling "$2"); shift 2 ;;
     --fix-selection) fix_args+=(--fix-selection "$2"); shift 2 ;;
     *) echo "residual_unknown_effect: unknown argument $1" >&2; exit 2 ;;
   esac

@@ -240,8 +240,8 @@ int run_residual(int argc, char** argv) {
                   "delay: the commands d steps earlier as inputs; aux channel: an observed channel), fine-tune\n"
                   "on the first --train-fraction of each log and report before/after on the rest; the effect is\n"
                   "confirmed (and the model kept) only when it beats fine-tuning alone on the held-out rows of\n"
-                  "the channels it changes (one-sided Diebold-Mariano test at --alpha, each log of each fold in its\n"
-                  "own level; with --fix-folds 2 also on the mirrored fold's), else 'unexplained structure'");
+                  "the channels it changes (one-sided Diebold-Mariano test at --alpha; with --fix-folds 2 also on\n"
+                  "the mirrored fold's), else 'unexplained structure'");
   opt.value("rounds", "N",
             "with --fix: repeat analysis and fix until nothing is confirmed, at most N rounds (so that two\n"
             "effects at once are both found); the next round analyses the confirmed change on the network\n"
@@ -317,6 +317,12 @@ int run_residual(int argc, char** argv) {
             "(also divided by its clean 1-step residual level on the null, the floors' unit: each channel's\n"
             "relative change counts alike; needs a null, else std is used and said)",
             rs::decision_scale_name(rs::FixOptions{}.decision_scale));
+  opt.value("decision-pooling", "rows|logs",
+            "with --fix: how the held-out tests pool the logs' per-row losses: rows (every row as it comes:\n"
+            "a log with larger errors weighs more) or logs (each log of each fold divided by its mean loss of\n"
+            "the two models compared first: every log counts by its relative difference; docs/residual.md,\n"
+            "\"Each log in its own level\")",
+            rs::decision_pooling_name(rs::FixOptions{}.decision_pooling));
   opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
                         "unchanged model, a weaker guard)");
   if (!opt.parse(argc, argv)) return 2;
@@ -376,6 +382,12 @@ int run_residual(int argc, char** argv) {
   if (!decision_scale) {
     std::fprintf(stderr, "hadynet residual: --decision-scale is std or residual, not '%s'\n",
                  opt.get("decision-scale").c_str());
+    return 2;
+  }
+  const std::optional<rs::DecisionPooling> decision_pooling = rs::decision_pooling_named(opt.get("decision-pooling"));
+  if (!decision_pooling) {
+    std::fprintf(stderr, "hadynet residual: --decision-pooling is rows or logs, not '%s'\n",
+                 opt.get("decision-pooling").c_str());
     return 2;
   }
   const std::optional<rs::SelectionRule> selection = rs::selection_rule_named(opt.get("fix-selection"));
@@ -478,6 +490,7 @@ int run_residual(int argc, char** argv) {
     fo.folds = static_cast<int>(*folds);
     fo.decision_loss = *decision_loss;
     fo.decision_scale = *decision_scale;
+    fo.decision_pooling = *decision_pooling;
     fo.selection = *selection;
     if (fix_min_excess) fo.min_excess_null = fix_min_excess;
     fo.reference = &reference;

@@ -97,6 +97,7 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                          {"test", "Diebold-Mariano, one-sided, Newey-West variance"},
                          {"loss", rs::decision_loss_name(o.decision_loss)},
                          {"scale", rs::decision_scale_name(f.scale)},
+                         {"pooling", rs::decision_pooling_name(o.decision_pooling)},
                          {"scale_note", f.scale_note},
                          {"own_channels", f.own_channels ? json{{"channels", f.own_channel_names},
                                                                  {"mean_loss_difference", f.own_channels->mean},

@@ -90,6 +90,8 @@ expect 2 "--decision-loss is squared or absolute, not 'cubic'" "$model" good.csv
   --json out.json
 expect 2 "--decision-scale is std or residual, not 'relative'" "$model" good.csv --fix --decision-scale relative \
   --json out.json
+expect 2 "--decision-pooling is rows or logs, not 'folds'" "$model" good.csv --fix --decision-pooling folds \
+  --json out.json
 expect 2 "--fix-selection is screen-order or every-channel, not 'best'" "$model" good.csv --fix --fix-selection best \
   --json out.json
 expect 2 "--fix-min-excess-null 4 is above the screen's --min-excess-null 3" "$model" good.csv --fix \

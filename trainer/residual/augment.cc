@@ -124,6 +124,14 @@ std::optional<DecisionScale> decision_scale_named(const std::string& name) {
   return value_named(name, {DecisionScale::kStd, DecisionScale::kResidual}, decision_scale_name);
 }
 
+const char* decision_pooling_name(DecisionPooling pooling) {
+  return pooling == DecisionPooling::kRows ? "rows" : "logs";
+}
+
+std::optional<DecisionPooling> decision_pooling_named(const std::string& name) {
+  return value_named(name, {DecisionPooling::kRows, DecisionPooling::kLogs}, decision_pooling_name);
+}
+
 DecisionRows decision_rows(int T, int split, int d) {
   DecisionRows r;
   const int inner = static_cast<int>(std::floor(DecisionRows::kSelectionFraction * split));
@@ -921,8 +929,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     return t;
   };
   // One-sided Diebold-Mariano on `channels`, on every fold judged: the loss
-  // of `a` (first fold, mirrored fold) minus that of `b`, each log of each
-  // fold in its own level (relative_to_segment_level; since stop 77).
+  // of `a` (first fold, mirrored fold) minus that of `b` (with
+  // DecisionPooling::kLogs, each log of each fold in its own level).
   const auto compare = [&](const HeldOutError& a, const std::optional<HeldOutError>& a_mirrored, const HeldOutError& b,
                            const std::optional<HeldOutError>& b_mirrored, const std::vector<std::string>& channels) {
     Segments a_loss = standardised_loss(model, a, channels, loss, levels);
@@ -933,7 +941,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       for (auto& segment : standardised_loss(model, *b_mirrored, channels, loss, levels))
         b_loss.push_back(std::move(segment));
     }
-    relative_to_segment_level(a_loss, b_loss);
+    if (options.decision_pooling == DecisionPooling::kLogs) relative_to_segment_level(a_loss, b_loss);
     return diebold_mariano(a_loss, b_loss);
   };
   const auto significant = [&](const DieboldMariano& t) {

@@ -83,8 +83,9 @@ DieboldMariano diebold_mariano(const Segments& loss_a, const Segments& loss_b, i
 // Without it the log with the largest errors carries the test: a hard
 // grasp's squared errors are ten times another's and heavy-tailed, and its
 // fine-tuning noise hides a gain every log shows (docs/residual.md, "Each
-// log in its own level (stop 77)"). Equal accuracy within each log stays
-// equal accuracy. A segment of level 0 (or empty) is left as it is.
+// log in its own level"; --decision-pooling logs). Equal accuracy within
+// each log stays equal accuracy. A segment of level 0 (or empty) is left
+// as it is.
 // Throws std::invalid_argument when the segments do not pair.
 void relative_to_segment_level(Segments& loss_a, Segments& loss_b);
 
