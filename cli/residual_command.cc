@@ -184,6 +184,16 @@ void print_fix(const rs::FixResult& fixed) {
   if (fixed.tried) std::printf("verdict after: %s\n", fixed.after.verdict.c_str());
 }
 
+// The value of the named option --`name` that `named` reads (one of
+// `values`, as the error message lists them); none after printing the error.
+template <class Named>
+auto named_value(const Options& opt, const char* name, Named named, const char* values) {
+  auto value = named(opt.get(name));
+  if (!value)
+    std::fprintf(stderr, "hadynet residual: --%s is %s, not '%s'\n", name, values, opt.get(name).c_str());
+  return value;
+}
+
 }  // namespace
 
 int run_residual(int argc, char** argv) {
@@ -372,30 +382,14 @@ int run_residual(int argc, char** argv) {
   const auto candidates = opt.get_int("candidates", 1, 20);
   const auto folds = opt.get_int("fix-folds", 1, 2);
   const auto drift_probe_alpha = opt.get_double("drift-probe-alpha", 0.0, 0.5);
-  const std::optional<rs::DecisionLoss> decision_loss = rs::decision_loss_named(opt.get("decision-loss"));
-  if (!decision_loss) {
-    std::fprintf(stderr, "hadynet residual: --decision-loss is squared or absolute, not '%s'\n",
-                 opt.get("decision-loss").c_str());
-    return 2;
-  }
-  const std::optional<rs::DecisionScale> decision_scale = rs::decision_scale_named(opt.get("decision-scale"));
-  if (!decision_scale) {
-    std::fprintf(stderr, "hadynet residual: --decision-scale is std or residual, not '%s'\n",
-                 opt.get("decision-scale").c_str());
-    return 2;
-  }
-  const std::optional<rs::DecisionPooling> decision_pooling = rs::decision_pooling_named(opt.get("decision-pooling"));
-  if (!decision_pooling) {
-    std::fprintf(stderr, "hadynet residual: --decision-pooling is rows or logs, not '%s'\n",
-                 opt.get("decision-pooling").c_str());
-    return 2;
-  }
-  const std::optional<rs::SelectionRule> selection = rs::selection_rule_named(opt.get("fix-selection"));
-  if (!selection) {
-    std::fprintf(stderr, "hadynet residual: --fix-selection is screen-order or every-channel, not '%s'\n",
-                 opt.get("fix-selection").c_str());
-    return 2;
-  }
+  const auto decision_loss = named_value(opt, "decision-loss", rs::decision_loss_named, "squared or absolute");
+  if (!decision_loss) return 2;
+  const auto decision_scale = named_value(opt, "decision-scale", rs::decision_scale_named, "std or residual");
+  if (!decision_scale) return 2;
+  const auto decision_pooling = named_value(opt, "decision-pooling", rs::decision_pooling_named, "rows or logs");
+  if (!decision_pooling) return 2;
+  const auto selection = named_value(opt, "fix-selection", rs::selection_rule_named, "screen-order or every-channel");
+  if (!selection) return 2;
   std::optional<double> fix_min_excess;  // given; else FixOptions' default (fix() keeps it at most the screen's)
   if (opt.has("fix-min-excess-null")) {
     fix_min_excess = opt.get_double("fix-min-excess-null", 0.0, 1e6);
