@@ -18,9 +18,9 @@
 # stop 70) and applied: with each log in its own level (stop 77,
 # --decision-pooling logs, not the default) the curve is confirmed (p
 # 0.00045) and the rail of fc4, fc3, fc7 and fc6 beside it (p 0.00014)
-# predicts best, so the rail is applied that way. Also checked: the lead's held-out RMSE cut by 30 % and below
-# fine-tuning alone (issue 12's bar), and the summed loadcell RMSE below
-# fine-tuning alone's.
+# predicts best, so the rail is applied that way. Also checked: the
+# lead's held-out RMSE cut by 30 % and below fine-tuning alone (issue
+# 12's bar), and the summed loadcell RMSE below fine-tuning alone's.
 # Seed 1595 was a development seed of this step (the miss it mends).
 #   residual_rail_simpler_test.sh HADYNET MODEL WORKDIR
 set -uo pipefail
