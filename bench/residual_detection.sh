@@ -332,7 +332,11 @@
 # 3545, 3573, 3574 and 3581, read for the diagnosis), 3590-3599 every effect at
 # its larger strength and 3630-3649 cross-talk measured with both poolings (the
 # same logs), 3600-3619 clean sets, 3620-3629 the gain wobble
-# (bench/residual_unknown_effect.sh). Next unused: 3650 on.
+# (bench/residual_unknown_effect.sh). Stop 78 (the curve's knots at the
+# pooled quantiles and the whole curve's scale as a search step, neither
+# kept): development stop 77's sensor-curve=0.7 sets 3590-3599; 3650-3689
+# sensor-curve=0.7 measured with the pooled knots and with the current code
+# (the same logs). Next unused: 3690 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...
