@@ -336,7 +336,8 @@
 # pooled quantiles and the whole curve's scale as a search step, neither
 # kept): development stop 77's sensor-curve=0.7 sets 3590-3599; 3650-3689
 # sensor-curve=0.7 measured with the pooled knots and with the current code
-# (the same logs). Next unused: 3690 on.
+# (the same logs); 3690-3699 every effect at its larger strength measured
+# with the current code (3700-3719: clean sets). Next unused: 3720 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -130,8 +130,9 @@
 # 75: 3470-3489 with its final code (a rail's rivals; 0 of 20). Stop 76:
 # 3550-3569 with its final code (a target's source of two fitted
 # together; 0 of 20). Stop 77: 3600-3619 with --decision-pooling logs (0 of 20;
-# the screen proposed nothing, so the default gives the same). Stop 78: no
-# clean sets (no change kept). Next unused seed: 3690
+# the screen proposed nothing, so the default gives the same). Stop 78:
+# 3700-3719 with the current code (0 of 20; no change kept). Next unused
+# seed: 3720
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
