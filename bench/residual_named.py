@@ -12,7 +12,10 @@ bench/residual_detection.sh and bench/residual_two_effects.sh:
   saturation    loadcell upper rails within 10 % of the plant's;
   input-delay   the commands the plant's delay earlier as inputs (lag<d>_u*);
   sensor-curve  curves on loadcells only, the first (the winner's) reading
-                within 25 % of the plant's 50 (L / 50)^E at its highest knot L.
+                within 25 % of the plant's 50 (L / 50)^E at its highest
+                fitted knot L (since stop 79 a curve can end with a knot at
+                the rated top, 50 N, that reads its own level by
+                construction: the datasheet's, not a fit, so not read).
 
 Usable as a module (names(effect, strength, fix)) or run as
 `residual_named.py EFFECT STRENGTH FIX_JSON_FILE` (prints yes or no).
@@ -56,9 +59,14 @@ def names(effect, strength, fix):
         def plant_reading(level):
             return 50.0 * (max(level, 0.0) / 50.0) ** strength
 
-        return (named_effect == "sensor-curve" and bool(curves) and all(c["channel"].startswith("fc") for c in curves)
-                and abs(curves[0]["reading"][-1] - plant_reading(curves[0]["level"][-1]))
-                <= 0.25 * plant_reading(curves[0]["level"][-1]))
+        if not (named_effect == "sensor-curve" and bool(curves) and all(c["channel"].startswith("fc") for c in curves)):
+            return False
+        # the highest fitted knot: a knot at the rated top (50 N, the datasheet's) is not a fit
+        levels, readings = curves[0]["level"], curves[0]["reading"]
+        k = len(levels) - 1
+        while k > 0 and levels[k] >= 50.0 - 1e-9 and readings[k] == levels[k]:
+            k -= 1
+        return abs(readings[k] - plant_reading(levels[k])) <= 0.25 * plant_reading(levels[k])
     raise ValueError("residual_named: no naming rule for effect " + effect)
 
 

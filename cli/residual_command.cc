@@ -240,8 +240,8 @@ int run_residual(int argc, char** argv) {
             "unit");
   opt.repeated("rated-range", "NAME=LOW..HIGH",
                "a sensor's rated range (datasheet) for an output group or channel, e.g. fc=0..50: the predictions\n"
-               "are clipped there as known before anything is searched (a rail there is not an effect); either\n"
-               "bound may be left out (f=0..)");
+               "are clipped there as known before anything is searched (a rail there is not an effect), and a\n"
+               "calibration curve --fix fits ends at HIGH reading HIGH; either bound may be left out (f=0..)");
   opt.value("report", "DIR", "write DIR/REPORT.md with PNG plots (gnuplot) and DIR/residual.json");
   opt.value("json", "FILE", "write every number as JSON");
   opt.flag("fix", "add the winning effect (sensor delay: time alignment, or the commands' dead time when the delay\n"
@@ -475,6 +475,7 @@ int run_residual(int argc, char** argv) {
     const std::string& pb_choice = ao.pb_choice;
     rs::FixOptions fo;
     fo.train_fraction = *fraction;
+    fo.rated_ranges = rated_ranges;
     fo.epochs = static_cast<int>(*fix_epochs);
     fo.lr = *fix_lr;
     fo.seed = static_cast<std::uint64_t>(*fix_seed);

@@ -57,8 +57,11 @@ if richer:
 curves = aug.get("curves", [])
 if curves:
     c = curves[0]
-    level = c["level"][-1]
-    print(f"{c['channel']} reads {c['reading'][-1]:.4g} at {level:.4g} N (the plant: {50 * (level / 50) ** 0.7:.4g})")
+    k = len(c["level"]) - 1  # the highest fitted knot (a knot at the rated top 50 N is not a fit)
+    while k > 0 and c["level"][k] >= 50 and c["reading"][k] == c["level"][k]:
+        k -= 1
+    level = c["level"][k]
+    print(f"{c['channel']} reads {c['reading'][k]:.4g} at {level:.4g} N (the plant: {50 * (level / 50) ** 0.7:.4g})")
 lead_and_loadcells(fix, check)
 finish()
 PY

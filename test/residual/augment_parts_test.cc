@@ -421,6 +421,59 @@ TEST(SensorFrame, TheCurveBendsOneWay) {
   EXPECT_TRUE(non_increasing || non_decreasing) << zigzag[0] << " " << zigzag[1] << " " << zigzag[2] << " " << zigzag[3];
 }
 
+// With a rated top above its knots (CalibrationCurves::rated_top) the
+// curve ends there reading its own level, and the segment up to it keeps
+// the order. A faked probe of the unchanged network whose loss is the
+// squared distance of fc0's readings at its knots 1..4 from a compressive
+// target that dips at the top knot (slopes 2, 1, 0.9, then 0.3: the fit's
+// top segment on a few rows of one grasp's peak, stop 78). Without the
+// rated top the fit follows the dip; with it at 8 the segment from knot 4
+// to 8 may be no steeper than the one before, so the top knot reads at
+// least 8 - 4 s3 (s3 the fitted slope below it) and stays near the body's
+// line, above the unanchored reading.
+TEST(SensorFrame, TheCurveEndsAtTheRatedTopAndKeepsItsOrderThere) {
+  const auto fitted = [](std::optional<double> rated_top, std::string* description) {
+    residual::Augmentation a;
+    a.kind = residual::EffectKind::kSensorCurve;
+    a.channels = {"fc0"};
+    auto& change = a.change.emplace<residual::CalibrationCurves>();
+    change.curves = {{"fc0", {0, 1, 2, 3, 4}, {0, 1, 2, 3, 4}}};
+    change.rated_top = rated_top;
+    const std::vector<double> target = {0, 2, 3, 3.9, 4.2};  // readings at knots 0..4
+    residual::TrainingRmse rmse;
+    rmse.y_names = {"fc0", "l0"};
+    rmse.all = [target](const SensorModel& s) {
+      Eigen::VectorXd e = Eigen::VectorXd::Ones(2);
+      if (const SensorCurve* c = s.curve_of("fc0"))
+        for (std::size_t k = 1; k < target.size(); ++k) e(1) += std::pow(c->reading[k] - target[k], 2);
+      return e;
+    };
+    std::vector<double> rates;
+    change.refine(a, SensorModel{}, rmse, rates);
+    if (description != nullptr) *description = a.description;
+    return change.curves.front();
+  };
+  const SensorCurve free = fitted(std::nullopt, nullptr);
+  ASSERT_EQ(free.level.size(), 5u);
+  EXPECT_LT(free.reading[4], 4.5);  // follows the dip (4.2; the identity reads 4)
+  std::string description;
+  const SensorCurve anchored = fitted(8.0, &description);
+  ASSERT_EQ(anchored.level, (std::vector<double>{0, 1, 2, 3, 4, 8}));
+  EXPECT_EQ(anchored.reading.back(), 8.0);
+  std::vector<double> slopes;
+  for (std::size_t k = 1; k < anchored.level.size(); ++k)
+    slopes.push_back((anchored.reading[k] - anchored.reading[k - 1]) / (anchored.level[k] - anchored.level[k - 1]));
+  for (std::size_t k = 1; k < slopes.size(); ++k) EXPECT_LE(slopes[k], slopes[k - 1] + 1e-9) << k;
+  for (double s : slopes) EXPECT_GE(s, 0.25);  // the search's bound (kMinSlope)
+  // Above the dip: the top segment no steeper than the one below it.
+  EXPECT_GT(anchored.reading[4], free.reading[4] + 0.3);
+  EXPECT_NE(description.find("through the rated top 8"), std::string::npos) << description;
+  // A rated top at or below the top knot is no anchor: the curve as without one.
+  const SensorCurve below = fitted(4.0, nullptr);
+  EXPECT_EQ(below.level, free.level);
+  EXPECT_EQ(below.reading, free.reading);
+}
+
 // A drift re-estimated at rate 0 changes nothing, so it leaves the change,
 // the affected channels and the channels the models are compared on
 // (found_on).

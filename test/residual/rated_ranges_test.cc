@@ -74,5 +74,16 @@ TEST(RatedRange, ANameThatIsNoOutputIsAnError) {
   EXPECT_THROW(with_rated_ranges(build_model(), {parse_rated_range("fc9=0..1")}, nullptr), std::invalid_argument);
 }
 
+// A channel's range (rated_range_of): its own wins over its group's; none
+// for a channel neither names.
+TEST(RatedRange, AChannelsOwnRangeWinsOverItsGroups) {
+  const std::vector<RatedRange> ranges = {parse_rated_range("fc=0..50"), parse_rated_range("fc3=0..20")};
+  ASSERT_NE(rated_range_of(ranges, "fc1"), nullptr);
+  EXPECT_EQ(rated_range_of(ranges, "fc1")->high, 50.0);
+  ASSERT_NE(rated_range_of(ranges, "fc3"), nullptr);
+  EXPECT_EQ(rated_range_of(ranges, "fc3")->high, 20.0);
+  EXPECT_EQ(rated_range_of(ranges, "f1"), nullptr);
+}
+
 }  // namespace
 }  // namespace hadynet::trainer::residual

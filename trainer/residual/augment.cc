@@ -147,6 +147,22 @@ DecisionRows decision_rows(int T, int split, int d) {
   return r;
 }
 
+namespace {
+
+// The curve's channels' common rated top (CalibrationCurves::rated_top):
+// none when one has no rated top or two differ.
+std::optional<double> common_rated_top(const CalibrationCurves& change, const FixOptions& options) {
+  std::optional<double> top;
+  for (const SensorCurve& c : change.curves) {
+    const RatedRange* range = rated_range_of(options.rated_ranges, c.channel);
+    if (range == nullptr || !range->high || (top && *top != *range->high)) return std::nullopt;
+    top = range->high;
+  }
+  return top;
+}
+
+}  // namespace
+
 std::string why_not_fixable(const ResidualData& data, const Attribution& attribution, const HypothesisResult& r) {
   const EffectInfo& info = effect_info(r.hypothesis.kind);
   if (!info.plan) return info.augmentation;
@@ -691,6 +707,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       }
       return Eigen::VectorXd(held_out_error(probe, train, HeldOutDetail::kErrorsOnly).rmse);
     };
+    if (auto* curves = std::get_if<CalibrationCurves>(&a.change)) curves->rated_top = common_rated_top(*curves, options);
     std::vector<double> rates;
     std::visit([&](auto& change) { change.refine(a, model.sensor, training_rmse, rates); }, a.change);
     if (fitted != nullptr) *fitted = std::move(rates);

@@ -33,6 +33,7 @@
 #include "trainer/residual/residuals.h"
 #include "trainer/residual/fine_tune.h"
 #include "trainer/residual/held_out.h"
+#include "trainer/residual/rated_ranges.h"
 #include "trainer/residual/statistics.h"
 #include "trainer/residual/whiteness.h"
 
@@ -118,6 +119,10 @@ Segments standardised_loss(const HadynetModel& model, const HeldOutError& e, con
                            DecisionLoss loss, const ResidualLevels* levels = nullptr);
 
 struct FixOptions {
+  // The sensors' rated ranges (--rated-range): a calibration curve of
+  // channels with one common rated top passes through it
+  // (CalibrationCurves::rated_top).
+  std::vector<RatedRange> rated_ranges;
   double train_fraction = 0.6;  // of each log's rows, from its start: what the reported models are fine-tuned on
   int epochs = 20;              // fine-tuning epochs from the current weights (batch norm frozen)
   int batch = 100;
@@ -314,6 +319,12 @@ struct OutputClips : ModelChange {
 // it.
 struct CalibrationCurves : ModelChange {
   std::vector<SensorCurve> curves;  // one per channel
+  // The channels' common rated top (their --rated-range's HIGH, fix() sets
+  // it; none when a channel has none or they differ): refine() then ends the
+  // curve with a knot there that reads its own level, as a loadcell's
+  // datasheet states its nonlinearity against the straight line through
+  // zero and the rated output.
+  std::optional<double> rated_top;
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;
   void refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
               std::vector<double>& fitted);

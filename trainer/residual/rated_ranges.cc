@@ -34,6 +34,15 @@ RatedRange parse_rated_range(const std::string& text) {
   return r;
 }
 
+const RatedRange* rated_range_of(const std::vector<RatedRange>& ranges, const std::string& channel) {
+  const RatedRange* range = nullptr;
+  for (const RatedRange& r : ranges) {
+    if (r.name == channel) range = &r;
+    else if (!range && r.name == channel_group(channel)) range = &r;
+  }
+  return range;
+}
+
 HadynetModel with_rated_ranges(const HadynetModel& model, const std::vector<RatedRange>& ranges,
                                std::vector<OutputClip>* added) {
   HadynetModel out = model;
@@ -44,12 +53,7 @@ HadynetModel with_rated_ranges(const HadynetModel& model, const std::vector<Rate
     if (!any) throw std::invalid_argument("rated range '" + r.name + "': no output channel or group of that name");
   }
   for (const std::string& channel : names) {
-    // A channel's own range wins over its group's.
-    const RatedRange* range = nullptr;
-    for (const RatedRange& r : ranges) {
-      if (r.name == channel) range = &r;
-      else if (!range && r.name == channel_group(channel)) range = &r;
-    }
+    const RatedRange* range = rated_range_of(ranges, channel);
     if (!range) continue;
     for (const int side : {-1, +1}) {
       const std::optional<double>& bound = side < 0 ? range->low : range->high;

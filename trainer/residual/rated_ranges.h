@@ -24,6 +24,10 @@ struct RatedRange {
 // LOW < HIGH. Throws std::invalid_argument naming the fault.
 RatedRange parse_rated_range(const std::string& text);
 
+// The range of output channel `channel` in `ranges`: its own (NAME the
+// channel) wins over its group's; none when neither is given.
+const RatedRange* rated_range_of(const std::vector<RatedRange>& ranges, const std::string& channel);
+
 // `model` with a clip at each given bound of each channel a range names (a
 // channel's own range wins over its group's), except where the model already
 // clips that side. `added` (optional) receives the clips added. Throws
