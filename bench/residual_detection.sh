@@ -337,7 +337,14 @@
 # kept): development stop 77's sensor-curve=0.7 sets 3590-3599; 3650-3689
 # sensor-curve=0.7 measured with the pooled knots and with the current code
 # (the same logs); 3690-3699 every effect at its larger strength measured
-# with the current code (3700-3719: clean sets). Next unused: 3720 on.
+# with the current code (3700-3719: clean sets). Stop 79 (a calibration
+# curve ends at its channels' rated top, reading it): development stop
+# 77's sensor-curve=0.7 sets 3590-3599 and stop 78's misses of every
+# effect 3692, 3693, 3696, 3698 and 3699 (read for the diagnosis);
+# 3720-3749 sensor-curve=0.7 and 3750-3759 every effect at its larger
+# strength measured with the final code, and stop 78's code re-run on the
+# same logs (3760-3779: clean sets; 3780-3789 the gain wobble; 3790-3794
+# two effects). Next unused: 3795 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...
