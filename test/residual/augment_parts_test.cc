@@ -430,16 +430,19 @@ TEST(SensorFrame, TheCurveBendsOneWay) {
 // rated top the fit follows the dip; with it at 8 the segment from knot 4
 // to 8 may be no steeper than the one before, so the top knot reads at
 // least 8 - 4 s3 (s3 the fitted slope below it) and stays near the body's
-// line, above the unanchored reading.
+// line, above the unanchored reading. A target whose top segment is flat
+// (slope 0.1: a rail's signature, the fit at its slope bound 1/4) keeps
+// the fit without the rated top, whose flat end the rail's simpler
+// account reads (flat_at_end).
 TEST(SensorFrame, TheCurveEndsAtTheRatedTopAndKeepsItsOrderThere) {
-  const auto fitted = [](std::optional<double> rated_top, std::string* description) {
+  const auto fitted = [](std::optional<double> rated_top, std::string* description, double top_target = 4.2) {
     residual::Augmentation a;
     a.kind = residual::EffectKind::kSensorCurve;
     a.channels = {"fc0"};
     auto& change = a.change.emplace<residual::CalibrationCurves>();
     change.curves = {{"fc0", {0, 1, 2, 3, 4}, {0, 1, 2, 3, 4}}};
     change.rated_top = rated_top;
-    const std::vector<double> target = {0, 2, 3, 3.9, 4.2};  // readings at knots 0..4
+    const std::vector<double> target = {0, 2, 3, 3.9, top_target};  // readings at knots 0..4
     residual::TrainingRmse rmse;
     rmse.y_names = {"fc0", "l0"};
     rmse.all = [target](const SensorModel& s) {
@@ -472,6 +475,11 @@ TEST(SensorFrame, TheCurveEndsAtTheRatedTopAndKeepsItsOrderThere) {
   const SensorCurve below = fitted(4.0, nullptr);
   EXPECT_EQ(below.level, free.level);
   EXPECT_EQ(below.reading, free.reading);
+  // A flat top: the fit without the rated top, ending at the slope bound.
+  const SensorCurve flat = fitted(8.0, &description, 4.0);
+  ASSERT_EQ(flat.level.size(), 5u);
+  EXPECT_TRUE(residual::CalibrationCurves::flat_at_end(flat, +1));
+  EXPECT_EQ(description.find("rated top"), std::string::npos) << description;
 }
 
 // A drift re-estimated at rate 0 changes nothing, so it leaves the change,

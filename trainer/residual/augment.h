@@ -323,7 +323,8 @@ struct CalibrationCurves : ModelChange {
   // it; none when a channel has none or they differ): refine() then ends the
   // curve with a knot there that reads its own level, as a loadcell's
   // datasheet states its nonlinearity against the straight line through
-  // zero and the rated output.
+  // zero and the rated output, unless the curve without it ends flat
+  // (flat_at_end: a rail's signature).
   std::optional<double> rated_top;
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;
   void refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,

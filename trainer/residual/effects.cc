@@ -1084,15 +1084,19 @@ bool CalibrationCurves::flat_at_end(const SensorCurve& curve, int side) {
 // 1-step predictor of a slow loadcell); what the network predicts of every
 // other channel from that level shows the distortion. `fitted` is left as
 // it is: the search starts from the identity, not from a fitted parameter.
-// With a rated top above the channels' levels (rated_top) the curve ends
-// with a knot there that reads its own level: the segment up to it is not
-// searched but follows from the others, and must keep the bounds and the
-// order too. A loadcell's datasheet states its nonlinearity against the
-// straight line through zero and its rated output, and without that end
-// the fit's top segment, which rests on a few rows of one grasp's peak,
-// dipped below the body of the curve (stop 78: 0.72 of the plant's curve
-// at the top knot where the body read 0.81; docs/residual.md, "The curve
-// through its rated top (stop 79)").
+// With a rated top above the channels' levels (rated_top) the curve is
+// fitted again ending with a knot there that reads its own level: the
+// segment up to it is not searched but follows from the others, and must
+// keep the bounds and the order too. A loadcell's datasheet states its
+// nonlinearity against the straight line through zero and its rated
+// output, and without that end the fit's top segment, which rests on a few
+// rows of one grasp's peak, dipped below the body of the curve (stop 78:
+// 0.72 of the plant's curve at the top knot where the body read 0.81;
+// docs/residual.md, "The curve through its rated top (stop 79)"). Not
+// when the fit without it ends flat (flat_at_end): a rail's signature,
+// which the rail's simpler account reads, and which the rated top would
+// hide (a 2 N rail under a 50 N rated top: stop 79's fresh sets 3750 and
+// 3751).
 void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
                                std::vector<double>&) {
   if (curves.empty()) return;
@@ -1107,17 +1111,10 @@ void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const
   const double min_gap = 1e-4 * (union_levels.back() - union_levels.front());
   std::vector<double> knots;
   for (double v : union_levels) sensor_curve::push_distinct_knot(knots, v, min_gap);
-  // The rated top as the curve's last knot, reading its own level
-  // (CalibrationCurves::rated_top), when it lies above the channels' levels.
-  const std::optional<double> top =
-      rated_top && *rated_top > knots.back() + min_gap ? rated_top : std::optional<double>();
-  if (top) knots.push_back(*top);
-  for (SensorCurve& c : curves) {  // reading[0] stays at the lowest knot: the curve's anchor
-    c.level = knots;
-    c.reading = knots;
-  }
-  const std::size_t searched = knots.size() - 1 - (top ? 1 : 0);  // the anchored last segment is not searched
-  std::vector<double> slopes(searched, 1.0);  // the identity
+  const std::vector<double> data_knots = knots;
+  std::optional<double> top;  // the fit's rated top, when it has one: its last knot, reading its own level
+  std::size_t searched = 0;   // the segments searched (the last one follows from the rated top)
+  std::vector<double> slopes;
   const auto set_slopes = [&] {
     for (SensorCurve& c : curves) {
       for (std::size_t k = 1; k <= searched; ++k)
@@ -1129,8 +1126,12 @@ void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const
     const std::size_t n = knots.size();
     return (curves.front().reading[n - 1] - curves.front().reading[n - 2]) / (knots[n - 1] - knots[n - 2]);
   };
-  set_slopes();
   const auto loss = [&] { return (training_rmse.all(sensor_after(before, a)).array() / rmse_before).square().sum(); };
+  // The identity (with or without the rated top: it reads every level as it is).
+  for (SensorCurve& c : curves) {
+    c.level = knots;
+    c.reading = knots;
+  }
   const double at_identity = loss();  // each search's start: one probe of the network, not two
   // One search from the identity with the segment slopes kept in order:
   // `shape` -1 non-increasing (a compressive curve, concave), +1
@@ -1171,13 +1172,32 @@ void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const
     }
     return best;
   };
-  const double compressive = search(-1);
-  const std::vector<double> compressive_slopes = slopes;
-  const double expansive = search(+1);
-  if (compressive <= expansive) {
-    slopes = compressive_slopes;
-    set_slopes();
-  }
+  // The curve on the channels' knots, ending at `rated` when given: both
+  // shapes searched, the lower loss kept.
+  const auto fit = [&](std::optional<double> rated) {
+    top = rated;
+    knots = data_knots;
+    if (top) knots.push_back(*top);
+    for (SensorCurve& c : curves) {  // reading[0] stays at the lowest knot: the curve's anchor
+      c.level = knots;
+      c.reading = knots;
+    }
+    searched = knots.size() - 1 - (top ? 1 : 0);
+    slopes.assign(searched, 1.0);  // the identity
+    const double compressive = search(-1);
+    const std::vector<double> compressive_slopes = slopes;
+    const double expansive = search(+1);
+    if (compressive <= expansive) {
+      slopes = compressive_slopes;
+      set_slopes();
+    }
+  };
+  fit(std::nullopt);
+  // The rated top, when it lies above the channels' levels and the fit
+  // without it does not end flat there (a rail's signature, left to the
+  // rail: flat_at_end).
+  const bool flat_top = slopes.back() * sensor_curve::kFinestStepDown < kMinSlope;
+  if (rated_top && *rated_top > data_knots.back() + min_gap && !flat_top) fit(rated_top);
   const std::size_t n = knots.size() - (top ? 1 : 0);  // the top knot fitted
   const char* shape = slopes.front() > slopes.back()   ? "compressive"
                       : slopes.front() < slopes.back() ? "expansive"
