@@ -342,9 +342,14 @@
 # 77's sensor-curve=0.7 sets 3590-3599 and stop 78's misses of every
 # effect 3692, 3693, 3696, 3698 and 3699 (read for the diagnosis);
 # 3720-3749 sensor-curve=0.7 and 3750-3759 every effect at its larger
-# strength measured with the final code, and stop 78's code re-run on the
-# same logs (3760-3779: clean sets; 3780-3789 the gain wobble; 3790-3794
-# two effects). Next unused: 3795 on.
+# strength measured with the rule's first version, and stop 78's code
+# re-run on the same logs (3760-3779: clean sets; 3780-3794 started and
+# stopped); the saturation=2 sets 3750 and 3751 then development of the
+# flat-top exception; 3795-3824 sensor-curve=0.7, 3825-3834 every effect
+# at its larger strength and 3835-3844 saturation=2 measured with the
+# final code, and stop 78's code re-run on the same logs (3845-3864: clean
+# sets; 3865-3874 the gain wobble; 3875-3879 two effects). Next unused:
+# 3880 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

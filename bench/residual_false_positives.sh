@@ -132,8 +132,9 @@
 # together; 0 of 20). Stop 77: 3600-3619 with --decision-pooling logs (0 of 20;
 # the screen proposed nothing, so the default gives the same). Stop 78:
 # 3700-3719 with the current code (0 of 20; no change kept). Stop 79:
-# 3760-3779 with its final code (a curve ends at its channels' rated top).
-# Next unused seed: 3795
+# 3760-3779 with the first version of a curve that ends at its channels'
+# rated top, 3845-3864 with the final code (0 of 20 each). Next unused
+# seed: 3880
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

@@ -46,8 +46,9 @@
 # pairs, the squared loss; 0 of 10 confirmed); 2270-2279 (stop 61: the
 # residual's unit in the held-out tests); 2355-2364 (stop 62: a cross-talk
 # between groups a candidate of its own); 3620-3629 (stop 77,
-# --decision-pooling logs: 0 of 10 confirmed); 3780-3789 (stop 79, a curve
-# ends at its channels' rated top).
+# --decision-pooling logs: 0 of 10 confirmed); 3865-3874 (stop 79, a curve
+# ends at its channels' rated top: 0 of 10 confirmed; 3780-3789 started
+# with the rule's first version and stopped).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R]

@@ -1196,8 +1196,7 @@ void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const
   // The rated top, when it lies above the channels' levels and the fit
   // without it does not end flat there (a rail's signature, left to the
   // rail: flat_at_end).
-  const bool flat_top = slopes.back() * sensor_curve::kFinestStepDown < kMinSlope;
-  if (rated_top && *rated_top > data_knots.back() + min_gap && !flat_top) fit(rated_top);
+  if (rated_top && *rated_top > data_knots.back() + min_gap && !flat_at_end(curves.front(), +1)) fit(rated_top);
   const std::size_t n = knots.size() - (top ? 1 : 0);  // the top knot fitted
   const char* shape = slopes.front() > slopes.back()   ? "compressive"
                       : slopes.front() < slopes.back() ? "expansive"
