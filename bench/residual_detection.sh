@@ -343,8 +343,8 @@
 # effect 3692, 3693, 3696, 3698 and 3699 (read for the diagnosis);
 # 3720-3749 sensor-curve=0.7 and 3750-3759 every effect at its larger
 # strength measured with the rule's first version, and stop 78's code
-# re-run on the same logs (3760-3779: clean sets; 3780-3794 started and
-# stopped); the saturation=2 sets 3750 and 3751 then development of the
+# re-run on the same logs (3760-3779: clean sets; 3780-3789 the gain
+# wobble; 3790-3794 two effects, stopped); the saturation=2 sets 3750 and 3751 then development of the
 # flat-top exception; 3795-3824 sensor-curve=0.7, 3825-3834 every effect
 # at its larger strength and 3835-3844 saturation=2 measured with the
 # final code, and stop 78's code re-run on the same logs (3845-3864: clean
