@@ -348,8 +348,8 @@
 # flat-top exception; 3795-3824 sensor-curve=0.7, 3825-3834 every effect
 # at its larger strength and 3835-3844 saturation=2 measured with the
 # final code, and stop 78's code re-run on the same logs (3845-3864: clean
-# sets; 3865-3874 the gain wobble; 3875-3879 two effects). Next unused:
-# 3880 on.
+# sets; 3865-3874 the gain wobble; 3875-3879 two effects); 3880-3899
+# sensor-curve=0.7 measured the same way. Next unused: 3900 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...
