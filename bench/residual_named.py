@@ -27,6 +27,17 @@ import sys
 PLANT_CROSSTALK_PAIRS = {("fc0", "fc1"), ("fc1", "fc2"), ("fc2", "fc3"), ("fc3", "fc4"), ("fc4", "fc3")}
 
 
+def top_fitted_knot(curve, rated_top=50.0):
+    """The index of a curve's highest fitted knot (a JSON curve: level,
+    reading): a last knot at the loadcells' rated top (50 N) that reads its
+    own level is the datasheet's, not a fit (CalibrationCurves::rated_top)."""
+    levels, readings = curve["level"], curve["reading"]
+    k = len(levels) - 1
+    while k > 0 and levels[k] >= rated_top - 1e-9 and readings[k] == levels[k]:
+        k -= 1
+    return k
+
+
 def names(effect, strength, fix):
     """True when the fix's augmentation (confirmed or not) has the plant
     effect `effect` at `strength` with the right parameter."""
@@ -61,12 +72,9 @@ def names(effect, strength, fix):
 
         if not (named_effect == "sensor-curve" and bool(curves) and all(c["channel"].startswith("fc") for c in curves)):
             return False
-        # the highest fitted knot: a knot at the rated top (50 N, the datasheet's) is not a fit
-        levels, readings = curves[0]["level"], curves[0]["reading"]
-        k = len(levels) - 1
-        while k > 0 and levels[k] >= 50.0 - 1e-9 and readings[k] == levels[k]:
-            k -= 1
-        return abs(readings[k] - plant_reading(levels[k])) <= 0.25 * plant_reading(levels[k])
+        k = top_fitted_knot(curves[0])
+        level, reading = curves[0]["level"][k], curves[0]["reading"][k]
+        return abs(reading - plant_reading(level)) <= 0.25 * plant_reading(level)
     raise ValueError("residual_named: no naming rule for effect " + effect)
 
 

@@ -36,7 +36,7 @@ grep -E "^Richer" "$work/out.txt" | sed -E "s/l0, l1, [^:(]*th1/every channel/g"
 python3 - "$work/residual.json" "$here/bench" "$here/test/cli" <<'PY'
 import sys
 sys.path[:0] = sys.argv[2:4]
-from residual_named import names
+from residual_named import names, top_fitted_knot
 from plant_fix_checks import checked_fix, lead_and_loadcells
 fix, aug, check, finish = checked_fix(sys.argv[1])
 check(bool(fix.get("changed")), "nothing confirmed: " + fix.get("status", "")[:120])
@@ -57,9 +57,7 @@ if richer:
 curves = aug.get("curves", [])
 if curves:
     c = curves[0]
-    k = len(c["level"]) - 1  # the highest fitted knot (a knot at the rated top 50 N is not a fit)
-    while k > 0 and c["level"][k] >= 50 and c["reading"][k] == c["level"][k]:
-        k -= 1
+    k = top_fitted_knot(c)
     level = c["level"][k]
     print(f"{c['channel']} reads {c['reading'][k]:.4g} at {level:.4g} N (the plant: {50 * (level / 50) ** 0.7:.4g})")
 lead_and_loadcells(fix, check)
