@@ -362,6 +362,44 @@ TEST(SensorFrame, ThePlansCurvesAreFittedAsOneOnTheUnionOfTheirKnots) {
   EXPECT_NE(a.description.find("one curve, 5 knots"), std::string::npos) << a.description;
 }
 
+// The curve's criterion is the unchanged network's error over windows of
+// its N_train steps when the probe has it (TrainingRmse::windows), not its
+// 1-step error: a faked probe whose 1-step error is least at the identity
+// and whose windows' error is least at slope 2 gives a curve reading twice
+// the level with the windows and the identity without them.
+TEST(SensorFrame, TheCurveIsFittedOnTheWindowsError) {
+  const auto fitted_readings = [](bool with_windows) {
+    residual::Augmentation a;
+    a.kind = residual::EffectKind::kSensorCurve;
+    a.channels = {"fc0"};
+    auto& change = a.change.emplace<residual::CalibrationCurves>();
+    change.curves = {{"fc0", {0, 1, 2}, {0, 1, 2}}};
+    // 1 + the squared distance of fc0's readings at its knots from `scale` times the level.
+    const auto error_least_at = [](double scale) {
+      return [scale](const SensorModel& s) {
+        Eigen::VectorXd e = Eigen::VectorXd::Ones(2);
+        if (const SensorCurve* c = s.curve_of("fc0"))
+          for (std::size_t k = 0; k < c->level.size(); ++k) e(1) += std::pow(c->reading[k] - scale * c->level[k], 2);
+        return e;
+      };
+    };
+    residual::TrainingRmse rmse;
+    rmse.y_names = {"fc0", "l0"};
+    rmse.all = error_least_at(1);
+    if (with_windows) rmse.windows = error_least_at(2);
+    std::vector<double> fitted;
+    change.refine(a, SensorModel{}, rmse, fitted);
+    return change.curves.front().reading;
+  };
+  const std::vector<double> windows = fitted_readings(true), one_step = fitted_readings(false);
+  ASSERT_EQ(windows.size(), 3u);
+  ASSERT_EQ(one_step.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_NEAR(windows[k], 2.0 * static_cast<double>(k), 1e-12) << k;
+    EXPECT_NEAR(one_step[k], static_cast<double>(k), 1e-12) << k;
+  }
+}
+
 // The curve bends one way (CalibrationCurves::refine): its segment slopes
 // are fitted non-increasing (compressive) and non-decreasing (expansive),
 // and the lower loss is kept. A faked probe of the unchanged network whose

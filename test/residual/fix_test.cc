@@ -357,13 +357,10 @@ TEST(ResidualFix, TheUntunedChangeFineTunedIsTheFixedModel) {
   EXPECT_FALSE(trainer::testing::bit_identical(first.fix.untuned.params, first.fix.model.params));
 }
 
-// held_out_error's two details (HeldOutDetail): the probes' errors alone
-// are the report's errors, bit for bit (the probes decide on them), and only
-// the report's carry the diagnostics. The rows: the last 40 % of each log.
-TEST(HeldOutError, ErrorsAloneAreTheReportsErrors) {
-  const trainer::HadynetModel& model = build_model();
-  const std::vector<LogInput> logs = plant_logs("sensor-delay");
-  const ResidualData data = compute_residuals(model, logs, "auto");
+// The last 40 % of each log's rows for held_out_error and window_rmse, fed
+// to `model` in its frame with the PBs of `data`'s analysis.
+std::vector<HeldOutLog> last_rows(const trainer::HadynetModel& model, const std::vector<LogInput>& logs,
+                                  const ResidualData& data) {
   std::vector<HeldOutLog> rows;
   for (std::size_t i = 0; i < logs.size(); ++i) {
     HeldOutLog e;
@@ -375,6 +372,16 @@ TEST(HeldOutError, ErrorsAloneAreTheReportsErrors) {
     e.first = e.end - e.end * 2 / 5;
     rows.push_back(std::move(e));
   }
+  return rows;
+}
+
+// held_out_error's two details (HeldOutDetail): the probes' errors alone
+// are the report's errors, bit for bit (the probes decide on them), and only
+// the report's carry the diagnostics. The rows: the last 40 % of each log.
+TEST(HeldOutError, ErrorsAloneAreTheReportsErrors) {
+  const trainer::HadynetModel& model = build_model();
+  const std::vector<LogInput> logs = plant_logs("sensor-delay");
+  const std::vector<HeldOutLog> rows = last_rows(model, logs, compute_residuals(model, logs, "auto"));
   const HeldOutError full = held_out_error(model, rows);
   const HeldOutError errors = held_out_error(model, rows, HeldOutDetail::kErrorsOnly);
   ASSERT_EQ(full.channels, errors.channels);
@@ -389,6 +396,51 @@ TEST(HeldOutError, ErrorsAloneAreTheReportsErrors) {
   EXPECT_EQ(full.inputs_outside.size(), full.channels.size());
   EXPECT_TRUE(errors.whiteness.empty());
   EXPECT_TRUE(errors.inputs_outside.empty());
+}
+
+// window_rmse (the curve's criterion, CalibrationCurves::refine): with one
+// step it is held_out_error's 1-step error; with N steps every row is
+// predicted once, by the window of N steps that holds it, run open loop from
+// the frame row before the window: the same as picking those windows out of
+// predict_windows() (every window of N steps) and reading each channel
+// through the model's curve. The rows: the last 40 % of each plant log with
+// a curve on fc1, fed through a model with a curve on fc1. Tolerance 1e-5
+// relative: both paths run the network in float, in batches of other sizes.
+TEST(WindowRmse, OneStepIsTheHeldOutErrorAndLongerWindowsRunOpenLoopThroughTheCurve) {
+  trainer::HadynetModel model = build_model();
+  model.sensor.curves = {{"fc1", {0, 2, 50}, {0, 4, 50}}};
+  const std::vector<LogInput> logs = plant_logs("sensor-curve");
+  const std::vector<HeldOutLog> rows = last_rows(model, logs, compute_residuals(build_model(), logs, "auto"));
+  const auto ny = static_cast<Eigen::Index>(model.layout.y_names.size());
+  const Eigen::Index fc1 = std::find(model.layout.y_names.begin(), model.layout.y_names.end(), "fc1") -
+                           model.layout.y_names.begin();
+  ASSERT_LT(fc1, ny);
+  const auto near = [](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    ASSERT_EQ(a.size(), b.size());
+    for (Eigen::Index c = 0; c < a.size(); ++c) EXPECT_NEAR(a(c), b(c), 1e-5 * b(c)) << c;
+  };
+  near(window_rmse(model, rows, 1), held_out_error(model, rows, HeldOutDetail::kErrorsOnly).rmse);
+
+  const int steps = model.train_steps;
+  ASSERT_GT(steps, 1);
+  Eigen::VectorXd sum_ee = Eigen::VectorXd::Zero(ny);
+  long count = 0;
+  for (const HeldOutLog& log : rows) {
+    // Column k * B + b of predict_windows: window b's prediction of row b + 2 + k.
+    const Eigen::MatrixXd p = predict_windows(model, log.frame, log.pb, steps);
+    const Eigen::Index B = p.cols() / steps;
+    for (int b = log.first - 2; b < B; b += steps)
+      for (int k = 0; k < steps && b + 2 + k < log.end; ++k) {
+        Eigen::VectorXd v = p.col(k * B + b);
+        v(fc1) = trainer::curve_reading(model.sensor.curves.front(), v(fc1));
+        sum_ee += (log.measured.y.col(b + 2 + k) - v).array().square().matrix();
+        ++count;
+      }
+  }
+  ASSERT_GT(count, 0);
+  const Eigen::VectorXd windows = window_rmse(model, rows, steps);
+  near(windows, (sum_ee / static_cast<double>(count)).cwiseSqrt());
+  EXPECT_THROW(window_rmse(model, rows, 0), std::logic_error);
 }
 
 // The null is read through the sensors it was recorded with

@@ -698,14 +698,23 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   auto refined = [&](Augmentation a, const RowSpan& rows, std::vector<double>* fitted) {
     TrainingRmse training_rmse;
     training_rmse.y_names = model.layout.y_names;
-    training_rmse.all = [&](const SensorModel& sensor) {
+    // The rows of `rows`, fed to the unchanged network with `sensor`.
+    const auto training_logs = [&](const SensorModel& sensor) {
       probe.sensor = sensor;
       std::vector<HeldOutLog> train = eval_logs(probe, before_pbs);
       for (std::size_t i = 0; i < train.size(); ++i) {
         train[i].first = std::max(rows[i].from, ResidualLog::kFirstRow + d);
         train[i].end = std::min(rows[i].to, train[i].measured.steps() - d);
       }
+      return train;
+    };
+    training_rmse.all = [&](const SensorModel& sensor) {
+      const std::vector<HeldOutLog> train = training_logs(sensor);
       return Eigen::VectorXd(held_out_error(probe, train, HeldOutDetail::kErrorsOnly).rmse);
+    };
+    training_rmse.windows = [&](const SensorModel& sensor) {
+      const std::vector<HeldOutLog> train = training_logs(sensor);
+      return window_rmse(probe, train, model.train_steps);
     };
     if (auto* curves = std::get_if<CalibrationCurves>(&a.change)) curves->rated_top = common_rated_top(*curves, options);
     std::vector<double> rates;

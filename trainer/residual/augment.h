@@ -223,8 +223,12 @@ struct Augmentation;
 // fix()'s probe for refine(): the unchanged network's 1-step RMSE (physical
 // units) on the training rows, in the measured frame, with sensor model
 // `sensor`: of every y channel (`all`, in y_names' order) or of one.
+// `windows`: the same rows' RMSE over windows of the model's N_train steps
+// (window_rmse: the loss the network was trained on), in all()'s order;
+// empty where the probe has none (CalibrationCurves::refine then uses all()).
 struct TrainingRmse {
   std::function<Eigen::VectorXd(const SensorModel& sensor)> all;
+  std::function<Eigen::VectorXd(const SensorModel& sensor)> windows;
   std::vector<std::string> y_names;
   double operator()(const SensorModel& sensor, const std::string& channel) const;
   // The element of all()'s result that is `channel` (std::logic_error if none).

@@ -5,6 +5,10 @@
 #include <limits>
 #include <stdexcept>
 
+#include "trainer/hadynet_network.h"
+#include "trainer/output_clip.h"
+#include "trainer/window_dataset.h"
+
 namespace hadynet::trainer::residual {
 
 namespace {
@@ -86,7 +90,81 @@ Eigen::MatrixXd measured_predictions(const HadynetModel& model, const LogSequenc
   return out;
 }
 
+// The predictions of frame rows s + 1 .. s + steps of `frame` (y x steps,
+// physical units, the output clips applied) by the window whose initial
+// state is frame row s, for every s in `starts` (one block of `steps`
+// columns each, in that order).
+Eigen::MatrixXd predict_from(const HadynetModel& model, const LogSequence& frame, const Eigen::VectorXf& pb,
+                             const std::vector<int>& starts, int steps) {
+  const WindowDataset data({frame}, {0}, model.layout, model.norm, steps);
+  std::vector<int> ids;  // window b starts from frame row b + 1
+  for (int s : starts) ids.push_back(s - 1);
+  const auto count = static_cast<Eigen::Index>(ids.size());
+  WindowBatch<float> batch;
+  Matrix<float> target;
+  data.gather(ids, batch, target);
+  batch.pb = pb.replicate(1, count);
+  HadynetNetwork<float> net;
+  const Eigen::MatrixXd step_major = net.forward(model.params, batch, BnMode::kEval).cast<double>();
+  Eigen::MatrixXd y(step_major.rows(), step_major.cols());  // column i * steps + k: window i, step k
+  for (Eigen::Index i = 0; i < count; ++i)
+    for (int k = 0; k < steps; ++k) y.col(i * steps + k) = step_major.col(k * count + i);
+  y = (y.array().colwise() * model.norm.y.std.array()).colwise() + model.norm.y.mean.array();
+  apply_output_clips(model, y);
+  return y;
+}
+
 }  // namespace
+
+Eigen::VectorXd window_rmse(const HadynetModel& model, const std::vector<HeldOutLog>& logs, int steps) {
+  if (steps < 1) throw std::logic_error("window_rmse: steps must be >= 1");
+  const OutputMap map = output_map(model);
+  const auto ny = static_cast<Eigen::Index>(model.layout.y_names.size());
+  Eigen::VectorXd sum_ee = Eigen::VectorXd::Zero(ny);
+  Eigen::VectorXd rows = Eigen::VectorXd::Zero(ny);
+  for (const auto& log : logs) {
+    // Initial states first - 1 - D, every `steps` rows, while a window holds a
+    // row before `end` (frame row s >= 1: the first window's x row is 1).
+    std::vector<int> starts;
+    const int last_start = std::min(log.end - 1, log.frame.steps() - 1 - steps);
+    for (int s = std::max(1, log.first - 1 - map.d); s <= last_start; s += steps) starts.push_back(s);
+    if (starts.empty()) continue;
+    const Eigen::MatrixXd p = predict_from(model, log.frame, log.pb, starts, steps);
+    const double dt = log_dt(log.raw->table, log.raw->file);
+    std::vector<std::vector<double>> drivers;
+    for (const auto& [c, drift] : map.drifts) drivers.push_back(drift_driver(log.raw->table, log.raw->file, drift));
+    // The window's prediction of frame row r for channel c, NaN outside it.
+    const auto predicted = [&](std::size_t i, Eigen::Index c, int r) {
+      const int k = r - starts[i] - 1;
+      return k >= 0 && k < steps ? p(c, static_cast<Eigen::Index>(i) * steps + k) : std::nan("");
+    };
+    for (std::size_t i = 0; i < starts.size(); ++i) {
+      for (int t = std::max(log.first, starts[i] + 1); t < log.end && t <= starts[i] + steps + map.d; ++t) {
+        Eigen::VectorXd v(ny);
+        for (Eigen::Index c = 0; c < ny; ++c) v(c) = predicted(i, c, t - map.delay[static_cast<std::size_t>(c)]);
+        for (const auto& [c, curve] : map.curves)
+          if (!std::isnan(v(c))) v(c) = curve_reading(curve, v(c));
+        for (const auto& x : map.crosstalk) v(x.target) += x.gain * predicted(i, x.source, t);
+        for (std::size_t j = 0; j < map.drifts.size(); ++j) {
+          const auto& [c, drift] = map.drifts[j];
+          if (std::isnan(v(c))) continue;
+          const double increment = drift.load ? std::abs(v(c)) * dt : dt;
+          v(c) += drift.rate * (drivers[j][static_cast<std::size_t>(t - 1)] + increment);
+        }
+        for (const auto& [c, clip] : map.clips)
+          if (clip.side > 0 ? v(c) > clip.rail : v(c) < clip.rail) v(c) = clip.rail;
+        for (Eigen::Index c = 0; c < ny; ++c) {
+          if (std::isnan(v(c))) continue;
+          const double r = log.measured.y(c, t) - v(c);
+          sum_ee(c) += r * r;
+          rows(c) += 1;
+        }
+      }
+    }
+  }
+  if ((rows.array() == 0).any()) throw std::logic_error("window_rmse: a channel has no row in a window");
+  return (sum_ee.array() / rows.array()).sqrt().matrix();
+}
 
 HeldOutError held_out_error(const HadynetModel& model, const std::vector<HeldOutLog>& logs, HeldOutDetail detail) {
   const OutputMap map = output_map(model);

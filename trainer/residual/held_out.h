@@ -57,4 +57,20 @@ enum class HeldOutDetail { kWithDiagnostics, kErrorsOnly };
 HeldOutError held_out_error(const HadynetModel& model, const std::vector<HeldOutLog>& logs,
                             HeldOutDetail detail = HeldOutDetail::kWithDiagnostics);
 
+// A model's RMSE per y channel (physical units, in the measured frame) over
+// windows of `steps` steps: the rows [first, end) of each log are cut into
+// consecutive windows, each run open loop from its initial state (the
+// measured frame row before it) with the logged commands, so every row is
+// predicted once, at a horizon of 1..steps. With `steps` the model's
+// N_train (HadynetModel::train_steps) this is the loss it was trained on,
+// in the measured frame. The sensor model maps the predictions as in
+// held_out_error: channel c's measured row t is the window's prediction of
+// frame row t - delay_c, read through its curve; cross-talk adds gain times
+// the source's prediction of frame row t from the same window; a drift adds
+// the bias known at t - 1 plus its increment from the prediction; the rails
+// clip. A row whose frame rows fall outside every window (the first
+// delay_c rows, the last rows short of a window) is left out. Throws
+// std::logic_error if `steps` < 1 or a channel has no row.
+Eigen::VectorXd window_rmse(const HadynetModel& model, const std::vector<HeldOutLog>& logs, int steps);
+
 }  // namespace hadynet::trainer::residual
