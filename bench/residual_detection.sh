@@ -349,7 +349,13 @@
 # at its larger strength and 3835-3844 saturation=2 measured with the
 # final code, and stop 78's code re-run on the same logs (3845-3864: clean
 # sets; 3865-3874 the gain wobble; 3875-3879 two effects); 3880-3899
-# sensor-curve=0.7 measured the same way. Next unused: 3900 on.
+# sensor-curve=0.7 measured the same way. Stop 80 (the curve fitted on the
+# network's error over windows of its N_train steps): development stop
+# 79's sensor-curve=0.7 sets 3795-3824 and 3880-3899; 3900-3929
+# sensor-curve=0.7 and 3930-3939 every effect at its larger strength
+# measured with the final code, and stop 79's code re-run on the same logs
+# (3940-3959: clean sets; 3960-3969 the gain wobble; 3970-3974 two
+# effects). Next unused: 3975 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -133,8 +133,9 @@
 # the screen proposed nothing, so the default gives the same). Stop 78:
 # 3700-3719 with the current code (0 of 20; no change kept). Stop 79:
 # 3760-3779 with the first version of a curve that ends at its channels'
-# rated top, 3845-3864 with the final code (0 of 20 each). Next unused
-# seed: 3900
+# rated top, 3845-3864 with the final code (0 of 20 each). Stop 80:
+# 3940-3959 with the curve fitted over windows of N_train steps (0 of 20).
+# Next unused seed: 3975
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

@@ -56,7 +56,9 @@
 # 65 (the drift probe's place and level): 2525-2529 measured with its
 # final code. Stop 79 (a curve ends at its channels' rated top):
 # 3875-3879 measured with its final code (--candidates 5; 3790-3794
-# started with the rule's first version and stopped).
+# started with the rule's first version and stopped). Stop 80 (the curve
+# fitted over windows of N_train steps): 3970-3974 measured with its final
+# code (--candidates 5).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]... [--decision-loss L] [--decision-scale S] [--fix-selection R]
