@@ -5,10 +5,6 @@
 #include <limits>
 #include <stdexcept>
 
-#include "trainer/hadynet_network.h"
-#include "trainer/output_clip.h"
-#include "trainer/window_dataset.h"
-
 namespace hadynet::trainer::residual {
 
 namespace {
@@ -90,30 +86,6 @@ Eigen::MatrixXd measured_predictions(const HadynetModel& model, const LogSequenc
   return out;
 }
 
-// The predictions of frame rows s + 1 .. s + steps of `frame` (y x steps,
-// physical units, the output clips applied) by the window whose initial
-// state is frame row s, for every s in `starts` (one block of `steps`
-// columns each, in that order).
-Eigen::MatrixXd predict_from(const HadynetModel& model, const LogSequence& frame, const Eigen::VectorXf& pb,
-                             const std::vector<int>& starts, int steps) {
-  const WindowDataset data({frame}, {0}, model.layout, model.norm, steps);
-  std::vector<int> ids;  // window b starts from frame row b + 1
-  for (int s : starts) ids.push_back(s - 1);
-  const auto count = static_cast<Eigen::Index>(ids.size());
-  WindowBatch<float> batch;
-  Matrix<float> target;
-  data.gather(ids, batch, target);
-  batch.pb = pb.replicate(1, count);
-  HadynetNetwork<float> net;
-  const Eigen::MatrixXd step_major = net.forward(model.params, batch, BnMode::kEval).cast<double>();
-  Eigen::MatrixXd y(step_major.rows(), step_major.cols());  // column i * steps + k: window i, step k
-  for (Eigen::Index i = 0; i < count; ++i)
-    for (int k = 0; k < steps; ++k) y.col(i * steps + k) = step_major.col(k * count + i);
-  y = (y.array().colwise() * model.norm.y.std.array()).colwise() + model.norm.y.mean.array();
-  apply_output_clips(model, y);
-  return y;
-}
-
 }  // namespace
 
 Eigen::VectorXd window_rmse(const HadynetModel& model, const std::vector<HeldOutLog>& logs, int steps) {
@@ -129,7 +101,7 @@ Eigen::VectorXd window_rmse(const HadynetModel& model, const std::vector<HeldOut
     const int last_start = std::min(log.end - 1, log.frame.steps() - 1 - steps);
     for (int s = std::max(1, log.first - 1 - map.d); s <= last_start; s += steps) starts.push_back(s);
     if (starts.empty()) continue;
-    const Eigen::MatrixXd p = predict_from(model, log.frame, log.pb, starts, steps);
+    const Eigen::MatrixXd p = predict_windows_from(model, log.frame, log.pb, steps, starts);
     const double dt = log_dt(log.raw->table, log.raw->file);
     std::vector<std::vector<double>> drivers;
     for (const auto& [c, drift] : map.drifts) drivers.push_back(drift_driver(log.raw->table, log.raw->file, drift));

@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <span>
 #include <stdexcept>
 
 #include "datalog/robot_profile.h"
@@ -117,21 +118,27 @@ namespace {
 // with windows x steps; 40 000 windows of 50 steps at once took 8 GB).
 constexpr int kWindowChunk = 256;
 
-// Predictions of windows [first, first + count) of `data`, laid out as
-// predict_windows() documents for `count` windows. `net` is reused across
+// Predictions of the windows `ids` of `data`, laid out as predict_windows()
+// documents for ids.size() windows (step-major). `net` is reused across
 // chunks (its buffers keep their size).
-Eigen::MatrixXd predict_window_range(HadynetNetwork<float>& net, const HadynetModel& model, const WindowDataset& data,
-                                     const Eigen::VectorXf& pb, int first, int count) {
-  std::vector<int> ids(static_cast<std::size_t>(count));
-  std::iota(ids.begin(), ids.end(), first);
+Eigen::MatrixXd predict_window_ids(HadynetNetwork<float>& net, const HadynetModel& model, const WindowDataset& data,
+                                   const Eigen::VectorXf& pb, std::span<const int> ids) {
   WindowBatch<float> batch;
   Matrix<float> target;
   data.gather(ids, batch, target);
-  batch.pb = pb.replicate(1, count);
+  batch.pb = pb.replicate(1, static_cast<Eigen::Index>(ids.size()));
   Eigen::MatrixXd y = net.forward(model.params, batch, BnMode::kEval).cast<double>();
   y = (y.array().colwise() * model.norm.y.std.array()).colwise() + model.norm.y.mean.array();
   apply_output_clips(model, y);
   return y;
+}
+
+// The windows [first, first + count) of `data`.
+Eigen::MatrixXd predict_window_range(HadynetNetwork<float>& net, const HadynetModel& model, const WindowDataset& data,
+                                     const Eigen::VectorXf& pb, int first, int count) {
+  std::vector<int> ids(static_cast<std::size_t>(count));
+  std::iota(ids.begin(), ids.end(), first);
+  return predict_window_ids(net, model, data, pb, ids);
 }
 
 }  // namespace
@@ -147,6 +154,28 @@ Eigen::MatrixXd predict_windows(const HadynetModel& model, const LogSequence& se
     const Eigen::MatrixXd y = predict_window_range(net, model, data, pb, first, count);
     for (int k = 0; k < steps; ++k)
       out.middleCols(static_cast<Eigen::Index>(k) * B + first, count) = y.middleCols(static_cast<Eigen::Index>(k) * count, count);
+  }
+  return out;
+}
+
+Eigen::MatrixXd predict_windows_from(const HadynetModel& model, const LogSequence& seq, const Eigen::VectorXf& pb,
+                                     int steps, const std::vector<int>& starts) {
+  const WindowDataset data({seq}, {0}, model.layout, model.norm, steps);
+  const auto n = static_cast<int>(starts.size());
+  Eigen::MatrixXd out(model.params.dims.y, static_cast<Eigen::Index>(n) * steps);
+  HadynetNetwork<float> net;
+  for (int first = 0; first < n; first += kWindowChunk) {
+    const int count = std::min(kWindowChunk, n - first);
+    std::vector<int> ids;  // window b starts from row b + 1
+    for (int i = first; i < first + count; ++i) {
+      const int s = starts[static_cast<std::size_t>(i)];
+      if (s < 1 || s - 1 >= data.size()) throw std::logic_error("predict_windows_from: a window starts outside the log");
+      ids.push_back(s - 1);
+    }
+    const Eigen::MatrixXd y = predict_window_ids(net, model, data, pb, ids);
+    for (int i = 0; i < count; ++i)
+      for (int k = 0; k < steps; ++k)
+        out.col(static_cast<Eigen::Index>(first + i) * steps + k) = y.col(static_cast<Eigen::Index>(k) * count + i);
   }
   return out;
 }

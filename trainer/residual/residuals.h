@@ -126,6 +126,14 @@ ResidualData compute_residuals(const HadynetModel& model, const std::vector<LogI
 Eigen::MatrixXd predict_windows(const HadynetModel& model, const LogSequence& seq,
                                 const Eigen::VectorXf& pb, int steps);
 
+// Raw network predictions of the windows of `steps` steps of a log whose
+// initial states are the rows `starts` (each in 1 .. T - 1 - steps, else
+// std::logic_error): column i * steps + k is the prediction of row
+// starts[i] + k + 1, in physical units. Run in chunks of windows, so memory
+// does not grow with their number.
+Eigen::MatrixXd predict_windows_from(const HadynetModel& model, const LogSequence& seq, const Eigen::VectorXf& pb,
+                                     int steps, const std::vector<int>& starts);
+
 // Fit and RMSE per channel and horizon h = 1..H over every window start of
 // every log (pooled: the norms run over all logs; the mean is the pooled mean
 // of the targets at that horizon):
