@@ -355,7 +355,8 @@
 # sensor-curve=0.7 and 3930-3939 every effect at its larger strength
 # measured with the final code, and stop 79's code re-run on the same logs
 # (3940-3959: clean sets; 3960-3969 the gain wobble; 3970-3974 two
-# effects). Next unused: 3975 on.
+# effects); 3975-3994 sensor-curve=0.7 and 3995-4004 every effect
+# measured the same way. Next unused: 4005 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...
