@@ -63,10 +63,12 @@ HeldOutError held_out_error(const HadynetModel& model, const std::vector<HeldOut
 // measured frame row before it) with the logged commands, so every row is
 // predicted once, at a horizon of 1..steps. With `steps` the model's
 // N_train (HadynetModel::train_steps) this is the loss it was trained on,
-// in the measured frame. The sensor model maps the predictions as in
-// held_out_error: channel c's measured row t is the window's prediction of
-// frame row t - delay_c, read through its curve; cross-talk adds gain times
-// the source's prediction of frame row t from the same window; a drift adds
+// in the measured frame. The sensor model maps the predictions as
+// sensor_model.h defines it: channel c's measured row t is the window's
+// prediction of frame row t - delay_c, read through its curve; cross-talk
+// adds gain times the source's prediction of frame row t from the same
+// window (held_out_error reads the source at frame row t - D, the same
+// where D = 0, as in every curve fit so far); a drift adds
 // the bias known at t - 1 plus its increment from the prediction; the rails
 // clip. A row whose frame rows fall outside every window (the first
 // delay_c rows, the last rows short of a window) is left out. Throws

@@ -129,8 +129,8 @@ Eigen::MatrixXd predict_windows(const HadynetModel& model, const LogSequence& se
 // Raw network predictions of the windows of `steps` steps of a log whose
 // initial states are the rows `starts` (each in 1 .. T - 1 - steps, else
 // std::logic_error): column i * steps + k is the prediction of row
-// starts[i] + k + 1, in physical units. Run in chunks of windows, so memory
-// does not grow with their number.
+// starts[i] + k + 1, in physical units. The network runs on chunks of
+// windows, so its activations do not grow with their number.
 Eigen::MatrixXd predict_windows_from(const HadynetModel& model, const LogSequence& seq, const Eigen::VectorXf& pb,
                                      int steps, const std::vector<int>& starts);
 
