@@ -68,7 +68,7 @@ HeldOutError held_out_error(const HadynetModel& model, const std::vector<HeldOut
 // prediction of frame row t - delay_c, read through its curve; cross-talk
 // adds gain times the source's prediction of frame row t from the same
 // window (held_out_error reads the source at frame row t - D, the same
-// where D = 0, as in every curve fit so far); a drift adds
+// where D = 0); a drift adds
 // the bias known at t - 1 plus its increment from the prediction; the rails
 // clip. A row whose frame rows fall outside every window (the first
 // delay_c rows, the last rows short of a window) is left out. Throws
