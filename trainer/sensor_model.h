@@ -4,12 +4,13 @@
 // trained on logs as they are. With the network's channels y' (physical
 // units, the model's frame), a measured channel is
 //
-//   y_c(t) = clip_c( g_c(y'_c(t - delay_c)) + sum_s k_cs y'_s(t) + b_c(t) )
+//   y_c(t) = clip_c( g_c(y'_c(t - delay_c)) + sum_s k_cs y'_s(t - delay_s) + b_c(t) )
 //
 //   delay_c y_c is reported `steps` rows late (a sensor delay);
 //   g_c     a static calibration curve: the sensor reports a monotone
 //           function of its channel's level (identity without one);
-//   k_cs    cross-talk: the target picks up `gain` times the source;
+//   k_cs    cross-talk: the target picks up `gain` times the source as
+//           measured in the same row (so its own delay applies);
 //   b_c     a drift/bias state, rate * D_c(t), D_c the load the sensor has
 //           carried since the log's start (its level, the reading less the
 //           bias, accumulated: SensorDrift) or the time since then (t dt),

@@ -15,6 +15,7 @@
 #include "trainer/residual/analysis.h"
 #include "trainer/residual/augment.h"
 #include "trainer/residual/drift_probe.h"
+#include "trainer/residual/sensor_readout.h"
 #include "trainer/sensor_model.h"
 
 namespace hadynet::test {
@@ -320,6 +321,58 @@ TEST(SensorFrame, ACalibrationCurveAndItsInverse) {
       EXPECT_NE(std::string(e.what()).find("fc0"), std::string::npos) << e.what();
     }
   }
+}
+
+// SensorReadout reads a log's own frame back as the log: a delayed
+// cross-talk source is read at its own delay (the measured source of the
+// target's row, which crosstalk_removed() subtracts), a delayed target at
+// its, through the source's curve into the frame and out of the target's,
+// with a drift with time. Reading the source at the largest delay, as
+// held_out_error did before stop 81, gives fc0 off by 0.3 times the
+// source's change over a row. Rows whose frame rows are missing read NaN.
+TEST(SensorReadout, ReadsALogsFrameBackAsTheLog) {
+  datalog::LogTable in = table({"fc0", "fc1", "fc2", "u0"}, {{1, 5, 0.5, 0},
+                                                            {-2, 6, 1, 0},
+                                                            {3, 8, 1.5, 0},
+                                                            {0, 7, 0.5, 0},
+                                                            {4, 9, 2, 0},
+                                                            {2, 4, 1, 0},
+                                                            {1, 3, 0, 0},
+                                                            {5, 6, 3, 0}});
+  in.metadata.set("dt_s", "0.5");
+  SensorModel s;
+  s.delays = {{"fc0", 2}, {"fc1", 1}};
+  s.crosstalk = {{"fc0", "fc1", 0.3}};
+  s.curves = {{"fc1", {0, 4, 20}, {0, 6, 12}}};
+  s.drifts = {{"fc2", false, 0.2}};
+  s.period_s = 0.5;
+  const datalog::LogTable frame = to_model_frame(s, in, "d.csv");
+  ASSERT_EQ(frame.rows(), 6u);
+  const residual::LogInput log{in, "d.csv"};
+  const std::vector<std::string> y_names = {"fc0", "fc1", "fc2"};
+  const residual::SensorReadout readout(y_names, s, log);
+  EXPECT_EQ(readout.max_delay(), 2);
+  const auto from_frame = [&](Eigen::Index c, int r) {
+    return r >= 0 && r < static_cast<int>(frame.rows()) ? frame.at(static_cast<std::size_t>(r), static_cast<std::size_t>(c))
+                                                        : std::nan("");
+  };
+  // Rows 2..5: every frame row they read exists (fc2, not delayed, reads frame row t).
+  for (int t = 2; t <= 5; ++t) {
+    const Eigen::VectorXd v = readout.row(from_frame, t);
+    for (Eigen::Index c = 0; c < 3; ++c)
+      EXPECT_NEAR(v(c), in.at(static_cast<std::size_t>(t), static_cast<std::size_t>(c)), 1e-12) << y_names[c] << " row " << t;
+  }
+  // Row 6: fc2 would read frame row 6, which the frame (6 rows) lacks; fc0 and fc1 read rows 4 and 5.
+  const Eigen::VectorXd last = readout.row(from_frame, 6);
+  EXPECT_TRUE(std::isnan(last(2)));
+  EXPECT_NEAR(last(0), in.at(6, 0), 1e-12);
+  // The source read at the largest delay instead: fc0 is off.
+  const auto source_late = [&](Eigen::Index c, int r) { return from_frame(c, c == 1 && r == 4 - 1 ? r - 1 : r); };
+  EXPECT_GT(std::abs(readout.row(source_late, 4)(0) - in.at(4, 0)), 0.1);
+  // A channel the model does not have.
+  SensorModel unknown = s;
+  unknown.crosstalk = {{"fc0", "fc9", 0.3}};
+  EXPECT_THROW(residual::SensorReadout(y_names, unknown, log), std::logic_error);
 }
 
 // Which candidate the decision tests: the first, in the screen's order,

@@ -398,6 +398,48 @@ TEST(HeldOutError, ErrorsAloneAreTheReportsErrors) {
   EXPECT_TRUE(errors.inputs_outside.empty());
 }
 
+// held_out_error reads a cross-talk's source at the source's own delay
+// (SensorReadout): with fc0 delayed 2 rows and fc1 1, the measured row t of
+// fc0 is the run's step predicting frame row t - 2 plus the gain times the
+// step predicting fc1's frame row t - 1, both from the run that starts at
+// frame row t - 3 (D = 2). Before stop 81 the source came from the run's
+// first step (frame row t - 2), so fc0's residuals differed by the gain
+// times fc1's predicted change over a row. The rows: the last 40 % of each
+// plant log but the last 2. Tolerance 1e-9 relative to fc0's RMSE: both paths take the
+// same predict_windows() output and differ only in the order of additions.
+TEST(HeldOutError, ACrosstalkSourceIsReadAtItsOwnDelay) {
+  trainer::HadynetModel model = build_model();
+  model.sensor.delays = {{"fc0", 2}, {"fc1", 1}};
+  model.sensor.crosstalk = {{"fc0", "fc1", 0.3}};
+  const std::vector<LogInput> logs = plant_logs("crosstalk");
+  std::vector<HeldOutLog> rows = last_rows(model, logs, compute_residuals(build_model(), logs, "auto"));
+  const int d = 2;
+  for (HeldOutLog& log : rows) log.end -= d;  // the frame ends d rows before the log
+  const auto index = [&](const std::string& name) {
+    return std::find(model.layout.y_names.begin(), model.layout.y_names.end(), name) - model.layout.y_names.begin();
+  };
+  const Eigen::Index fc0 = index("fc0"), fc1 = index("fc1");
+  ASSERT_LT(fc1, static_cast<Eigen::Index>(model.layout.y_names.size()));
+  const HeldOutError e = held_out_error(model, rows, HeldOutDetail::kErrorsOnly);
+  double largest = 0, moved = 0;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const HeldOutLog& log = rows[i];
+    const Eigen::MatrixXd p = predict_windows(model, log.frame, log.pb, d + 1);
+    const Eigen::Index B = p.cols() / (d + 1);
+    const Eigen::VectorXd& residual = e.residuals[static_cast<std::size_t>(fc0)][i];
+    ASSERT_EQ(residual.size(), log.end - log.first);
+    for (int t = log.first; t < log.end; ++t) {
+      const Eigen::Index b = t - d - 2;  // the run from frame row t - 3
+      const double own = p(fc0, 0 * B + b) + 0.3 * p(fc1, 1 * B + b);
+      const double first_step = p(fc0, 0 * B + b) + 0.3 * p(fc1, 0 * B + b);
+      largest = std::max(largest, std::abs(residual(t - log.first) - (log.measured.y(fc0, t) - own)));
+      moved = std::max(moved, std::abs(own - first_step));
+    }
+  }
+  EXPECT_LT(largest, 1e-9 * e.rmse(fc0));
+  EXPECT_GT(moved, 10 * 1e-9 * e.rmse(fc0));  // the two rules differ on these rows
+}
+
 // window_rmse (the curve's criterion, CalibrationCurves::refine): with one
 // step it is held_out_error's 1-step error; with N steps every row is
 // predicted once, by the window of N steps that holds it, run open loop from

@@ -1,13 +1,13 @@
 // The before/after of `hadynet residual --fix` (docs/residual.md): a model's
 // causal 1-step error on held-out rows of measured logs, per channel. Each
-// model is fed the logs in its own frame and its predictions are mapped back
-// through its sensor model (sensor_model.h): with D its largest delay, the
-// measured row t is predicted from frame row t - D - 1 (known at t - 1),
-// running D + 1 steps with the logged commands; channel c is the step that
-// predicts frame row t - delay_c; cross-talk adds gain times the model's
-// prediction of the source from the same step; a drift adds the bias known at
-// t - 1 plus its increment from the prediction. Without a sensor model this
-// is the analysis's 1-step prediction.
+// model is fed the logs in its own frame and its predictions are read as
+// measured rows through its sensor model (SensorReadout,
+// sensor_readout.h): with D its largest delay, the measured row t is
+// predicted from frame row t - D - 1 (known at t - 1), running D + 1 steps
+// with the logged commands; every frame row the readout asks for (channel
+// c's t - delay_c, a cross-talk source's t - delay_s) is the step of that
+// run that predicts it. Without a sensor model this is the analysis's
+// 1-step prediction.
 #pragma once
 
 #include <Eigen/Core>
@@ -63,16 +63,12 @@ HeldOutError held_out_error(const HadynetModel& model, const std::vector<HeldOut
 // measured frame row before it) with the logged commands, so every row is
 // predicted once, at a horizon of 1..steps. With `steps` the model's
 // N_train (HadynetModel::train_steps) this is the loss it was trained on,
-// in the measured frame. The sensor model maps the predictions as
-// sensor_model.h defines it: channel c's measured row t is the window's
-// prediction of frame row t - delay_c, read through its curve; cross-talk
-// adds gain times the source's prediction of frame row t from the same
-// window (held_out_error reads the source at frame row t - D, the same
-// where D = 0); a drift adds
-// the bias known at t - 1 plus its increment from the prediction; the rails
-// clip. A row whose frame rows fall outside every window (the first
-// delay_c rows, the last rows short of a window) is left out. Throws
-// std::logic_error if `steps` < 1 or a channel has no row.
+// in the measured frame. The predictions are read as measured rows as
+// held_out_error reads them (SensorReadout), each frame row the readout asks
+// for from the window that predicts it. A channel's row whose frame rows
+// fall outside every window (the first delay_c rows, the last rows short of
+// a window) is left out. Throws std::logic_error if `steps` < 1 or a channel
+// has no row.
 Eigen::VectorXd window_rmse(const HadynetModel& model, const std::vector<HeldOutLog>& logs, int steps);
 
 }  // namespace hadynet::trainer::residual
