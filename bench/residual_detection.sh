@@ -356,7 +356,15 @@
 # measured with the final code, and stop 79's code re-run on the same logs
 # (3940-3959: clean sets; 3960-3969 the gain wobble; 3970-3974 two
 # effects); 3975-3994 sensor-curve=0.7 and 3995-4004 every effect
-# measured the same way. Next unused: 4005 on.
+# measured the same way. Stop 81 (one readout of the frame; a calibration
+# curve of the whole group, not kept): development stop 79's
+# sensor-curve=0.7 sets 3795-3824 and 3880-3899 (3880-3899 also for three
+# variants not kept); 4040-4059 sensor-curve=0.7 and 4060-4069 every
+# effect at its larger strength measured with the whole group, and the
+# final code re-run on the same logs; 4005-4009 two effects (stop 80's
+# code, the final code, the whole group), 4020-4039 clean sets (the final
+# code, the whole group), 4070-4079 the gain wobble (the whole group).
+# Next unused: 4080 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

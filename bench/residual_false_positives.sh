@@ -135,7 +135,8 @@
 # 3760-3779 with the first version of a curve that ends at its channels'
 # rated top, 3845-3864 with the final code (0 of 20 each). Stop 80:
 # 3940-3959 with the curve fitted over windows of N_train steps (0 of 20).
-# Next unused seed: 4005
+# Stop 81: 4020-4039 with one readout of the frame (its final code) and
+# with the curve of the whole group, not kept (0 of 20 each). Next unused seed: 4080
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

@@ -49,7 +49,8 @@
 # --decision-pooling logs: 0 of 10 confirmed); 3865-3874 (stop 79, a curve
 # ends at its channels' rated top: 0 of 10 confirmed; 3780-3789 with the
 # rule's first version: 0 of 10 confirmed); 3960-3969 (stop 80, the curve
-# fitted over windows of N_train steps: 0 of 10 confirmed).
+# fitted over windows of N_train steps: 0 of 10 confirmed); 4070-4079
+# (stop 81, the curve of the whole group, not kept: 0 of 10 confirmed).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R]
