@@ -353,14 +353,16 @@ TEST(SensorReadout, ReadsALogsFrameBackAsTheLog) {
   const residual::SensorReadout readout(y_names, s, log);
   EXPECT_EQ(readout.max_delay(), 2);
   const auto from_frame = [&](Eigen::Index c, int r) {
-    return r >= 0 && r < static_cast<int>(frame.rows()) ? frame.at(static_cast<std::size_t>(r), static_cast<std::size_t>(c))
-                                                        : std::nan("");
+    if (r < 0 || r >= static_cast<int>(frame.rows())) return std::nan("");
+    return frame.at(static_cast<std::size_t>(r), static_cast<std::size_t>(c));
   };
   // Rows 2..5: every frame row they read exists (fc2, not delayed, reads frame row t).
   for (int t = 2; t <= 5; ++t) {
     const Eigen::VectorXd v = readout.row(from_frame, t);
-    for (Eigen::Index c = 0; c < 3; ++c)
-      EXPECT_NEAR(v(c), in.at(static_cast<std::size_t>(t), static_cast<std::size_t>(c)), 1e-12) << y_names[c] << " row " << t;
+    for (Eigen::Index c = 0; c < 3; ++c) {
+      const double measured = in.at(static_cast<std::size_t>(t), static_cast<std::size_t>(c));
+      EXPECT_NEAR(v(c), measured, 1e-12) << y_names[static_cast<std::size_t>(c)] << " row " << t;
+    }
   }
   // Row 6: fc2 would read frame row 6, which the frame (6 rows) lacks; fc0 and fc1 read rows 4 and 5.
   const Eigen::VectorXd last = readout.row(from_frame, 6);

@@ -53,8 +53,8 @@ Eigen::VectorXd window_rmse(const HadynetModel& model, const std::vector<HeldOut
     const auto frame = [&](Eigen::Index c, int r) {
       const int from_first = r - starts.front() - 1;
       const int i = from_first / steps;
-      return from_first >= 0 && i < static_cast<int>(starts.size()) ? p(c, static_cast<Eigen::Index>(i) * steps + from_first % steps)
-                                                                     : std::nan("");
+      if (from_first < 0 || i >= static_cast<int>(starts.size())) return std::nan("");
+      return p(c, static_cast<Eigen::Index>(i) * steps + from_first % steps);
     };
     for (int t = std::max(log.first, starts.front() + 1); t < log.end && t <= starts.back() + steps + d; ++t) {
       const Eigen::VectorXd v = readout.row(frame, t);

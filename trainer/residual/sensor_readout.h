@@ -38,7 +38,9 @@ class SensorReadout {
   //   a drift adds rate (D(t - 1) + its step): the driver known from the
   //     measured rows up to t - 1, and the step from this row's reading
   //     (the level's magnitude times dt for a load drift, dt for time);
-  //   a rail clips the reading.
+  //   a rail clips the reading (the network's own output is clipped at the
+  //   frame's rail already, output_clip.h; a cross-talk or a drift may
+  //   carry the reading past the rail, as the firmware reports it).
   // A channel is NaN where a value it reads is. Requires t >= 1.
   template <class Frame>
   Eigen::VectorXd row(const Frame& frame, int t) const {
