@@ -364,9 +364,10 @@
 # final code re-run on the same logs; 4005-4009 two effects (stop 80's
 # code, the final code, the whole group), 4020-4039 clean sets (the final
 # code, the whole group), 4070-4079 the gain wobble (the whole group);
-# 4080-4099 sensor-curve=0.7 measured with a curve fitted where the test
-# finds it and applied to the whole group (not kept), and the final code
-# re-run on the same logs. 4010-4019 not used. Next unused: 4100 on.
+# 4080-4099 sensor-curve=0.7 and 4100-4109 every effect measured with a
+# curve fitted where the test finds it and applied to the whole group (not
+# the default yet), and the final code re-run on the same logs; 4110-4129
+# clean sets (the same variant). 4010-4019 not used. Next unused: 4130 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -136,7 +136,9 @@
 # rated top, 3845-3864 with the final code (0 of 20 each). Stop 80:
 # 3940-3959 with the curve fitted over windows of N_train steps (0 of 20).
 # Stop 81: 4020-4039 with one readout of the frame (its final code) and
-# with the curve of the whole group, not kept (0 of 20 each). Next unused seed: 4100
+# with the curve of the whole group, not kept (0 of 20 each); 4110-4129
+# with the curve fitted where the test finds it and applied to the whole
+# group (0 of 20). Next unused seed: 4130
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
