@@ -9,24 +9,28 @@
 # (bench/residual_run_line.py), as a rival of CHOSEN tested beside it on the
 # held-out rows and applied (decision_rivals(); docs/residual.md). The two
 # cases of the suite, each set a development seed of its step:
-#   3396 crosstalk  until stop 73 a chosen cross-talk had no rivals: the
-#                   selection takes fc2 -> fc1 (p 0.038 on the selection's
-#                   rows; stop 72's code: the same), the decision does not
-#                   confirm it (p 0.032), and the loadcells' curves, which
-#                   gained on those rows too, were never tested. Since stop
-#                   73 ("A cross-talk's rivals") the curve of fc1, fc2, fc7,
-#                   fc3 and fc4 is confirmed beside it (p 3.3e-09) and
-#                   applied. (Stop 73 ran seed 3207 here; since stop 74's
-#                   curve shape the selection chooses the curve there
-#                   itself. 3396 was measured in stop 74 before it became
-#                   this test's seed.)
-#   3892 friction   until stop 74 a chosen friction had no rivals. Here the
-#                   selection takes friction of u4 on fc3 (p 2.5e-05 on the
-#                   selection's rows, a gain of 0.023; the loadcells' curve
-#                   gained 0.011 there, p 0.022), the decision confirms it
-#                   (p 0.00025), and the curve of fc4, fc1, fc2, fc3 and fc7,
-#                   tested beside it since stop 74 ("Friction's rivals"), is
-#                   confirmed (p 3.2e-12) and applied.
+#   3889 crosstalk  until stop 73 a chosen cross-talk had no rivals. Here
+#                   the selection takes a cross-talk between two loadcells,
+#                   the decision confirms it (p 0.0025), and the curve of
+#                   fc2, fc3, fc4 and fc7, applied to the rest of the
+#                   loadcells, tested beside it since stop 73 ("A
+#                   cross-talk's rivals"), is confirmed (p 2.8e-09) and
+#                   applied. (Stop 73 ran seed 3207 here, stops 74-81 3396;
+#                   on each, a later change of the curve made the selection
+#                   choose the curve itself: stop 74's curve shape, stop
+#                   82's curve applied to the rest of its group. 3889 is a
+#                   development set of stop 81.)
+#   4094 friction   until stop 74 a chosen friction had no rivals. Here the
+#                   selection takes friction, the decision confirms it (p
+#                   0.0003), and the curve of fc0, fc1, fc2, fc4 and fc7,
+#                   applied to the rest of the loadcells, tested beside it
+#                   since stop 74 ("Friction's rivals"), is confirmed (p
+#                   5.2e-10) and applied. Until stop 81 this case ran seed
+#                   3892; since stop 82 the curve applied to the rest of its
+#                   group ("The curve applied to the rest of its group")
+#                   gains more on the selection's rows there, and the
+#                   selection chooses it itself. 4094 is a fresh curve set
+#                   of stop 81, where that variant was measured.
 #   3797 saturation until stop 75 a chosen rail had no rivals. Here the
 #                   selection takes a lower rail of the finger lengths l3 and
 #                   l4 (p 0.01, a gain of 0.002; the loadcells' curve gained

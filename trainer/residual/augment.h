@@ -330,6 +330,13 @@ struct CalibrationCurves : ModelChange {
   // zero and the rated output, unless the curve without it ends flat
   // (flat_at_end: a rail's signature).
   std::optional<double> rated_top;
+  // The other channels of the plan's group (a group extension's plan only,
+  // Augmentation::group_extension): refine() fits the curve where the test
+  // found it (the channels above), then gives each of these a copy of it
+  // and adds them to the change's channels. Sensors of one group are of one
+  // kind, and a loadcell at rest keeps the test from seeing its curve,
+  // though a grasp on other logs would load it. Empty once refine() ran.
+  std::vector<std::string> applied_to;
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;
   void refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
               std::vector<double>& fitted);

@@ -1020,6 +1020,12 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
                   " (piecewise linear, monotone): the logs read through its inverse, the prediction through it";
   a.found_on = a.channels;
   a.judged_on_every_channel = true;
+  if (!a.group_extension) return;
+  for (int c = 0; c < static_cast<int>(data.y_names.size()); ++c) {
+    const std::string& name = y_name(data, c);
+    if (channel_group(name) == group && std::find(a.channels.begin(), a.channels.end(), name) == a.channels.end())
+      change.applied_to.push_back(name);
+  }
 }
 
 }  // namespace sensor_curve
@@ -1222,6 +1228,16 @@ void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const
     std::snprintf(text, sizeof text, ", through the rated top %.4g", *top);
     a.description += text;
   }
+  // The rest of the group takes the fitted curve (applied_to).
+  if (applied_to.empty()) return;
+  for (const std::string& channel : applied_to) {
+    SensorCurve copy = curves.front();
+    copy.channel = channel;
+    curves.push_back(std::move(copy));
+    a.channels.push_back(channel);
+  }
+  a.description += "; applied to the rest of its group: " + join(applied_to);
+  applied_to.clear();
 }
 
 namespace {
