@@ -367,7 +367,13 @@
 # 4080-4099 sensor-curve=0.7 and 4100-4109 every effect measured with a
 # curve fitted where the test finds it and applied to the whole group (not
 # the default yet), and the final code re-run on the same logs; 4110-4129
-# clean sets (the same variant). 4010-4019 not used. Next unused: 4130 on.
+# clean sets (the same variant). 4010-4019 not used. Stop 82 (the curve
+# applied to the rest of its group, the default): development 3880-3899
+# and the saturation=2 sets of 4060-4069 (a curve always through its
+# rated top, not kept); 4130-4149 sensor-curve=0.7 and 4150-4159 every
+# effect at its larger strength measured with the final code, and stop
+# 81's code re-run on the same logs; 4160-4179 clean sets, 4180-4189 the
+# gain wobble, 4190-4194 two effects. Next unused: 4195 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -50,7 +50,9 @@
 # ends at its channels' rated top: 0 of 10 confirmed; 3780-3789 with the
 # rule's first version: 0 of 10 confirmed); 3960-3969 (stop 80, the curve
 # fitted over windows of N_train steps: 0 of 10 confirmed); 4070-4079
-# (stop 81, the curve of the whole group, not kept: 0 of 10 confirmed).
+# (stop 81, the curve of the whole group, not kept: 0 of 10 confirmed);
+# 4180-4189 (stop 82, the curve applied to the rest of its group: 0 of 10
+# confirmed).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R]

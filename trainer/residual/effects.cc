@@ -1601,7 +1601,8 @@ const std::vector<EffectInfo>& effect_library() {
        "be at least 1/4, the flattest a fitted curve may be)",
        "a static calibration curve in the sensor model: the measured y_c read through g^-1 before the "
        "network, its prediction through g; g piecewise linear through 9 quantile knots, its slopes "
-       "re-estimated on the training rows (the unchanged network's error over windows of its N_train steps)",
+       "re-estimated on the training rows (the unchanged network's error over windows of its N_train steps) "
+       "where the test finds the curve, then applied to the rest of its group",
        SourceKind::kNone, sensor_curve::enumerate, sensor_curve::features, sensor_curve::slope_ratio,
        sensor_curve::plausible_curve, sensor_curve::describe, sensor_curve::plan, nullptr, nullptr, nullptr,
        EffectKind::kSaturation},
