@@ -721,11 +721,13 @@ TEST(FixCandidates, EveryChannelTakesTheLargestSignificantStatistic) {
 
 // The plans fix() tries as the simpler account of a confirmed calibration
 // curve (EffectInfo::simpler: a rail): the rails planned on the curve's
-// lead channel, fewest channels first; none for a rail on another channel
-// only, for a plan that cannot be added, or for an effect without a
-// simpler one. (With none planned, the ranking without the floor is
+// lead channel, fewest channels first, else those on another channel the
+// curve was found on (since stop 82: one curve for its channels, so its
+// lead is one of them); none for a rail only on a channel the curve was
+// not found on, for a plan that cannot be added, or for an effect without
+// a simpler one. (With none planned, the ranking without the floor is
 // searched: here it is empty; cli.residual.rail_simpler_account runs it.)
-TEST(FixCandidates, TheSimplerAccountIsARailOnTheCurvesLeadChannel) {
+TEST(FixCandidates, TheSimplerAccountIsARailWhereTheCurveWasFound) {
   const auto plan = [](residual::EffectKind kind, std::vector<std::string> channels, bool group_extension = true) {
     residual::Augmentation a;
     a.kind = kind;
@@ -743,14 +745,23 @@ TEST(FixCandidates, TheSimplerAccountIsARailOnTheCurvesLeadChannel) {
     return out;
   };
   using Channels = std::vector<std::vector<std::string>>;
-  const residual::Augmentation curve = plan(EffectKind::kSensorCurve, {"fc4", "fc3", "fc0"});
+  // Found on fc4, fc3 and fc0, and applied to the rest of the group (fc7, ...).
+  residual::Augmentation curve = plan(EffectKind::kSensorCurve, {"fc4", "fc3", "fc0", "fc7"});
+  curve.found_on = {"fc4", "fc3", "fc0"};
   std::vector<residual::Augmentation> planned = {curve, plan(EffectKind::kSaturation, {"fc4", "fc3", "fc7"}),
                                                  plan(EffectKind::kSaturation, {"fc4"}, false)};
   EXPECT_EQ(simpler(planned), (Channels{{"fc4"}, {"fc4", "fc3", "fc7"}}));
   planned.pop_back();  // the extended rail alone
   EXPECT_EQ(simpler(planned), (Channels{{"fc4", "fc3", "fc7"}}));
-  // A rail of fc3 only (not the curve's lead) is no account of it.
+  // The rails of the lead before those of the other channels it was found on.
+  planned = {curve, plan(EffectKind::kSaturation, {"fc3"}), plan(EffectKind::kSaturation, {"fc4"})};
+  EXPECT_EQ(simpler(planned), (Channels{{"fc4"}}));
+  // None of the lead: a rail of fc3, where the curve was found too (stop
+  // 81's code asked the lead only and found none).
   planned = {curve, plan(EffectKind::kSaturation, {"fc3"})};
+  EXPECT_EQ(simpler(planned), (Channels{{"fc3"}}));
+  // A rail of fc7 only, where the curve was applied and not found, is no account of it.
+  planned = {curve, plan(EffectKind::kSaturation, {"fc7"})};
   EXPECT_EQ(simpler(planned), Channels{});
   // A rail plan that cannot be added.
   planned = {curve, plan(EffectKind::kSaturation, {"fc4"})};

@@ -332,17 +332,18 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
 
 namespace {
 
-// Whether `confirmed` is a calibration curve whose lead channel's end on
-// the side of `rail`'s clip of that channel is as flat as the curve's fit
-// may be (FixResult::SimplerAccount::flat_end).
+// Whether `confirmed` is a calibration curve whose end on the side of
+// `rail`'s first clip of a channel the curve holds is as flat as the
+// curve's fit may be (FixResult::SimplerAccount::flat_end; the channels
+// hold one curve, CalibrationCurves::refine).
 bool flat_end_at_rail(const Augmentation& confirmed, const Augmentation& rail) {
   const auto* curves = std::get_if<CalibrationCurves>(&confirmed.change);
   const auto* clips = std::get_if<OutputClips>(&rail.change);
-  if (curves == nullptr || clips == nullptr || curves->curves.empty()) return false;
-  const SensorCurve& lead = curves->curves.front();
-  const auto clip = std::find_if(clips->clips.begin(), clips->clips.end(),
-                                 [&](const OutputClip& c) { return c.channel == lead.channel; });
-  return clip != clips->clips.end() && CalibrationCurves::flat_at_end(lead, clip->side);
+  if (curves == nullptr || clips == nullptr) return false;
+  for (const OutputClip& clip : clips->clips)
+    for (const SensorCurve& curve : curves->curves)
+      if (curve.channel == clip.channel) return CalibrationCurves::flat_at_end(curve, clip.side);
+  return false;
 }
 
 }  // namespace
@@ -470,28 +471,43 @@ bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k) {
 namespace {
 
 // simpler_plans() and richer_plans(): the plans of effect `other` that
-// account for planned[k]'s lead channel (their contracts).
+// account for planned[k]'s lead channel, else for another channel it was
+// found on (their contracts).
 std::vector<Augmentation> other_account_plans(const ResidualData& data, const Attribution& floorless,
                                               const std::vector<Augmentation>& planned, std::size_t k,
                                               std::optional<EffectKind> other) {
   std::vector<Augmentation> out;
   if (!other || planned[k].channels.empty()) return out;
   const std::string& lead = planned[k].channels.front();
+  std::vector<std::string> found_on{lead};  // the lead first
+  for (const std::string& c : planned[k].found_on)
+    if (std::find(found_on.begin(), found_on.end(), c) == found_on.end()) found_on.push_back(c);
+  const auto holds = [](const std::vector<std::string>& channels, const std::string& c) {
+    return std::find(channels.begin(), channels.end(), c) != channels.end();
+  };
   for (const Augmentation& a : planned)
-    if (a.kind == *other && a.not_fixable.empty() &&
-        std::find(a.channels.begin(), a.channels.end(), lead) != a.channels.end())
-      out.push_back(a);
+    if (a.kind == *other && a.not_fixable.empty() && holds(a.channels, lead)) out.push_back(a);
+  if (out.empty())
+    for (const Augmentation& a : planned)
+      if (a.kind == *other && a.not_fixable.empty() &&
+          std::any_of(a.channels.begin(), a.channels.end(), [&](const std::string& c) { return holds(found_on, c); }))
+        out.push_back(a);
   if (out.empty()) {
-    const int target = index_of(data.y_names, lead);
-    const auto best = std::find_if(floorless.ranked.begin(), floorless.ranked.end(), [&](const HypothesisResult& r) {
-      return r.significant && r.hypothesis.kind == *other && r.hypothesis.target == target;
-    });
+    const auto best_on = [&](const auto& where) {
+      return std::find_if(floorless.ranked.begin(), floorless.ranked.end(), [&](const HypothesisResult& r) {
+        return r.significant && r.hypothesis.kind == *other && where(data.y_names[static_cast<std::size_t>(r.hypothesis.target)]);
+      });
+    };
+    auto best = best_on([&](const std::string& c) { return c == lead; });
+    if (best == floorless.ranked.end()) best = best_on([&](const std::string& c) { return holds(found_on, c); });
     if (best == floorless.ranked.end() || !why_not_fixable(data, floorless, *best).empty()) return out;
+    const int target = best->hypothesis.target;
     // Without the floor, the effect's family (Attribution::family_of: every
     // channel where it is significant) can reach other groups and the other
-    // side: the plan holds the lead's group and side only, the lead first.
+    // side: the plan holds its channel's group and side only, that channel
+    // first.
     Attribution view = floorless;
-    const std::string group = channel_group(lead);
+    const std::string group = channel_group(data.y_names[static_cast<std::size_t>(target)]);
     for (auto& r : view.ranked)
       if (r.hypothesis.kind == *other &&
           (channel_group(data.y_names[static_cast<std::size_t>(r.hypothesis.target)]) != group ||
@@ -1100,9 +1116,10 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   apply(decided.trial);
 
   // The simpler account (FixResult::simpler): a confirmed change that can
-  // imitate a simpler effect on its lead channel stands only if it predicts
-  // the channels either claims significantly better than the simpler plan
-  // does, once that plan is confirmed against the reference itself. Tried
+  // imitate a simpler effect on a channel it was found on (its lead
+  // first) stands only if it predicts the channels either claims
+  // significantly better than the simpler plan does, once that plan is
+  // confirmed against the reference itself. Tried
   // on the plan with the fewest channels; its extended plan, if any, is
   // then a wider plan. Plans that need more rows than the candidates were
   // judged on are not tried (a simpler effect that delays).

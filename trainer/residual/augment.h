@@ -536,13 +536,17 @@ ProbePlace drift_probe_place(const std::vector<Augmentation>& planned, const std
 // The plans fix() tries as the simpler account of a confirmed planned[k]
 // (its effect's EffectInfo::simpler), fewest channels first: the plans of
 // that effect among `planned` whose channels hold planned[k]'s lead
-// channel (its first); when none was planned, those of the simpler
-// effect's best hypothesis on the lead channel in `floorless` (the
-// attribution with no floor on the excess share, with_null_floor(.., 0):
-// a hypothesis that passes the test but explains too little beyond the
-// null to be a candidate), planned as plan_candidates() plans one (its
-// family alone, and its group when that adds channels), on the lead's
-// group and side only, the lead first. Empty when neither holds one.
+// channel (its first), else another channel planned[k] was found on
+// (found_on: a curve holds one curve for its channels, and is applied to
+// channels it was not found on); when none was planned, those of the
+// simpler effect's best hypothesis in `floorless` (the attribution with
+// no floor on the excess share, with_null_floor(.., 0): a hypothesis that
+// passes the test but explains too little beyond the null to be a
+// candidate) on the lead channel, else the first in its ranking on
+// another channel planned[k] was found on, planned as plan_candidates()
+// plans one (its family alone, and its group when that adds channels), on
+// that channel's group and side only, that channel first. Empty when
+// neither holds one.
 // fix() tests the first and then, as a wider plan, the last.
 std::vector<Augmentation> simpler_plans(const ResidualData& data, const Attribution& floorless,
                                         const std::vector<Augmentation>& planned, std::size_t k);
@@ -550,8 +554,9 @@ std::vector<Augmentation> simpler_plans(const ResidualData& data, const Attribut
 // The plans fix() tries as the richer account of a confirmed planned[k]
 // (its effect's EffectInfo::richer for that plan), planned as
 // simpler_plans() plans a simpler effect: the richer effect's candidates
-// holding the lead channel, else its best hypothesis on the lead channel in
-// `floorless`, on the lead's group; fewest channels first. Empty when the
+// holding the lead channel (else another channel planned[k] was found
+// on), else its best hypothesis on those channels in `floorless`, on that
+// channel's group; fewest channels first. Empty when the
 // effect names none for planned[k] or neither holds one.
 std::vector<Augmentation> richer_plans(const ResidualData& data, const Attribution& floorless,
                                        const std::vector<Augmentation>& planned, std::size_t k);
@@ -762,7 +767,8 @@ struct FixResult {
   };
   std::vector<Extension> extensions;
   // What the simpler and the richer account below hold alike: another
-  // plan of the confirmed change's lead channel, tried after the decision.
+  // plan of the confirmed change's lead channel (else of another channel
+  // it was found on), tried after the decision.
   struct OtherAccount {
     std::string effect;                 // the plan's effect
     std::string replaces;               // the confirmed change's effect
@@ -794,8 +800,8 @@ struct FixResult {
   // decision's.
   struct SimplerAccount : OtherAccount {
     DieboldMariano confirmed_gain;      // the simpler plan's loss minus the confirmed change's on gain_channels
-    // The confirmed change is a calibration curve whose lead channel's end
-    // on the rail's side is as flat as its fit may be
+    // The confirmed change is a calibration curve whose end on the side of
+    // the rail's first clip of a curve channel is as flat as its fit may be
     // (CalibrationCurves::flat_at_end): the rail is applied once confirmed
     // against the reference, whatever confirmed_gain says.
     bool flat_end = false;
