@@ -373,7 +373,13 @@
 # rated top, not kept); 4130-4149 sensor-curve=0.7 and 4150-4159 every
 # effect at its larger strength measured with the final code, and stop
 # 81's code re-run on the same logs; 4160-4179 clean sets, 4180-4189 the
-# gain wobble, 4190-4194 two effects. Next unused: 4195 on.
+# gain wobble, 4190-4194 two effects; a curve's rail asked where it was
+# found: development the saturation=2 sets of 4060-4069, 4100-4109 and
+# 4159, 3880-3899 sensor-curve=0.7 and the friction=4 sets of 4100-4109;
+# 4195-4204 every effect at its larger strength, 4205-4224 saturation=2
+# and 4225-4244 sensor-curve=0.7 measured with the final code and with
+# the first change alone on the same logs; 4245-4264 clean sets,
+# 4265-4269 two effects, 4270-4279 the gain wobble. Next unused: 4280 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

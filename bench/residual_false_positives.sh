@@ -139,7 +139,9 @@
 # with the curve of the whole group, not kept (0 of 20 each); 4110-4129
 # with the curve fitted where the test finds it and applied to the whole
 # group (0 of 20). Stop 82: 4160-4179 with its final code (the curve
-# applied to the rest of its group; 0 of 20). Next unused seed: 4195
+# applied to the rest of its group; 0 of 20), 4245-4264 with its final
+# code (and a curve's rail asked where it was found; 0 of 20). Next unused
+# seed: 4280
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

@@ -60,8 +60,9 @@
 # fitted over windows of N_train steps): 3970-3974 measured with its final
 # code (--candidates 5). Stop 81: 4005-4009 with its final code (one
 # readout of the frame), stop 80's code and the curve of the whole group,
-# not kept (--candidates 5). Stop 82: 4190-4194 with its final code (the
-# curve applied to the rest of its group; --candidates 5).
+# not kept (--candidates 5). Stop 82: 4190-4194 with the curve applied
+# to the rest of its group, 4265-4269 with its final code (and a curve's
+# rail asked where it was found; --candidates 5).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]... [--decision-loss L] [--decision-scale S] [--fix-selection R]
