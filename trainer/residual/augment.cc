@@ -1119,10 +1119,10 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // imitate a simpler effect on a channel it was found on (its lead
   // first) stands only if it predicts the channels either claims
   // significantly better than the simpler plan does, once that plan is
-  // confirmed against the reference itself. Tried
-  // on the plan with the fewest channels; its extended plan, if any, is
-  // then a wider plan. Plans that need more rows than the candidates were
-  // judged on are not tried (a simpler effect that delays).
+  // confirmed against the reference itself. Tried on the plan with the
+  // fewest channels; its extended plan, if any, is then a wider plan. Plans
+  // that need more rows than the candidates were judged on are not tried
+  // (a simpler effect that delays).
   const Augmentation* extended_of_applied = is_family_alone(planned, chosen) ? &planned[chosen - 1] : nullptr;
   const Augmentation* applied_plan = &planned[chosen];  // the applied change before its re-estimation (refined)
   bool applied_extended = !planned[chosen].extended_channels.empty();
