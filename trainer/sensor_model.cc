@@ -110,6 +110,13 @@ double piecewise_linear(const std::vector<double>& from, const std::vector<doubl
 double curve_reading(const SensorCurve& c, double level) { return piecewise_linear(c.level, c.reading, level); }
 double curve_level(const SensorCurve& c, double reading) { return piecewise_linear(c.reading, c.level, reading); }
 
+double curve_slope(const SensorCurve& c, double level) {
+  const std::size_t n = c.level.size();
+  std::size_t k = 1;  // segment [k - 1, k]; a knot belongs to the segment above it
+  while (k + 1 < n && level >= c.level[k]) ++k;
+  return (c.reading[k] - c.reading[k - 1]) / (c.level[k] - c.level[k - 1]);
+}
+
 int SensorModel::max_delay() const {
   int d = 0;
   for (const auto& x : delays) d = std::max(d, x.steps);

@@ -84,6 +84,9 @@ struct SensorCurve {
 // == v up to rounding).
 double curve_reading(const SensorCurve& curve, double level);
 double curve_level(const SensorCurve& curve, double reading);
+// g'(level): the slope (reading per level) of the segment holding `level`
+// (at a knot, the segment above it; beyond the end knots, the end segment).
+double curve_slope(const SensorCurve& curve, double level);
 
 struct OutputClip {
   std::string channel;  // a y channel

@@ -15,6 +15,7 @@
 #include "trainer/residual/analysis.h"
 #include "trainer/residual/augment.h"
 #include "trainer/residual/drift_probe.h"
+#include "trainer/residual/fine_tune.h"
 #include "trainer/residual/sensor_readout.h"
 #include "trainer/sensor_model.h"
 
@@ -271,6 +272,25 @@ TEST(SensorFrame, AlignmentCrosstalkAndTheWholeFrame) {
   EXPECT_EQ(to_model_frame(SensorModel{}, in, "d.csv").values, in.values);
 }
 
+// The fine-tuning loss read through a curve: a curved channel's element
+// weighs g'(level)^2 at its level (model's frame), every other element 1;
+// no curve, no weights.
+TEST(SensorFrame, TheFineTuningLossOfACurvedChannelIsItsReadingsLoss) {
+  trainer::LogSequence seq;
+  seq.y.resize(2, 4);
+  seq.y << 0.5, 1.0, 2.0, 4.0,  // fc0: curved
+      0.5, 1.0, 2.0, 4.0;       // fc1
+  SensorModel s;
+  EXPECT_TRUE(residual::reading_loss_weights(s, {"fc0", "fc1"}, {seq}).empty());
+  s.curves = {SensorCurve{"fc0", {0, 1, 3}, {0, 2, 3}}};
+  const std::vector<Eigen::MatrixXd> w = residual::reading_loss_weights(s, {"fc0", "fc1"}, {seq, seq});
+  ASSERT_EQ(w.size(), 2U);
+  Eigen::MatrixXd want(2, 4);
+  want << 4, 0.25, 0.25, 0.25, 1, 1, 1, 1;
+  EXPECT_EQ(w[0], want);
+  EXPECT_EQ(w[1], want);
+}
+
 // g through (0, 0), (1, 2), (3, 3): slope 2 on [0, 1], 1/2 on [1, 3],
 // continued along the end segments.
 TEST(SensorFrame, ACalibrationCurveAndItsInverse) {
@@ -280,6 +300,13 @@ TEST(SensorFrame, ACalibrationCurveAndItsInverse) {
   EXPECT_NEAR(curve_reading(g, -1.0), -2.0, 1e-12);  // below: the first segment's slope
   EXPECT_NEAR(curve_reading(g, 5.0), 4.0, 1e-12);    // above: the last's
   for (double v : {-2.0, 0.0, 0.25, 1.0, 2.9, 3.0, 7.5}) EXPECT_NEAR(curve_level(g, curve_reading(g, v)), v, 1e-12) << v;
+  // Its slope: a knot belongs to the segment above it; beyond, the end segments'.
+  EXPECT_EQ(curve_slope(g, -1.0), 2.0);
+  EXPECT_EQ(curve_slope(g, 0.0), 2.0);
+  EXPECT_EQ(curve_slope(g, 0.5), 2.0);
+  EXPECT_EQ(curve_slope(g, 1.0), 0.5);
+  EXPECT_EQ(curve_slope(g, 3.0), 0.5);
+  EXPECT_EQ(curve_slope(g, 9.0), 0.5);
   // In the frame: drift and cross-talk removed first, then the curve inverted.
   const datalog::LogTable in = drift_log();  // fc0: 1, -2, 3, 0
   SensorModel s;

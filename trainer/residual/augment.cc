@@ -805,7 +805,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     t.model = a != nullptr ? augmented_model(model, *a, seqs) : model;
     const auto states = ensure_states(t.model, seqs, before_pbs);
     if (untuned != nullptr) *untuned = t.model;
-    t.loss_history = fine_tune(t.model, seqs, states, tuning, &t.train_windows);
+    t.loss_history = fine_tune(t.model, seqs, states, tuning, &t.train_windows,
+                               reading_loss_weights(sensor, layout.y_names, seqs));
     t.model.check_consistent();
     return t;
   };

@@ -22,6 +22,15 @@ struct FineTuneOptions {
 std::vector<int> ensure_states(HadynetModel& model, const std::vector<LogSequence>& seqs,
                                const std::vector<Eigen::VectorXf>& pb_of_seq);
 
+// The weight of each target element of `seqs` (one matrix per sequence,
+// the shape of its y) that makes the fine-tuning loss, in the model's frame,
+// the loss of the readings to first order: a channel read through a curve g
+// (sensor.curves) weighs g'(level)^2 at its target's level (an error e in
+// the level is g'(level) e in the reading); every other element weighs 1.
+// Empty when the sensor model has no curve (every weight 1).
+std::vector<Eigen::MatrixXd> reading_loss_weights(const SensorModel& sensor, const std::vector<std::string>& y_names,
+                                                  const std::vector<LogSequence>& seqs);
+
 // Fine-tunes `model` on every window of `seqs` (state rows `state_rows`)
 // with batch norm frozen (eval mode: the running statistics of the original
 // training data stay; with a few hundred windows, batch statistics would move
@@ -29,9 +38,12 @@ std::vector<int> ensure_states(HadynetModel& model, const std::vector<LogSequenc
 // loss is that of the clipped output (a clipped element has zero gradient;
 // output_clip.h). Re-measures the value ranges on the windows and drops the
 // detection calibration (it belongs to the old weights). Returns the loss
-// per epoch (standardised) and sets *windows. Throws std::runtime_error for
-// fewer than 2 windows or a loss that is not finite.
+// per epoch (standardised) and sets *windows. `weights` (empty: all 1, or
+// reading_loss_weights()) weighs each target element's squared error.
+// Throws std::runtime_error for fewer than 2 windows or a loss that is not
+// finite.
 std::vector<double> fine_tune(HadynetModel& model, const std::vector<LogSequence>& seqs,
-                              const std::vector<int>& state_rows, const FineTuneOptions& options, long* windows);
+                              const std::vector<int>& state_rows, const FineTuneOptions& options, long* windows,
+                              const std::vector<Eigen::MatrixXd>& weights = {});
 
 }  // namespace hadynet::trainer::residual
