@@ -551,17 +551,22 @@ TEST(SensorFrame, TheCurveBendsOneWay) {
 // to 8 may be no steeper than the one before, so the top knot reads at
 // least 8 - 4 s3 (s3 the fitted slope below it) and stays near the body's
 // line, above the unanchored reading. A target whose top segment is flat
-// (slope 0.1: a rail's signature, the fit at its slope bound 1/4) keeps
-// the fit without the rated top, whose flat end the rail's simpler
-// account reads (flat_at_end).
+// (slope 0.1, the fit at its slope bound 1/4) where the group's channels
+// top out together (two of three within 5 % of the span: a rail's
+// signature) keeps the fit without the rated top, whose flat end the
+// rail's simpler account reads (flat_at_end); where one channel alone
+// reaches the top (one grasp's peak) it ends at the rated top.
 TEST(SensorFrame, TheCurveEndsAtTheRatedTopAndKeepsItsOrderThere) {
-  const auto fitted = [](std::optional<double> rated_top, std::string* description, double top_target = 4.2) {
+  const auto fitted = [](std::optional<double> rated_top, std::string* description, double top_target = 4.2,
+                         std::vector<double> group_tops = {4, 3.99, 2}) {
     residual::Augmentation a;
     a.kind = residual::EffectKind::kSensorCurve;
     a.channels = {"fc0"};
     auto& change = a.change.emplace<residual::CalibrationCurves>();
     change.curves = {{"fc0", {0, 1, 2, 3, 4}, {0, 1, 2, 3, 4}}};
     change.rated_top = rated_top;
+    change.group_tops = group_tops;
+    change.group_lowest = 0;
     const std::vector<double> target = {0, 2, 3, 3.9, top_target};  // readings at knots 0..4
     residual::TrainingRmse rmse;
     rmse.y_names = {"fc0", "l0"};
@@ -595,11 +600,32 @@ TEST(SensorFrame, TheCurveEndsAtTheRatedTopAndKeepsItsOrderThere) {
   const SensorCurve below = fitted(4.0, nullptr);
   EXPECT_EQ(below.level, free.level);
   EXPECT_EQ(below.reading, free.reading);
-  // A flat top: the fit without the rated top, ending at the slope bound.
+  // A flat top where the group tops out together: the fit without the
+  // rated top, ending at the slope bound.
   const SensorCurve flat = fitted(8.0, &description, 4.0);
   ASSERT_EQ(flat.level.size(), 5u);
   EXPECT_TRUE(residual::CalibrationCurves::flat_at_end(flat, +1));
   EXPECT_EQ(description.find("rated top"), std::string::npos) << description;
+  // The same fit where one channel alone reaches the top: no rail, the rated top.
+  const SensorCurve peak = fitted(8.0, &description, 4.0, {4, 3.7, 2});
+  ASSERT_EQ(peak.level, (std::vector<double>{0, 1, 2, 3, 4, 8}));
+  EXPECT_EQ(peak.reading.back(), 8.0);
+  EXPECT_NE(description.find("through the rated top 8"), std::string::npos) << description;
+}
+
+// Channels top out together when at least two of them lie within 5 % of
+// the span (from the group's lowest level to the highest top) from the
+// highest; the span, not the level, so an offset changes nothing.
+TEST(SensorFrame, ARailsChannelsTopOutTogether) {
+  using residual::CalibrationCurves;
+  EXPECT_TRUE(CalibrationCurves::tops_together({2.05, 2.04, 2.06, 0.05}, 0));
+  EXPECT_TRUE(CalibrationCurves::tops_together({10, 9.5, 3}, 0));         // 0.5 of 10: at the edge
+  EXPECT_FALSE(CalibrationCurves::tops_together({10, 9.4, 3}, 0));        // 0.6 of 10
+  EXPECT_FALSE(CalibrationCurves::tops_together({16.4, 11.7, 11.3}, 0));  // a curve set's peaks (3884)
+  EXPECT_TRUE(CalibrationCurves::tops_together({110, 109.5}, 100));       // 0.5 of a span of 10
+  EXPECT_FALSE(CalibrationCurves::tops_together({110, 109}, 100));
+  EXPECT_FALSE(CalibrationCurves::tops_together({2.05}, 0));              // one channel
+  EXPECT_FALSE(CalibrationCurves::tops_together({}, 0));
 }
 
 // A drift re-estimated at rate 0 changes nothing, so it leaves the change,

@@ -328,8 +328,20 @@ struct CalibrationCurves : ModelChange {
   // curve with a knot there that reads its own level, as a loadcell's
   // datasheet states its nonlinearity against the straight line through
   // zero and the rated output, unless the curve without it ends flat
-  // (flat_at_end: a rail's signature).
+  // (flat_at_end) where the group's channels top out together (tops_together):
+  // a rail's signature.
   std::optional<double> rated_top;
+  // The highest level of each channel of the curve's group on the rows its
+  // knots come from (plan() fills it; the model's frame, channel units).
+  std::vector<double> group_tops;
+  double group_lowest = 0;  // the group's lowest level on those rows
+  // Whether at least two of `tops` lie within 5 % of their span from the
+  // highest (the span: from `lowest`, the group's lowest level, to the
+  // highest). Sensors of one group clipped by one rail all top out there;
+  // a curve's channels top out where their grasps' peaks took them (on
+  // development sets, the second highest at 0.49-0.89 of the highest on
+  // 20 curve sets, 0.99-1.00 on 20 rail sets).
+  static bool tops_together(const std::vector<double>& tops, double lowest);
   // The other channels of the plan's group (a group extension's plan only,
   // Augmentation::group_extension): refine() fits the curve where the test
   // found it (the channels above), then gives each of these a copy of it

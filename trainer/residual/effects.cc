@@ -1020,6 +1020,13 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
                   " (piecewise linear, monotone): the logs read through its inverse, the prediction through it";
   a.found_on = a.channels;
   a.judged_on_every_channel = true;
+  for (int c = 0; c < static_cast<int>(data.y_names.size()); ++c) {
+    if (channel_group(y_name(data, c)) != group) continue;
+    const std::vector<double> v = sorted_values(data, c, true);  // the rows knot_levels reads
+    if (v.empty()) continue;
+    change.group_lowest = change.group_tops.empty() ? v.front() : std::min(change.group_lowest, v.front());
+    change.group_tops.push_back(v.back());
+  }
   if (!a.group_extension) return;
   for (int c = 0; c < static_cast<int>(data.y_names.size()); ++c) {
     const std::string& name = y_name(data, c);
@@ -1052,6 +1059,13 @@ void CalibrationCurves::add_to_sensor(SensorModel& s, const Augmentation&) const
     for (double v : level) composed.reading.push_back(curve_reading(*it, curve_reading(c, v)));
     *it = composed;
   }
+}
+
+bool CalibrationCurves::tops_together(const std::vector<double>& tops, double lowest) {
+  if (tops.size() < 2) return false;
+  const double highest = *std::max_element(tops.begin(), tops.end());
+  const double within = 0.05 * (highest - lowest);
+  return std::count_if(tops.begin(), tops.end(), [&](double t) { return highest - t <= within; }) >= 2;
 }
 
 bool CalibrationCurves::flat_at_end(const SensorCurve& curve, int side) {
@@ -1109,10 +1123,14 @@ bool CalibrationCurves::flat_at_end(const SensorCurve& curve, int side) {
 // rows of one grasp's peak, dipped below the body of the curve (stop 78:
 // 0.72 of the plant's curve at the top knot where the body read 0.81;
 // docs/residual.md, "The curve through its rated top (stop 79)"). Not
-// when the fit without it ends flat (flat_at_end): a rail's signature,
-// which the rail's simpler account reads, and which the rated top would
-// hide (a 2 N rail under a 50 N rated top: stop 79's fresh sets 3750 and
-// 3751).
+// when the fit without it ends flat (flat_at_end) where the group's
+// channels top out together (tops_together): a rail's signature, which the
+// rail's simpler account reads, and which the rated top would hide (a 2 N
+// rail under a 50 N rated top: stop 79's fresh sets 3750 and 3751). A flat
+// end where one channel alone reaches the top is one grasp's peak, and the
+// rated top holds it up (stop 83: the fit ended flat on 2 of 20
+// development curve sets and 1 of 20 rail sets; docs/residual.md, "A flat
+// top where one channel peaks (stop 83)").
 void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
                                std::vector<double>&) {
   if (curves.empty()) return;
@@ -1211,9 +1229,10 @@ void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const
   };
   fit(std::nullopt);
   // The rated top, when it lies above the channels' levels and the fit
-  // without it does not end flat there (a rail's signature, left to the
-  // rail: flat_at_end).
-  if (rated_top && *rated_top > data_knots.back() + min_gap && !flat_at_end(curves.front(), +1)) fit(rated_top);
+  // without it does not end flat where the group tops out together (a
+  // rail's signature, left to the rail: flat_at_end, tops_together).
+  const bool rail_at_top = flat_at_end(curves.front(), +1) && tops_together(group_tops, group_lowest);
+  if (rated_top && *rated_top > data_knots.back() + min_gap && !rail_at_top) fit(rated_top);
   const std::size_t n = knots.size() - (top ? 1 : 0);  // the top knot fitted
   const char* shape = slopes.front() > slopes.back()   ? "compressive"
                       : slopes.front() < slopes.back() ? "expansive"
