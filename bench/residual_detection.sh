@@ -379,7 +379,15 @@
 # 4195-4204 every effect at its larger strength, 4205-4224 saturation=2
 # and 4225-4244 sensor-curve=0.7 measured with the final code and with
 # the first change alone on the same logs; 4245-4264 clean sets,
-# 4265-4269 two effects, 4270-4279 the gain wobble. Next unused: 4280 on.
+# 4265-4269 two effects, 4270-4279 the gain wobble. Stop 83 (the
+# fine-tuning loss read through the curve; a flat top through the rated
+# top unless the group tops out together): development 3880-3899
+# sensor-curve=0.7 and the saturation=2 and friction=4 sets of 4060-4069
+# and 4100-4109; 4280-4289 every effect at its larger strength, 4290-4309
+# sensor-curve=0.7 and 4310-4329 saturation=2 measured with the final
+# code, the first change alone and stop 82's code on the same logs;
+# 4330-4349 clean sets, 4350-4354 two effects, 4355-4364 the gain wobble;
+# 4130-4139 (stop 82's) re-run with the final code. Next unused: 4365 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

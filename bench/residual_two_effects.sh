@@ -62,7 +62,8 @@
 # readout of the frame), stop 80's code and the curve of the whole group,
 # not kept (--candidates 5). Stop 82: 4190-4194 with the curve applied
 # to the rest of its group, 4265-4269 with its final code (and a curve's
-# rail asked where it was found; --candidates 5).
+# rail asked where it was found; --candidates 5). Stop 83: 4350-4354 with
+# its final code and stop 82's (--candidates 5).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]... [--decision-loss L] [--decision-scale S] [--fix-selection R]
