@@ -241,7 +241,8 @@ int run_residual(int argc, char** argv) {
   opt.repeated("rated-range", "NAME=LOW..HIGH",
                "a sensor's rated range (datasheet) for an output group or channel, e.g. fc=0..50: the predictions\n"
                "are clipped there as known before anything is searched (a rail there is not an effect), and a\n"
-               "calibration curve --fix fits ends at HIGH reading HIGH; either bound may be left out (f=0..)");
+               "calibration curve --fix fits ends at HIGH reading HIGH (unless its fit ends flat where the group's\n"
+               "channels top out together: a rail's signature); either bound may be left out (f=0..)");
   opt.value("report", "DIR", "write DIR/REPORT.md with PNG plots (gnuplot) and DIR/residual.json");
   opt.value("json", "FILE", "write every number as JSON");
   opt.flag("fix", "add the winning effect (sensor delay: time alignment, or the commands' dead time when the delay\n"
