@@ -382,8 +382,8 @@
 # 4265-4269 two effects, 4270-4279 the gain wobble. Stop 83 (the
 # fine-tuning loss read through the curve; a flat top through the rated
 # top unless the group tops out together): development 3880-3899
-# sensor-curve=0.7 and the saturation=2 and friction=4 sets of 4060-4069
-# and 4100-4109; 4280-4289 every effect at its larger strength, 4290-4309
+# sensor-curve=0.7, the saturation=2 sets of 4060-4069 and 4100-4109 and
+# the friction=4 sets of 4100-4109 (the first change only); 4280-4289 every effect at its larger strength, 4290-4309
 # sensor-curve=0.7 and 4310-4329 saturation=2 measured with the final
 # code, the first change alone and stop 82's code on the same logs;
 # 4330-4349 clean sets, 4350-4354 two effects, 4355-4364 the gain wobble;

@@ -142,7 +142,8 @@
 # applied to the rest of its group; 0 of 20), 4245-4264 with its final
 # code (and a curve's rail asked where it was found; 0 of 20). Stop 83:
 # 4330-4349 with its final code (the fine-tuning loss read through the
-# curve; 0 of 20). Next unused seed: 4365
+# curve, a flat top through the rated top unless the group tops out
+# together; 0 of 20). Next unused seed: 4365
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

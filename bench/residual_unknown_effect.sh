@@ -54,7 +54,8 @@
 # 4180-4189 (stop 82, the curve applied to the rest of its group: 0 of 10
 # confirmed); 4270-4279 (stop 82's final code, a curve's rail asked where
 # it was found: 0 of 10 confirmed); 4355-4364 (stop 83's final code, the
-# fine-tuning loss read through the curve: 0 of 10 confirmed).
+# fine-tuning loss read through the curve and a flat top through the rated
+# top unless the group tops out together: 0 of 10 confirmed).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R]

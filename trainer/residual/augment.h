@@ -339,7 +339,7 @@ struct CalibrationCurves : ModelChange {
   // highest (the span: from `lowest`, the group's lowest level, to the
   // highest). Sensors of one group clipped by one rail all top out there;
   // a curve's channels top out where their grasps' peaks took them (on
-  // development sets, the second highest at 0.49-0.89 of the highest on
+  // development sets, the second highest at 0.55-0.87 of the highest on
   // 20 curve sets, 0.99-1.00 on 20 rail sets).
   static bool tops_together(const std::vector<double>& tops, double lowest);
   // The other channels of the plan's group (a group extension's plan only,

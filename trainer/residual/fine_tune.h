@@ -39,9 +39,10 @@ std::vector<Eigen::MatrixXd> reading_loss_weights(const SensorModel& sensor, con
 // output_clip.h). Re-measures the value ranges on the windows and drops the
 // detection calibration (it belongs to the old weights). Returns the loss
 // per epoch (standardised) and sets *windows. `weights` (empty: all 1, or
-// reading_loss_weights()) weighs each target element's squared error.
-// Throws std::runtime_error for fewer than 2 windows or a loss that is not
-// finite.
+// reading_loss_weights(); each of y's shape) weighs each target element's
+// squared error. Throws std::invalid_argument when `weights` is neither
+// empty nor one matrix per sequence, std::runtime_error for fewer than 2
+// windows or a loss that is not finite.
 std::vector<double> fine_tune(HadynetModel& model, const std::vector<LogSequence>& seqs,
                               const std::vector<int>& state_rows, const FineTuneOptions& options, long* windows,
                               const std::vector<Eigen::MatrixXd>& weights = {});
