@@ -387,7 +387,8 @@
 # sensor-curve=0.7 and 4310-4329 saturation=2 measured with the final
 # code, the first change alone and stop 82's code on the same logs;
 # 4330-4349 clean sets, 4350-4354 two effects, 4355-4364 the gain wobble;
-# 4130-4139 (stop 82's) re-run with the final code. Next unused: 4365 on.
+# 4130-4139 (stop 82's) re-run with the final code; 4365-4374 every
+# effect with the final code and stop 82's code. Next unused: 4375 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

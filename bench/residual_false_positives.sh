@@ -143,7 +143,7 @@
 # code (and a curve's rail asked where it was found; 0 of 20). Stop 83:
 # 4330-4349 with its final code (the fine-tuning loss read through the
 # curve, a flat top through the rated top unless the group tops out
-# together; 0 of 20). Next unused seed: 4365
+# together; 0 of 20). Next unused seed: 4375
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
