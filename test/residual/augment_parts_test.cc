@@ -995,6 +995,65 @@ TEST(FixCandidates, TheNextRoundTriesWhatThisRoundDidNotApply) {
   EXPECT_EQ(next({}).size(), 6u);
 }
 
+// A sensor delay's steps come from its group (effects.cc, group_delay):
+// each channel votes for the steps whose delay explains most of its
+// held-out residual, and more than half of the voters for other steps than
+// the lead's move the plan there. Modelled on fresh logs with loadcells 2
+// steps late, where a 1-step delay of fc0 led the ranking.
+TEST(FixCandidates, ASensorDelaysStepsAreThoseMostOfItsGroupShow) {
+  residual::ResidualData data;
+  data.y_names = {"fc0", "fc1", "fc2", "fc3", "fc4"};
+  residual::Attribution screen;
+  // (target, steps, held-out explained share, gain, significant); every one passes Holm's test.
+  const auto add = [&](int target, int steps, double explained, double gain, bool significant) {
+    residual::HypothesisResult r;
+    r.hypothesis = {residual::EffectKind::kSensorDelay, target, -1, steps, 0, 0};
+    r.effect = "sensor-delay";
+    r.label = "delay = " + std::to_string(steps) + " on " + data.y_names[static_cast<std::size_t>(target)];
+    r.parameter = gain;
+    r.explained = explained;
+    r.p_adjusted = 1e-20;
+    r.significant = significant;
+    screen.ranked.push_back(r);
+  };
+  add(0, 1, 0.39, 0.57, true);   // the lead: fc0 nearly at rest on the null
+  add(3, 2, 0.77, 0.82, true);
+  add(4, 2, 0.67, 0.82, true);
+  add(3, 1, 0.38, 0.90, true);
+  add(0, 2, 0.41, 0.48, false);  // below the gain bound, still a vote for 2 steps
+  add(1, 2, 0.31, 0.69, false);
+  add(1, 1, 0.30, 0.68, false);
+  add(2, 1, 0.20, 0.30, false);
+  const auto first_plan = [&] {
+    const std::vector<residual::Augmentation> plans = residual::plan_candidates(data, screen, 1);
+    EXPECT_EQ(plans.size(), 1u);
+    return plans.empty() ? residual::Augmentation{} : plans.front();
+  };
+  const auto steps_of = [](const residual::Augmentation& a) {
+    const auto* alignment = std::get_if<residual::TimeAlignment>(&a.change);
+    return alignment != nullptr ? alignment->delay : -1;
+  };
+  // fc0, fc1, fc3 and fc4 (4 of 5) are best explained by 2 steps: fc3's delay leads.
+  residual::Augmentation a = first_plan();
+  EXPECT_EQ(steps_of(a), 2);
+  EXPECT_EQ(a.channels, (std::vector<std::string>{"fc3", "fc4", "fc0", "fc1"}));
+  EXPECT_NE(a.description.find("the group's delay: 2 steps explain most of 4 of fc's 5 channels"), std::string::npos)
+      << a.description;
+  // The most voters, but not more than half of them: the lead's 1 step stays.
+  screen.ranked[4].explained = 0.35;  // fc0 now votes for 1 step (0.39)
+  add(1, 3, 0.50, 0.60, false);       // fc1 for 3 steps
+  add(2, 4, 0.25, 0.40, false);       // fc2 for 4 steps: 2 steps have 2 of 5 voters
+  a = first_plan();
+  EXPECT_EQ(steps_of(a), 1);
+  EXPECT_EQ(a.description.find("the group's delay"), std::string::npos) << a.description;
+  // A majority for steps that no significant delay has leaves the lead too.
+  screen.ranked.resize(8);
+  screen.ranked[4].explained = 0.41;
+  for (std::size_t k : {1u, 2u}) screen.ranked[k].significant = false;
+  a = first_plan();
+  EXPECT_EQ(steps_of(a), 1);
+}
+
 TEST(FixCandidates, ByDefaultTheyReachDownToAShareOfOne) {
   residual::Attribution screen;
   screen.null = residual::NullCalibration{};
