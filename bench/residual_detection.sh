@@ -388,7 +388,17 @@
 # code, the first change alone and stop 82's code on the same logs;
 # 4330-4349 clean sets, 4350-4354 two effects, 4355-4364 the gain wobble;
 # 4130-4139 (stop 82's) re-run with the final code; 4365-4374 every
-# effect with the final code and stop 82's code. Next unused: 4375 on.
+# effect with the final code and stop 82's code. Stop 84 (a sensor
+# delay's steps from its group): development the stored runs of
+# 3750-4269 (the vote read off), the input-delay=2 sets of 3829, 4159
+# and 4195 and the sensor-delay=2 and input-delay=2 sets of 4060-4069 and
+# 4100-4109 (re-run), stop 83's delay sets of 4284; 4375-4384 every
+# effect at its larger strength, 4385-4404 clean sets, 4405-4409 two
+# effects, 4410-4429 sensor-delay=2 and input-delay=2 measured with the
+# final code (the vote changed no plan on any of them); stop 83's delay
+# sets of 4280-4289 and 4365-4374 re-run with the final code.
+# 4430-4439 the gain wobble (bench/residual_unknown_effect.sh). Next
+# unused: 4440 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

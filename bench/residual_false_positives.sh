@@ -143,7 +143,8 @@
 # code (and a curve's rail asked where it was found; 0 of 20). Stop 83:
 # 4330-4349 with its final code (the fine-tuning loss read through the
 # curve, a flat top through the rated top unless the group tops out
-# together; 0 of 20). Next unused seed: 4375
+# together; 0 of 20). Stop 84: 4385-4404 with its final code (a sensor
+# delay's steps from its group; 0 of 20). Next unused seed: 4440
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

@@ -55,7 +55,9 @@
 # confirmed); 4270-4279 (stop 82's final code, a curve's rail asked where
 # it was found: 0 of 10 confirmed); 4355-4364 (stop 83's final code, the
 # fine-tuning loss read through the curve and a flat top through the rated
-# top unless the group tops out together: 0 of 10 confirmed).
+# top unless the group tops out together: 0 of 10 confirmed); 4430-4439
+# (stop 84's final code, a sensor delay's steps from its group: 0 of 10
+# confirmed, 3 unexplained).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R]

@@ -93,18 +93,37 @@ void expect_every_sensor_delay_is_a_dead_time(const Outcome& o) {
     EXPECT_EQ(a.kind, EffectKind::kInputDelay) << r.label << ": " << a.description;
     EXPECT_TRUE(std::holds_alternative<DerivedCommandInputs>(a.change)) << r.label;
     EXPECT_NE(a.description.find("shows on"), std::string::npos) << a.description;
-    // Found on the first plannable significant input delay of the same steps'
-    // channels where there is one, else on the sensor delay's.
+    // At the group's steps (sensor_delay::group_delay): the lag inputs'
+    // lag<d>_ prefix. Where they differ from r's, the plan says so, and the
+    // highest ranked significant sensor delay of those steps in r's group leads.
+    const auto& inputs = std::get<DerivedCommandInputs>(a.change).inputs;
+    ASSERT_FALSE(inputs.empty()) << a.description;
+    const int d = std::stoi(inputs.front().substr(3));
+    const HypothesisResult* lead = &r;
+    if (d != r.hypothesis.delay) {
+      EXPECT_NE(a.description.find("the group's delay"), std::string::npos) << a.description;
+      for (const auto& x : o.attribution.ranked) {
+        if (!x.significant) break;
+        if (x.hypothesis.kind == EffectKind::kSensorDelay && x.hypothesis.delay == d &&
+            channel_group(name_of(o, x.hypothesis.target)) == channel_group(name_of(o, r.hypothesis.target))) {
+          lead = &x;
+          break;
+        }
+      }
+      EXPECT_NE(lead, &r) << r.label << ": no significant delay of " << d << " steps in its group";
+    }
+    // Found on the first plannable significant input delay of those steps'
+    // channels where there is one, else on the leading sensor delay's.
     std::vector<std::string> expected;
     for (const auto& x : o.attribution.ranked) {
       if (!x.significant) break;
-      if (x.hypothesis.kind != EffectKind::kInputDelay || x.hypothesis.delay != r.hypothesis.delay) continue;
+      if (x.hypothesis.kind != EffectKind::kInputDelay || x.hypothesis.delay != d) continue;
       if (!why_not_fixable(o.data, o.attribution, x).empty()) continue;
       for (const auto& f : o.attribution.family_of(x)) expected.push_back(name_of(o, f.hypothesis.target));
       break;
     }
     if (expected.empty())
-      for (const auto& f : o.attribution.family_of(r)) expected.push_back(name_of(o, f.hypothesis.target));
+      for (const auto& f : o.attribution.family_of(*lead)) expected.push_back(name_of(o, f.hypothesis.target));
     EXPECT_EQ(a.found_on, expected) << r.label << ": " << a.description;
   }
   EXPECT_TRUE(seen) << "no sensor delay is significant";
