@@ -17,10 +17,12 @@
 #include <cstdio>
 #include <iterator>
 #include <map>
+#include <optional>
 #include <set>
 #include <variant>
 
 #include "datalog/log_reader.h"
+#include "trainer/derived_inputs.h"
 #include "test/residual/plant_logs.h"
 #include "trainer/derived_inputs.h"
 #include "trainer/residual/analysis.h"
@@ -98,7 +100,9 @@ void expect_every_sensor_delay_is_a_dead_time(const Outcome& o) {
     // highest ranked significant sensor delay of those steps in r's group leads.
     const auto& inputs = std::get<DerivedCommandInputs>(a.change).inputs;
     ASSERT_FALSE(inputs.empty()) << a.description;
-    const int d = std::stoi(inputs.front().substr(3));
+    const std::optional<trainer::DerivedInput> lag = trainer::parse_derived_input(inputs.front());
+    ASSERT_TRUE(lag && lag->kind == trainer::DerivedKind::kLag) << inputs.front();
+    const int d = lag->lag;
     const HypothesisResult* lead = &r;
     if (d != r.hypothesis.delay) {
       EXPECT_NE(a.description.find("the group's delay"), std::string::npos) << a.description;
