@@ -613,6 +613,63 @@ TEST(SensorFrame, TheCurveEndsAtTheRatedTopAndKeepsItsOrderThere) {
   EXPECT_NE(description.find("through the rated top 8"), std::string::npos) << description;
 }
 
+// The curve refitted half-way through fine-tuning (CalibrationCurves::refit)
+// starts from the slopes refine() fitted on the unchanged network and keeps
+// its knots, its rated top and its shape. Two faked probes, each the squared
+// distance of fc0's readings at knots 1..4 from a compressive target: the
+// unchanged network's, which prefers the flatter readings 1.6, 2.6, 3.4, 4
+// (slopes 1.6, 1, 0.8, 0.6: a curve learnt partly by the network), and
+// the fine-tuned network's, which prefers the plant's 2, 3.4, 4.5, 5.4.
+// The refit moves every reading from the first fit toward the second
+// target; the curve ends at the rated top 8 as before, and the segment up
+// to it keeps the order. The refit runs on every curve of the change, and
+// the description says so.
+TEST(SensorFrame, TheCurveIsRefittedFromItsSlopesOnTheFineTunedNetwork) {
+  residual::Augmentation a;
+  a.kind = residual::EffectKind::kSensorCurve;
+  a.channels = {"fc0", "fc1"};
+  auto& change = a.change.emplace<residual::CalibrationCurves>();
+  change.curves = {{"fc0", {0, 1, 2, 3, 4}, {0, 1, 2, 3, 4}}, {"fc1", {0, 1, 2, 3, 4}, {0, 1, 2, 3, 4}}};
+  change.rated_top = 8.0;
+  change.group_tops = {4, 3, 2};
+  const auto probe_least_at = [](std::vector<double> target) {  // readings at knots 1..4
+    residual::TrainingRmse rmse;
+    rmse.y_names = {"fc0", "l0"};
+    rmse.all = [target](const SensorModel& s) {
+      Eigen::VectorXd e = Eigen::VectorXd::Ones(2);
+      if (const SensorCurve* c = s.curve_of("fc0"))
+        for (std::size_t k = 1; k <= target.size(); ++k) e(1) += std::pow(c->reading[k] - target[k - 1], 2);
+      return e;
+    };
+    return rmse;
+  };
+  const std::vector<double> unchanged = {1.6, 2.6, 3.4, 4.0}, tuned = {2.0, 3.4, 4.5, 5.4};
+  std::vector<double> rates;
+  change.refine(a, SensorModel{}, probe_least_at(unchanged), rates);
+  ASSERT_TRUE(change.through_rated_top);
+  const SensorCurve first = change.curves.front();
+  ASSERT_EQ(first.level, (std::vector<double>{0, 1, 2, 3, 4, 8}));
+  change.refit(a, SensorModel{}, probe_least_at(tuned), 10);
+  ASSERT_EQ(change.curves.size(), 2u);
+  const SensorCurve& refitted = change.curves.front();
+  EXPECT_EQ(change.curves[1].reading, refitted.reading);  // one curve for the plan's channels
+  ASSERT_EQ(refitted.level, first.level);
+  EXPECT_EQ(refitted.reading.front(), 0.0);  // anchored at its lowest knot
+  EXPECT_EQ(refitted.reading.back(), 8.0);   // through the rated top
+  for (std::size_t k = 1; k <= 4; ++k) {
+    // Closer to the tuned network's target than the first fit (which sat
+    // within 0.3 of the unchanged network's: the targets differ by 0.4-1.4).
+    EXPECT_LT(std::abs(refitted.reading[k] - tuned[k - 1]), std::abs(first.reading[k] - tuned[k - 1])) << k;
+    EXPECT_GT(refitted.reading[k], first.reading[k]) << k;
+  }
+  std::vector<double> slopes;
+  for (std::size_t k = 1; k < refitted.level.size(); ++k)
+    slopes.push_back((refitted.reading[k] - refitted.reading[k - 1]) / (refitted.level[k] - refitted.level[k - 1]));
+  for (std::size_t k = 1; k < slopes.size(); ++k) EXPECT_LE(slopes[k], slopes[k - 1] + 1e-9) << k;  // compressive
+  EXPECT_NE(a.description.find("; refitted after 10 epochs of fine-tuning: 5 knots"), std::string::npos)
+      << a.description;
+}
+
 // Channels top out together when at least two of them lie within 5 % of
 // the span (from the group's lowest level to the highest top) from the
 // highest; the span, not the level, so an offset changes nothing.

@@ -352,7 +352,7 @@ TEST(ResidualFix, TheUntunedChangeFineTunedIsTheFixedModel) {
   }
   const std::vector<int> rows = ensure_states(control, seqs, pbs);
   long windows = 0;
-  fine_tune(control, seqs, rows, {defaults.epochs, defaults.batch, defaults.lr, defaults.seed}, &windows);
+  fine_tune(control, seqs, rows, {defaults.epochs, defaults.batch, defaults.lr, defaults.seed, 1}, &windows);
   EXPECT_TRUE(trainer::testing::bit_identical(control.params, first.fix.model.params));
   EXPECT_FALSE(trainer::testing::bit_identical(first.fix.untuned.params, first.fix.model.params));
 }

@@ -171,5 +171,40 @@ TEST(ResidualFineTune, AWeightedChannelIsFittedCloser) {
   EXPECT_THROW(fine_tune(ones, seqs, rows, options, nullptr, short_list), std::invalid_argument);
 }
 
+// A fine-tuning run in two parts (fix(): a calibration curve refitted
+// between them) is the uninterrupted run, bit for bit, when the second
+// part continues the first's optimiser (FineTuneState) and its epoch
+// numbers (FineTuneOptions::first_epoch: the same window order). With a
+// fresh optimiser in the second part it is not: Adam's restart alone
+// changes the weights, which would let a change that does nothing (a
+// curve refitted as the identity) differ from the control.
+TEST(ResidualFineTune, ARunInPartsWithItsOptimiserCarriedIsOneRun) {
+  trainer::HadynetModel whole = spring_model();
+  std::vector<trainer::LogSequence> seqs;
+  std::vector<Eigen::VectorXf> pbs;
+  for (const LogInput& l : spring_logs(0)) {
+    seqs.push_back(trainer::log_sequence(l.table, l.file, whole.layout));
+    pbs.push_back(whole.params.pb.row(whole.state_index("soft")).transpose());
+  }
+  const std::vector<int> rows = ensure_states(whole, seqs, pbs);
+  trainer::HadynetModel parts = whole, restarted = whole;
+  FineTuneOptions options;
+  options.epochs = 6;
+  const std::vector<double> history = fine_tune(whole, seqs, rows, options, nullptr);
+  FineTuneOptions first = options, second = options;
+  first.epochs = 2;
+  second.epochs = 4;
+  second.first_epoch = 3;
+  FineTuneState optimiser;
+  std::vector<double> in_parts = fine_tune(parts, seqs, rows, first, nullptr, {}, &optimiser);
+  EXPECT_FALSE(optimiser.adam.t.empty());
+  for (const double l : fine_tune(parts, seqs, rows, second, nullptr, {}, &optimiser)) in_parts.push_back(l);
+  EXPECT_TRUE(tt::bit_identical(whole.params, parts.params));
+  EXPECT_EQ(history, in_parts);
+  fine_tune(restarted, seqs, rows, first, nullptr);
+  fine_tune(restarted, seqs, rows, second, nullptr);
+  EXPECT_FALSE(tt::bit_identical(whole.params, restarted.params));
+}
+
 }  // namespace
 }  // namespace hadynet::test

@@ -352,6 +352,17 @@ struct CalibrationCurves : ModelChange {
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;
   void refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
               std::vector<double>& fitted);
+  // Whether refine() ended the curve at rated_top (its last knot).
+  bool through_rated_top = false;
+  // fix(), half-way through fine-tuning: the curve refine() fitted, searched
+  // again from its slopes (same knots, bounds and shape) on the network
+  // fine-tuned so far (`tuned_rmse`: that network's error on the training
+  // rows; `tuned_epochs`: its epochs, for the description). refine() fits
+  // on the unchanged network, which learnt part of the curve from the
+  // curved data and preferred a flatter curve than the plant's; fine-tuning
+  // cannot move the curve afterwards (docs/residual.md, "The curve refitted
+  // on the fine-tuned network").
+  void refit(Augmentation& a, const SensorModel& before, const TrainingRmse& tuned_rmse, int tuned_epochs);
   bool carried_before_tuning() const { return true; }  // refine() fitted it
   // Whether the curve's end segment on `side` (+1 its top, -1 its bottom)
   // is as flat as refine() may fit it: a further step of its search
@@ -722,6 +733,9 @@ struct FixResult {
   // ensure_states()); valid if tried. Fine-tuning it as fix() does gives
   // `model` again, so a round that starts from it has the last round's model
   // as its control (tested: ResidualFix.TheUntunedChangeFineTunedIsTheFixedModel).
+  // A calibration curve holds the curve as refitted during fine-tuning
+  // (CalibrationCurves::refit): fine-tuned in one run, it is close to
+  // `model` but not the same bit for bit.
   HadynetModel untuned;
   HeldOutError before, after;  // after: the augmented model (valid if tried)
   std::vector<std::string> confirmation_channels;  // where the effect was found (the test's channels)

@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <map>
 #include <optional>
@@ -1029,6 +1030,114 @@ void push_distinct_knot(std::vector<double>& knots, double level, double min_gap
     knots.push_back(level);
 }
 
+// The segment slopes of one curve that every curve of `curves` takes (one
+// knot vector, CalibrationCurves::refine), and their coordinate search.
+// A segment's slope stays within kMinSlope..kMaxSlope of the identity's:
+// beyond, the search fitted the noise of a loadcell at rest (slopes of
+// 1/64 on seed-1 development logs) without a better fit on fresh ones.
+// The curve stays anchored at its lowest knot (reading[0] = knots[0]).
+struct SlopeSearch {
+  SlopeSearch(std::vector<SensorCurve>& searched_curves, std::function<double()> loss_of_curves)
+      : curves(searched_curves), loss(std::move(loss_of_curves)) {}
+
+  std::vector<SensorCurve>& curves;
+  std::function<double()> loss;  // the criterion at the curves as they are set
+  std::vector<double> knots;
+  std::optional<double> top;  // the curve's rated top, when it has one: its last knot, reading its own level
+  std::size_t searched = 0;   // the segments searched (the last one follows from the rated top)
+  std::vector<double> slopes;
+
+  // Every curve on `data_knots` (and `rated`, the last knot, when given) as the identity.
+  void place_knots(const std::vector<double>& data_knots, std::optional<double> rated) {
+    top = rated;
+    knots = data_knots;
+    if (top) knots.push_back(*top);
+    for (SensorCurve& c : curves) {
+      c.level = knots;
+      c.reading = knots;
+    }
+    searched = knots.size() - 1 - (top ? 1 : 0);
+    set_identity();
+  }
+  // The search's slopes from curves.front() as it reads (knots and top as set).
+  void read_slopes() {
+    const SensorCurve& c = curves.front();
+    slopes.resize(searched);
+    for (std::size_t k = 1; k <= searched; ++k) slopes[k - 1] = (c.reading[k] - c.reading[k - 1]) / (knots[k] - knots[k - 1]);
+  }
+  void set_identity() { set(std::vector<double>(searched, 1.0)); }
+  void set(const std::vector<double>& s) {
+    slopes = s;
+    for (SensorCurve& c : curves) {
+      for (std::size_t k = 1; k <= searched; ++k)
+        c.reading[k] = c.reading[k - 1] + slopes[k - 1] * (knots[k] - knots[k - 1]);
+      if (top) c.reading.back() = *top;
+    }
+  }
+  double last_slope() const {
+    const std::size_t n = knots.size();
+    return (curves.front().reading[n - 1] - curves.front().reading[n - 2]) / (knots[n - 1] - knots[n - 2]);
+  }
+  // One search from the slopes as they are (their loss: `start`), kept in
+  // order: `shape` -1 non-increasing (a compressive curve, concave), +1
+  // non-decreasing (an expansive one, convex). Each slope times each of
+  // kSlopeFactors is tried, kept where the loss falls; sweeps until one
+  // changes nothing, at most 6. Returns the loss reached.
+  double run(int shape, double start) {
+    double best = start;
+    const auto in_order = [&](std::size_t k, double s) {
+      const bool below_left = k == 0 || shape * (s - slopes[k - 1]) >= 0;
+      const bool above_right = k + 1 == slopes.size() || shape * (slopes[k + 1] - s) >= 0;
+      return below_left && above_right;
+    };
+    // With the rated top: the last segment's slope (set by the others) within the bounds and in order.
+    const auto anchor_ok = [&] {
+      if (!top) return true;
+      const double s = last_slope();
+      return s >= kMinSlope && s <= kMaxSlope && shape * (s - slopes.back()) >= 0;
+    };
+    bool changed = true;
+    for (int sweep = 0; sweep < 6 && changed; ++sweep) {
+      changed = false;
+      for (std::size_t k = 0; k < slopes.size(); ++k) {
+        const double kept = slopes[k];
+        double best_slope = kept;
+        for (double f : kSlopeFactors) {
+          const double s = kept * f;
+          if (s < kMinSlope || s > kMaxSlope || !in_order(k, s)) continue;
+          std::vector<double> trial = slopes;
+          trial[k] = s;
+          set(trial);
+          if (!anchor_ok()) continue;
+          const double l = loss();
+          if (l < best) best = l, best_slope = s, changed = true;
+        }
+        std::vector<double> kept_slopes = slopes;
+        kept_slopes[k] = best_slope;
+        set(kept_slopes);
+      }
+    }
+    return best;
+  }
+  // "N knots, slope .. at .. .. slope .. at .., reads .. at .. (shape)[, through the rated top ..]".
+  std::string describe() const {
+    const std::size_t n = knots.size() - (top ? 1 : 0);  // the top knot fitted
+    const char* shape = slopes.front() > slopes.back()   ? "compressive"
+                        : slopes.front() < slopes.back() ? "expansive"
+                                                         : "straight";
+    char text[192];
+    std::snprintf(text, sizeof text, "%zu knots, slope %.3g at %.4g .. %.3g at %.4g, reads %.4g at %.4g (%s)", n,
+                  slopes.front(), knots.front(), slopes.back(), knots[n - 1], curves.front().reading[n - 1],
+                  knots[n - 1], shape);
+    std::string out = text;
+    if (top) {
+      std::snprintf(text, sizeof text, ", through the rated top %.4g", *top);
+      out += text;
+    }
+    return out;
+  }
+};
+
 // The knots of a channel's curve: 9 quantiles (0, 1/8, .., 1) of its values
 // in the first half of each log (inside the fix's training rows, the first
 // 60 %); a quantile within 1e-4 of the values' range above the last knot,
@@ -1196,102 +1305,35 @@ bool CalibrationCurves::flat_at_end(const SensorCurve& curve, int side) {
 // end where one channel alone reaches the top is one grasp's peak, and the
 // rated top holds it up (stop 83: the fit ended flat on 2 of 20
 // development curve sets and 1 of 20 rail sets; docs/residual.md, "A flat
-// top where one channel peaks (stop 83)").
+// top where one channel peaks (stop 83)"). fix() refits the curve during
+// fine-tuning (refit): the unchanged network, trained on the curved data,
+// prefers a flatter curve than the plant's.
 void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
                                std::vector<double>&) {
   if (curves.empty()) return;
-  // A segment's slope stays within kMinSlope..kMaxSlope of the identity's:
-  // beyond, the search fitted the noise of a loadcell at rest (slopes of
-  // 1/64 on seed-1 development logs) without a better fit on fresh ones.
-  using sensor_curve::kMaxSlope, sensor_curve::kMinSlope, sensor_curve::kSlopeFactors;
   const auto& criterion = training_rmse.windows ? training_rmse.windows : training_rmse.all;
   const Eigen::ArrayXd rmse_before = criterion(before).array().max(1e-12);
   std::vector<double> union_levels;
   for (const SensorCurve& c : curves) union_levels.insert(union_levels.end(), c.level.begin(), c.level.end());
   std::sort(union_levels.begin(), union_levels.end());
   const double min_gap = 1e-4 * (union_levels.back() - union_levels.front());
-  std::vector<double> knots;
-  for (double v : union_levels) sensor_curve::push_distinct_knot(knots, v, min_gap);
-  const std::vector<double> data_knots = knots;
-  std::optional<double> top;  // the fit's rated top, when it has one: its last knot, reading its own level
-  std::size_t searched = 0;   // the segments searched (the last one follows from the rated top)
-  std::vector<double> slopes;
-  const auto set_slopes = [&] {
-    for (SensorCurve& c : curves) {
-      for (std::size_t k = 1; k <= searched; ++k)
-        c.reading[k] = c.reading[k - 1] + slopes[k - 1] * (knots[k] - knots[k - 1]);
-      if (top) c.reading.back() = *top;
-    }
-  };
-  const auto last_slope = [&] {
-    const std::size_t n = knots.size();
-    return (curves.front().reading[n - 1] - curves.front().reading[n - 2]) / (knots[n - 1] - knots[n - 2]);
-  };
-  const auto loss = [&] { return (criterion(sensor_after(before, a)).array() / rmse_before).square().sum(); };
+  std::vector<double> data_knots;
+  for (double v : union_levels) sensor_curve::push_distinct_knot(data_knots, v, min_gap);
+  sensor_curve::SlopeSearch search(curves, [&] {
+    return (criterion(sensor_after(before, a)).array() / rmse_before).square().sum();
+  });
   // The identity (with or without the rated top: it reads every level as it is).
-  for (SensorCurve& c : curves) {
-    c.level = knots;
-    c.reading = knots;
-  }
-  const double at_identity = loss();  // each search's start: one probe of the network, not two
-  // One search from the identity with the segment slopes kept in order:
-  // `shape` -1 non-increasing (a compressive curve, concave), +1
-  // non-decreasing (an expansive one, convex). Returns the loss reached.
-  const auto search = [&](int shape) {
-    std::fill(slopes.begin(), slopes.end(), 1.0);
-    set_slopes();
-    double best = at_identity;
-    const auto in_order = [&](std::size_t k, double s) {
-      const bool below_left = k == 0 || shape * (s - slopes[k - 1]) >= 0;
-      const bool above_right = k + 1 == slopes.size() || shape * (slopes[k + 1] - s) >= 0;
-      return below_left && above_right;
-    };
-    // With the rated top: the last segment's slope (set by the others) within the bounds and in order.
-    const auto anchor_ok = [&] {
-      if (!top) return true;
-      const double s = last_slope();
-      return s >= kMinSlope && s <= kMaxSlope && shape * (s - slopes.back()) >= 0;
-    };
-    bool changed = true;
-    for (int sweep = 0; sweep < 6 && changed; ++sweep) {
-      changed = false;
-      for (std::size_t k = 0; k < slopes.size(); ++k) {
-        const double kept = slopes[k];
-        double best_slope = kept;
-        for (double f : kSlopeFactors) {
-          const double s = kept * f;
-          if (s < kMinSlope || s > kMaxSlope || !in_order(k, s)) continue;
-          slopes[k] = s;
-          set_slopes();
-          if (!anchor_ok()) continue;
-          const double l = loss();
-          if (l < best) best = l, best_slope = s, changed = true;
-        }
-        slopes[k] = best_slope;
-        set_slopes();
-      }
-    }
-    return best;
-  };
+  search.place_knots(data_knots, std::nullopt);
+  const double at_identity = search.loss();  // each search's start: one probe of the network, not two
   // The curve on the channels' knots, ending at `rated` when given: both
-  // shapes searched, the lower loss kept.
+  // shapes searched from the identity, the lower loss kept.
   const auto fit = [&](std::optional<double> rated) {
-    top = rated;
-    knots = data_knots;
-    if (top) knots.push_back(*top);
-    for (SensorCurve& c : curves) {  // reading[0] stays at the lowest knot: the curve's anchor
-      c.level = knots;
-      c.reading = knots;
-    }
-    searched = knots.size() - 1 - (top ? 1 : 0);
-    slopes.assign(searched, 1.0);  // the identity
-    const double compressive = search(-1);
-    const std::vector<double> compressive_slopes = slopes;
-    const double expansive = search(+1);
-    if (compressive <= expansive) {
-      slopes = compressive_slopes;
-      set_slopes();
-    }
+    search.place_knots(data_knots, rated);
+    const double compressive = search.run(-1, at_identity);
+    const std::vector<double> compressive_slopes = search.slopes;
+    search.set_identity();
+    const double expansive = search.run(+1, at_identity);
+    if (compressive <= expansive) search.set(compressive_slopes);
   };
   fit(std::nullopt);
   // The rated top, when it lies above the channels' levels and the fit
@@ -1299,20 +1341,8 @@ void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const
   // rail's signature, left to the rail: flat_at_end, tops_together).
   const bool rail_at_top = flat_at_end(curves.front(), +1) && tops_together(group_tops, group_lowest);
   if (rated_top && *rated_top > data_knots.back() + min_gap && !rail_at_top) fit(rated_top);
-  const std::size_t n = knots.size() - (top ? 1 : 0);  // the top knot fitted
-  const char* shape = slopes.front() > slopes.back()   ? "compressive"
-                      : slopes.front() < slopes.back() ? "expansive"
-                                                       : "straight";
-  char text[192];
-  std::snprintf(text, sizeof text,
-                "; re-estimated: one curve, %zu knots, slope %.3g at %.4g .. %.3g at %.4g, reads %.4g at %.4g (%s)", n,
-                slopes.front(), knots.front(), slopes.back(), knots[n - 1], curves.front().reading[n - 1], knots[n - 1],
-                shape);
-  a.description += text;
-  if (top) {
-    std::snprintf(text, sizeof text, ", through the rated top %.4g", *top);
-    a.description += text;
-  }
+  through_rated_top = search.top.has_value();
+  a.description += "; re-estimated: one curve, " + search.describe();
   // The rest of the group takes the fitted curve (applied_to).
   if (applied_to.empty()) return;
   for (const std::string& channel : applied_to) {
@@ -1323,6 +1353,44 @@ void CalibrationCurves::refine(Augmentation& a, const SensorModel& before, const
   }
   a.description += "; applied to the rest of its group: " + join(applied_to);
   applied_to.clear();
+}
+
+// The loss as refine()'s, each channel relative to its error with the
+// curve as it stands (the fine-tuned network has no error "before the
+// curve"); the search from the curve's slopes in its shape, a straight
+// curve both ways.
+void CalibrationCurves::refit(Augmentation& a, const SensorModel& before, const TrainingRmse& tuned_rmse,
+                              int tuned_epochs) {
+  if (curves.empty() || curves.front().level.size() < 2) return;
+  const auto& criterion = tuned_rmse.windows ? tuned_rmse.windows : tuned_rmse.all;
+  const Eigen::ArrayXd at_fit = criterion(sensor_after(before, a)).array().max(1e-12);
+  sensor_curve::SlopeSearch search(curves, [&] {
+    return (criterion(sensor_after(before, a)).array() / at_fit).square().sum();
+  });
+  // The fitted curve's knots (the last at the rated top when it ends there) and slopes.
+  search.knots = curves.front().level;
+  if (through_rated_top) search.top = search.knots.back();
+  search.searched = search.knots.size() - 1 - (search.top ? 1 : 0);
+  search.read_slopes();
+  const std::vector<double> fitted = search.slopes;
+  const double start = static_cast<double>(at_fit.size());  // every channel at its error with the fitted curve
+  // The fitted curve's shape; a straight one may bend either way (the lower loss kept).
+  const int shape = fitted.front() > fitted.back() ? -1 : fitted.front() < fitted.back() ? +1 : 0;
+  if (shape != 0) {
+    search.run(shape, start);
+  } else {
+    const double compressive = search.run(-1, start);
+    const std::vector<double> compressive_slopes = search.slopes;
+    search.set(fitted);
+    const double expansive = search.run(+1, start);
+    if (compressive <= expansive) search.set(compressive_slopes);
+  }
+  // The last refit's description replaces an earlier one's.
+  const std::size_t earlier = a.description.find("; refitted after ");
+  if (earlier != std::string::npos) a.description.erase(earlier);
+  char epochs[48];
+  std::snprintf(epochs, sizeof epochs, "; refitted after %d epochs of fine-tuning: ", tuned_epochs);
+  a.description += epochs + search.describe();
 }
 
 namespace {

@@ -50,7 +50,7 @@ std::vector<Eigen::MatrixXd> reading_loss_weights(const SensorModel& sensor, con
 
 std::vector<double> fine_tune(HadynetModel& model, const std::vector<LogSequence>& seqs,
                               const std::vector<int>& state_rows, const FineTuneOptions& o, long* windows,
-                              const std::vector<Eigen::MatrixXd>& weights) {
+                              const std::vector<Eigen::MatrixXd>& weights, FineTuneState* resume) {
   if (!weights.empty() && weights.size() != seqs.size())
     throw std::invalid_argument("fine_tune: one weight matrix per sequence expected");
   const WindowDataset data(seqs, state_rows, model.layout, model.norm, model.train_steps);
@@ -58,13 +58,14 @@ std::vector<double> fine_tune(HadynetModel& model, const std::vector<LogSequence
   std::iota(ids.begin(), ids.end(), 0);
   if (ids.size() < 2) throw std::runtime_error("--fix: the training part of the logs holds fewer than 2 windows");
   Adam<float> adam(Adam<float>::Options{o.lr, 0.9, 0.999, 1e-8}, GroupSet::all().without(ParamGroup::kEncoderBn));
+  if (resume != nullptr && !resume->adam.t.empty()) adam.set_state(resume->adam);
   HadynetNetwork<float> net;
   HadynetGrads<float> grads;
   WindowBatch<float> batch;
   Matrix<float> y, y_hat, d_y, w;
   std::vector<double> history;
   const auto batch_size = static_cast<std::size_t>(std::max(1, o.batch));
-  for (int epoch = 1; epoch <= o.epochs; ++epoch) {
+  for (int epoch = o.first_epoch; epoch < o.first_epoch + o.epochs; ++epoch) {
     const std::vector<int> order = epoch_order(ids, o.seed, epoch);
     double sum = 0;
     int batches = 0;
@@ -98,6 +99,7 @@ std::vector<double> fine_tune(HadynetModel& model, const std::vector<LogSequence
     history.push_back(sum / batches);
     if (!std::isfinite(history.back())) throw std::runtime_error("--fix: fine-tuning diverged (loss not finite)");
   }
+  if (resume != nullptr) resume->adam = adam.state();
   ValueRanges ranges = measure_ranges(model, data, ids);
   ranges.source = "hadynet residual --fix: training part of " + std::to_string(seqs.size()) + " logs";
   model.ranges = ranges;

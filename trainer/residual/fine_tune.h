@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "trainer/hadynet_model.h"
+#include "trainer/optim.h"
 
 namespace hadynet::trainer::residual {
 
@@ -15,6 +16,20 @@ struct FineTuneOptions {
   int batch = 100;         // windows per Adam step
   double lr = 1e-3;        // Adam
   std::uint64_t seed = 1;  // window order: epoch_order(seed, epoch)
+  // The first epoch's number (epochs first_epoch .. first_epoch + epochs - 1):
+  // a fine-tuning continued after k epochs starts at k + 1, so its windows
+  // come in the order the uninterrupted run's later epochs would take.
+  int first_epoch = 1;
+};
+
+// Where a fine-tuning stopped: the optimiser's moments and step counts
+// (Adam::State). fine_tune() given one continues from it (none yet: it
+// starts afresh) and leaves its own end there, so a fine-tuning run in
+// parts (the data re-read between them, FineTuneOptions::first_epoch
+// numbering the epochs on) is the same as one run where nothing changed
+// between the parts.
+struct FineTuneState {
+  Adam<float>::State adam;
 };
 
 // Adds a PB row for every state of `seqs` the model does not know, started
@@ -42,9 +57,10 @@ std::vector<Eigen::MatrixXd> reading_loss_weights(const SensorModel& sensor, con
 // reading_loss_weights(); each of y's shape) weighs each target element's
 // squared error. Throws std::invalid_argument when `weights` is neither
 // empty nor one matrix per sequence, std::runtime_error for fewer than 2
-// windows or a loss that is not finite.
+// windows or a loss that is not finite. `resume` (nullptr: a fresh
+// optimiser): the optimiser's state to continue from, set to its end.
 std::vector<double> fine_tune(HadynetModel& model, const std::vector<LogSequence>& seqs,
                               const std::vector<int>& state_rows, const FineTuneOptions& options, long* windows,
-                              const std::vector<Eigen::MatrixXd>& weights = {});
+                              const std::vector<Eigen::MatrixXd>& weights = {}, FineTuneState* resume = nullptr);
 
 }  // namespace hadynet::trainer::residual
