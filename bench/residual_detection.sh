@@ -397,8 +397,15 @@
 # effects, 4410-4429 sensor-delay=2 and input-delay=2 measured with the
 # final code (the vote changed no plan on any of them); stop 83's delay
 # sets of 4280-4289 and 4365-4374 re-run with the final code.
-# 4430-4439 the gain wobble (bench/residual_unknown_effect.sh). Next
-# unused: 4440 on.
+# 4430-4439 the gain wobble (bench/residual_unknown_effect.sh). Stop 85
+# (the curve refitted during fine-tuning): development 3880-3899
+# sensor-curve=0.7 and the saturation=2 sets of 4060-4069 and 4100-4109;
+# 4440-4449 every effect at its larger strength and 4450-4469
+# sensor-curve=0.7 measured with the final code, and stop 84's code
+# re-run on the sets where a curve was fine-tuned; the every-effect sets
+# of 4280-4289, 4365-4374 and 4375-4384 where a curve was fine-tuned
+# re-run with the final code; 4470-4489 clean sets, 4490-4494 two
+# effects, 4495-4504 the gain wobble. Next unused: 4505 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -144,7 +144,9 @@
 # 4330-4349 with its final code (the fine-tuning loss read through the
 # curve, a flat top through the rated top unless the group tops out
 # together; 0 of 20). Stop 84: 4385-4404 with its final code (a sensor
-# delay's steps from its group; 0 of 20). Next unused seed: 4440
+# delay's steps from its group; 0 of 20). Stop 85: 4470-4489 with its
+# final code (the curve refitted during fine-tuning; 0 of 20). Next
+# unused seed: 4505
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

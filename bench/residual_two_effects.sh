@@ -65,6 +65,8 @@
 # rail asked where it was found; --candidates 5). Stop 83: 4350-4354 with
 # its final code and stop 82's (--candidates 5). Stop 84: 4405-4409 with
 # its final code (a sensor delay's steps from its group; --candidates 5).
+# Stop 85: 4490-4494 with its final code and stop 84's (the curve
+# refitted during fine-tuning; --candidates 5).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]... [--decision-loss L] [--decision-scale S] [--fix-selection R]
