@@ -138,15 +138,27 @@ Eigen::VectorXd window_mse(const trainer::HadynetModel& model, const std::vector
 // from the same start on the same windows. Tolerance: q0's error at most
 // 0.8 of the plain fine-tune's (a 25-fold weight on one of four channels;
 // the plain loss leaves q0 at its share of the fit).
-TEST(ResidualFineTune, AWeightedChannelIsFittedCloser) {
-  trainer::HadynetModel plain = spring_model();
+// The spring model and the spring logs of seed 0 as fine_tune() takes them
+// (every log with the trained "soft" state's PB row).
+struct SpringFineTune {
+  trainer::HadynetModel model = spring_model();
   std::vector<trainer::LogSequence> seqs;
-  std::vector<Eigen::VectorXf> pbs;
-  for (const LogInput& l : spring_logs(0)) {
-    seqs.push_back(trainer::log_sequence(l.table, l.file, plain.layout));
-    pbs.push_back(plain.params.pb.row(plain.state_index("soft")).transpose());
+  std::vector<int> rows;
+  SpringFineTune() {
+    std::vector<Eigen::VectorXf> pbs;
+    for (const LogInput& l : spring_logs(0)) {
+      seqs.push_back(trainer::log_sequence(l.table, l.file, model.layout));
+      pbs.push_back(model.params.pb.row(model.state_index("soft")).transpose());
+    }
+    rows = ensure_states(model, seqs, pbs);
   }
-  const std::vector<int> rows = ensure_states(plain, seqs, pbs);
+};
+
+TEST(ResidualFineTune, AWeightedChannelIsFittedCloser) {
+  SpringFineTune spring;
+  trainer::HadynetModel plain = spring.model;
+  const std::vector<trainer::LogSequence>& seqs = spring.seqs;
+  const std::vector<int>& rows = spring.rows;
   trainer::HadynetModel ones = plain;
   trainer::HadynetModel weighted = plain;
   const auto q0 = static_cast<Eigen::Index>(
@@ -179,14 +191,10 @@ TEST(ResidualFineTune, AWeightedChannelIsFittedCloser) {
 // changes the weights, which would let a change that does nothing (a
 // curve refitted as the identity) differ from the control.
 TEST(ResidualFineTune, ARunInPartsWithItsOptimiserCarriedIsOneRun) {
-  trainer::HadynetModel whole = spring_model();
-  std::vector<trainer::LogSequence> seqs;
-  std::vector<Eigen::VectorXf> pbs;
-  for (const LogInput& l : spring_logs(0)) {
-    seqs.push_back(trainer::log_sequence(l.table, l.file, whole.layout));
-    pbs.push_back(whole.params.pb.row(whole.state_index("soft")).transpose());
-  }
-  const std::vector<int> rows = ensure_states(whole, seqs, pbs);
+  SpringFineTune spring;
+  trainer::HadynetModel whole = spring.model;
+  const std::vector<trainer::LogSequence>& seqs = spring.seqs;
+  const std::vector<int>& rows = spring.rows;
   trainer::HadynetModel parts = whole, restarted = whole;
   FineTuneOptions options;
   options.epochs = 6;
