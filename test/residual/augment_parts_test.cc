@@ -613,7 +613,7 @@ TEST(SensorFrame, TheCurveEndsAtTheRatedTopAndKeepsItsOrderThere) {
   EXPECT_NE(description.find("through the rated top 8"), std::string::npos) << description;
 }
 
-// The curve refitted half-way through fine-tuning (CalibrationCurves::refit)
+// The curve refitted between parts of fine-tuning (CalibrationCurves::refit)
 // starts from the slopes refine() fitted on the unchanged network and keeps
 // its knots, its rated top and its shape. Two faked probes, each the squared
 // distance of fc0's readings at knots 1..4 from a compressive target: the

@@ -816,8 +816,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // kCurveFits parts, and before each but the first the curve is fitted
   // again (CalibrationCurves::refit) on the network as fine-tuned so far,
   // its PBs and the same rows; the next part reads the logs through it and
-  // continues the same optimiser (FineTuneState), so a refit that changes
-  // nothing leaves the one run's result. `a` then holds the refitted
+  // continues the same optimiser (FineTuneState), so the parts alone change
+  // nothing (a refit that keeps the slopes rebuilds the curve's readings
+  // from them, which can round their last digits). `a` then holds the refitted
   // curve. `untuned`: the augmented model before fine-tuning, with `a` as
   // it ends.
   auto tune = [&](Augmentation* a, const RowSpan& rows, HadynetModel* untuned = nullptr) {

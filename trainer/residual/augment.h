@@ -354,14 +354,15 @@ struct CalibrationCurves : ModelChange {
               std::vector<double>& fitted);
   // Whether refine() ended the curve at rated_top (its last knot).
   bool through_rated_top = false;
-  // fix(), half-way through fine-tuning: the curve refine() fitted, searched
-  // again from its slopes (same knots, bounds and shape) on the network
-  // fine-tuned so far (`tuned_rmse`: that network's error on the training
-  // rows; `tuned_epochs`: its epochs, for the description). refine() fits
-  // on the unchanged network, which learnt part of the curve from the
-  // curved data and preferred a flatter curve than the plant's; fine-tuning
-  // cannot move the curve afterwards (docs/residual.md, "The curve refitted
-  // on the fine-tuned network").
+  // fix(), between the parts of fine-tuning (after each quarter of the
+  // epochs but the last): the curve as fitted so far, searched again from
+  // its slopes (same knots, bounds and shape) on the network fine-tuned so
+  // far (`tuned_rmse`: that network's error on the training rows;
+  // `tuned_epochs`: its epochs, for the description). refine() fits on the
+  // unchanged network, which learnt part of the curve from the curved data
+  // and preferred a flatter curve than the plant's; fine-tuning cannot move
+  // the curve afterwards (docs/residual.md, "The curve refitted during
+  // fine-tuning (stop 85)").
   void refit(Augmentation& a, const SensorModel& before, const TrainingRmse& tuned_rmse, int tuned_epochs);
   bool carried_before_tuning() const { return true; }  // refine() fitted it
   // Whether the curve's end segment on `side` (+1 its top, -1 its bottom)

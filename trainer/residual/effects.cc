@@ -1373,7 +1373,11 @@ void CalibrationCurves::refit(Augmentation& a, const SensorModel& before, const 
   search.searched = search.knots.size() - 1 - (search.top ? 1 : 0);
   search.read_slopes();
   const std::vector<double> fitted = search.slopes;
-  const double start = static_cast<double>(at_fit.size());  // every channel at its error with the fitted curve
+  // Every channel at its error with the fitted curve: the loss there is
+  // the number of channels (a channel predicted without any error, its
+  // error clamped to 1e-12, would count below 1 and let a slightly worse
+  // curve pass for a better one).
+  const double start = static_cast<double>(at_fit.size());
   // The fitted curve's shape; a straight one may bend either way (the lower loss kept).
   const int shape = fitted.front() > fitted.back() ? -1 : fitted.front() < fitted.back() ? +1 : 0;
   if (shape != 0) {
