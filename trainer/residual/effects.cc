@@ -1059,9 +1059,13 @@ struct SlopeSearch {
     searched = knots.size() - 1 - (top ? 1 : 0);
     set_identity();
   }
-  // The search's slopes from curves.front() as it reads (knots and top as set).
-  void read_slopes() {
+  // The knots and slopes of the curves as fitted (curves.front()'s; its
+  // last knot the rated top when `through_top`), the curves left as they read.
+  void take_fitted(bool through_top) {
     const SensorCurve& c = curves.front();
+    knots = c.level;
+    top = through_top ? std::optional<double>(knots.back()) : std::nullopt;
+    searched = knots.size() - 1 - (top ? 1 : 0);
     slopes.resize(searched);
     for (std::size_t k = 1; k <= searched; ++k) slopes[k - 1] = (c.reading[k] - c.reading[k - 1]) / (knots[k] - knots[k - 1]);
   }
@@ -1367,11 +1371,7 @@ void CalibrationCurves::refit(Augmentation& a, const SensorModel& before, const 
   sensor_curve::SlopeSearch search(curves, [&] {
     return (criterion(sensor_after(before, a)).array() / at_fit).square().sum();
   });
-  // The fitted curve's knots (the last at the rated top when it ends there) and slopes.
-  search.knots = curves.front().level;
-  if (through_rated_top) search.top = search.knots.back();
-  search.searched = search.knots.size() - 1 - (search.top ? 1 : 0);
-  search.read_slopes();
+  search.take_fitted(through_rated_top);
   const std::vector<double> fitted = search.slopes;
   // Every channel at its error with the fitted curve: the loss there is
   // the number of channels (a channel predicted without any error, its
