@@ -6,8 +6,10 @@
 // 1e-12.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
+#include <vector>
 
 #include "trainer/derived_inputs.h"
 #include "trainer/log_dataset.h"
@@ -683,6 +685,37 @@ TEST(SensorFrame, ARailsChannelsTopOutTogether) {
   EXPECT_FALSE(CalibrationCurves::tops_together({110, 109}, 100));
   EXPECT_FALSE(CalibrationCurves::tops_together({2.05}, 0));              // one channel
   EXPECT_FALSE(CalibrationCurves::tops_together({}, 0));
+}
+
+// A channel of a curve's group takes a copy of the fitted curve only when
+// it carries load on the training rows: at least min_rows of its levels
+// more than 5 % of the fitted curve's span above its own lowest level.
+// Stop 85's fresh curve set 4442: fc0 read 0 to 0.073 N in steps of
+// 0.0122 N (12-bit over 50 N) beside a curve fitted from 0 to 18.66 N,
+// and the copy raised its held-out error 1.51 times.
+TEST(SensorFrame, AChannelAtRestTakesNoCopyOfTheCurve) {
+  using residual::CalibrationCurves;
+  std::vector<double> at_rest;
+  for (int k = 0; k < 600; ++k) at_rest.push_back(0.0122 * (k % 7));
+  std::sort(at_rest.begin(), at_rest.end());
+  EXPECT_FALSE(CalibrationCurves::carries_load(at_rest, 18.66, 5));
+  // A few rows of one grasp beyond the foot: 5 carry load, 4 do not.
+  std::vector<double> grasped = at_rest;
+  for (int k = 0; k < 4; ++k) grasped.push_back(1.0 + k);
+  EXPECT_FALSE(CalibrationCurves::carries_load(grasped, 18.66, 5));
+  grasped.push_back(5.0);
+  EXPECT_TRUE(CalibrationCurves::carries_load(grasped, 18.66, 5));
+  // The foot is the channel's own lowest level plus 5 % of the span (0.933
+  // here): a level at it is still at rest, one beyond it is not.
+  std::vector<double> offset(600, 227.0);
+  offset.insert(offset.end(), 5, 227.0 + 0.05 * 18.66);
+  EXPECT_FALSE(CalibrationCurves::carries_load(offset, 18.66, 5));
+  offset.back() += 0.01;
+  EXPECT_FALSE(CalibrationCurves::carries_load(offset, 18.66, 5));
+  for (auto& v : offset) v = v > 227.0 ? v + 0.01 : v;
+  EXPECT_TRUE(CalibrationCurves::carries_load(offset, 18.66, 5));
+  EXPECT_TRUE(CalibrationCurves::carries_load(offset, 18.66, 0));  // at least one row
+  EXPECT_FALSE(CalibrationCurves::carries_load({}, 18.66, 5));
 }
 
 // A drift re-estimated at rate 0 changes nothing, so it leaves the change,

@@ -638,10 +638,18 @@ TEST(ResidualFix, ACalibrationCurveIsFittedAndCutsTheLoadcellsError) {
   // copy of it (CalibrationCurves::applied_to) and may be at rest in these
   // logs, where no curve can cut an error.
   for (const auto& ch : a.found_on) expect_cut(r.fix, ch, fm::kSensorCurve.family_vs_before);
-  // Every loadcell of the model reads through the curve: the plant curves them all.
+  // Every loadcell of the model reads through the curve (the plant curves
+  // them all) but those at rest on the training rows, which the plan names
+  // (CalibrationCurves::at_rest): a copy there cannot cut their error.
+  const std::vector<std::string>& at_rest = std::get<CalibrationCurves>(a.change).at_rest;
   int loadcells = 0;
   for (const auto& y : m.layout.y_names) loadcells += channel_group(y) == "fc";
-  EXPECT_EQ(m.sensor.curves.size(), static_cast<std::size_t>(loadcells));
+  EXPECT_EQ(m.sensor.curves.size() + at_rest.size(), static_cast<std::size_t>(loadcells));
+  for (const auto& ch : at_rest) {
+    EXPECT_EQ(channel_group(ch), "fc") << ch;
+    EXPECT_EQ(m.sensor.curve_of(ch), nullptr) << ch;
+    EXPECT_NE(a.description.find("no copy for"), std::string::npos) << a.description;
+  }
   EXPECT_EQ(a.channels.size(), m.sensor.curves.size());
   // With the null, the held-out tests measure each channel in its clean
   // residual's unit (--decision-scale residual, the default); a curve,

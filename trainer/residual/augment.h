@@ -342,6 +342,17 @@ struct CalibrationCurves : ModelChange {
   // development sets, the second highest at 0.55-0.87 of the highest on
   // 20 curve sets, 0.99-1.00 on 20 rail sets).
   static bool tops_together(const std::vector<double>& tops, double lowest);
+  // Whether a channel whose levels on the training rows are `sorted`
+  // (ascending; the rows the knots come from) carries load: at least
+  // `min_rows` of them (at least 1) lie more than kRestShare of the fitted
+  // curve's span (`fitted_span`: the lowest to the highest level of its
+  // knots) above the channel's lowest level. A channel at rest shows no
+  // level beyond the foot of the curve, where a compressive curve is
+  // steepest (its slope at the bottom reaches the fit's bound, 4, on most
+  // fitted loadcell curves): a copy there only reads the network's small
+  // errors about rest several times larger. False for no levels.
+  static constexpr double kRestShare = 0.05;
+  static bool carries_load(const std::vector<double>& sorted, double fitted_span, int min_rows);
   // The other channels of the plan's group (a group extension's plan only,
   // Augmentation::group_extension): refine() fits the curve where the test
   // found it (the channels above), then gives each of these a copy of it
@@ -349,6 +360,12 @@ struct CalibrationCurves : ModelChange {
   // kind, and a loadcell at rest keeps the test from seeing its curve,
   // though a grasp on other logs would load it. Empty once refine() ran.
   std::vector<std::string> applied_to;
+  // The other channels of the group that plan() leaves without a copy (a
+  // group extension's plan only): at rest on the training rows (fewer than
+  // AttributionOptions::min_support of them beyond the foot of the curve:
+  // carries_load). plan() names them in the
+  // description ("no copy for fc0 (at rest on the training rows)").
+  std::vector<std::string> at_rest;
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;
   void refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
               std::vector<double>& fitted);
