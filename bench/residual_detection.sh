@@ -405,7 +405,15 @@
 # re-run on the sets where a curve was fine-tuned; the every-effect sets
 # of 4280-4289, 4365-4374 and 4375-4384 where a curve was fine-tuned
 # re-run with the final code; 4470-4489 clean sets, 4490-4494 two
-# effects, 4495-4504 the gain wobble. Next unused: 4505 on.
+# effects, 4495-4504 the gain wobble. Stop 86 (the curve's copy only
+# where a channel carries load): development the sensor-curve=0.7 sets
+# 4440-4469, 4366 and 4373 (the rule read off there) and 3880-3899;
+# 4505-4514 every effect at its larger strength and 4515-4534
+# sensor-curve=0.7 measured with the final code, and stop 85's code
+# re-run where a plan left a channel at rest; the every-effect sets of
+# 4280-4289, 4365-4374, 4375-4384 and 4440-4449 where a curve was
+# fine-tuned re-run with the final code; 4535-4554 clean sets, 4555-4559
+# two effects, 4560-4569 the gain wobble. Next unused: 4570 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

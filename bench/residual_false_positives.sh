@@ -145,8 +145,9 @@
 # curve, a flat top through the rated top unless the group tops out
 # together; 0 of 20). Stop 84: 4385-4404 with its final code (a sensor
 # delay's steps from its group; 0 of 20). Stop 85: 4470-4489 with its
-# final code (the curve refitted during fine-tuning; 0 of 20). Next
-# unused seed: 4505
+# final code (the curve refitted during fine-tuning; 0 of 20). Stop 86:
+# 4535-4554 with its final code (the curve's copy only where a channel
+# carries load; 0 of 20). Next unused seed: 4570
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

@@ -66,7 +66,9 @@
 # its final code and stop 82's (--candidates 5). Stop 84: 4405-4409 with
 # its final code (a sensor delay's steps from its group; --candidates 5).
 # Stop 85: 4490-4494 with its final code and stop 84's (the curve
-# refitted during fine-tuning; --candidates 5).
+# refitted during fine-tuning; --candidates 5). Stop 86: 4555-4559 with
+# its final code and stop 85's (the curve's copy only where a channel
+# carries load; --candidates 5).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]... [--decision-loss L] [--decision-scale S] [--fix-selection R]

@@ -58,7 +58,9 @@
 # top unless the group tops out together: 0 of 10 confirmed); 4430-4439
 # (stop 84's final code, a sensor delay's steps from its group: 0 of 10
 # confirmed, 3 unexplained); 4495-4504 (stop 85's final code, the curve
-# refitted during fine-tuning: 0 of 10 confirmed, 0 unexplained).
+# refitted during fine-tuning: 0 of 10 confirmed, 0 unexplained);
+# 4560-4569 (stop 86's final code, the curve's copy only where a channel
+# carries load: 0 of 10 confirmed, 0 unexplained).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R]
