@@ -407,7 +407,9 @@
 # re-run with the final code; 4470-4489 clean sets, 4490-4494 two
 # effects, 4495-4504 the gain wobble. Stop 86 (the curve's copy only
 # where a channel carries load): development the sensor-curve=0.7 sets
-# 4440-4469, 4366 and 4373 (the rule read off there) and 3880-3899;
+# 4440-4469, 4366, 4373 and 4375 (the rule read off there) and 3880-3899
+# (run with the rule's first build, which differed only in the words of
+# its description);
 # 4505-4514 every effect at its larger strength and 4515-4534
 # sensor-curve=0.7 measured with the final code, and stop 85's code
 # re-run where a plan left a channel at rest; the every-effect sets of

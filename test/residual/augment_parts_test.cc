@@ -706,15 +706,15 @@ TEST(SensorFrame, AChannelAtRestTakesNoCopyOfTheCurve) {
   grasped.push_back(5.0);
   EXPECT_TRUE(CalibrationCurves::carries_load(grasped, 18.66, 5));
   // The foot is the channel's own lowest level plus 5 % of the span (0.933
-  // here): a level at it is still at rest, one beyond it is not.
+  // here): with a row needed, a level just below it is at rest, one just
+  // beyond it carries load.
   std::vector<double> offset(600, 227.0);
-  offset.insert(offset.end(), 5, 227.0 + 0.05 * 18.66);
-  EXPECT_FALSE(CalibrationCurves::carries_load(offset, 18.66, 5));
-  offset.back() += 0.01;
-  EXPECT_FALSE(CalibrationCurves::carries_load(offset, 18.66, 5));
-  for (auto& v : offset) v = v > 227.0 ? v + 0.01 : v;
-  EXPECT_TRUE(CalibrationCurves::carries_load(offset, 18.66, 5));
-  EXPECT_TRUE(CalibrationCurves::carries_load(offset, 18.66, 0));  // at least one row
+  offset.push_back(227.0 + 0.05 * 18.66 - 1e-3);
+  EXPECT_FALSE(CalibrationCurves::carries_load(offset, 18.66, 1));
+  offset.back() += 2e-3;
+  EXPECT_TRUE(CalibrationCurves::carries_load(offset, 18.66, 1));
+  // At least one row, whatever min_rows says.
+  EXPECT_FALSE(CalibrationCurves::carries_load(at_rest, 18.66, 0));
   EXPECT_FALSE(CalibrationCurves::carries_load({}, 18.66, 5));
 }
 

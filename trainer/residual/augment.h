@@ -348,9 +348,9 @@ struct CalibrationCurves : ModelChange {
   // curve's span (`fitted_span`: the lowest to the highest level of its
   // knots) above the channel's lowest level. A channel at rest shows no
   // level beyond the foot of the curve, where a compressive curve is
-  // steepest (its slope at the bottom reaches the fit's bound, 4, on most
-  // fitted loadcell curves): a copy there only reads the network's small
-  // errors about rest several times larger. False for no levels.
+  // steepest (a fitted loadcell curve's slope at 0 N is 2-4, the fit's
+  // bound): a copy there reads the network's small errors about rest
+  // several times larger. False for no levels.
   static constexpr double kRestShare = 0.05;
   static bool carries_load(const std::vector<double>& sorted, double fitted_span, int min_rows);
   // The other channels of the plan's group (a group extension's plan only,
@@ -362,9 +362,10 @@ struct CalibrationCurves : ModelChange {
   std::vector<std::string> applied_to;
   // The other channels of the group that plan() leaves without a copy (a
   // group extension's plan only): at rest on the training rows (fewer than
-  // AttributionOptions::min_support of them beyond the foot of the curve:
-  // carries_load). plan() names them in the
-  // description ("no copy for fc0 (at rest on the training rows)").
+  // AttributionOptions::min_support of the levels the knots are read from,
+  // the first half of each log, beyond the foot of the curve:
+  // carries_load). plan() names them in the description ("no copy for fc0
+  // (at rest on the training rows)").
   std::vector<std::string> at_rest;
   void add_to_sensor(SensorModel& s, const Augmentation& a) const;
   void refine(Augmentation& a, const SensorModel& before, const TrainingRmse& training_rmse,
