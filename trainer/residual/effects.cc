@@ -1265,7 +1265,7 @@ bool CalibrationCurves::tops_together(const std::vector<double>& tops, double lo
   return std::count_if(tops.begin(), tops.end(), [&](double t) { return highest - t <= within; }) >= 2;
 }
 
-// Chosen on stop 85's curve sets 4440-4469, 4366 and 4373, where the copy
+// Chosen on stop 85's curve sets 4440-4469, 4366, 4373 and 4375, where the copy
 // on a loadcell at rest raised its held-out error up to 2.1 times
 // (docs/residual.md, "The curve's copy only where a channel carries load
 // (stop 86)").
