@@ -415,7 +415,9 @@
 # re-run where a plan left a channel at rest; the every-effect sets of
 # 4280-4289, 4365-4374, 4375-4384 and 4440-4449 where a curve was
 # fine-tuned re-run with the final code; 4535-4554 clean sets, 4555-4559
-# two effects, 4560-4569 the gain wobble. Next unused: 4570 on.
+# two effects, 4560-4569 the gain wobble, 4570-4579 a sixth block of
+# every effect at its larger strength (stop 85's code re-run where a plan
+# left a channel at rest). Next unused: 4580 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...
