@@ -1202,14 +1202,6 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
                   " (piecewise linear, monotone): the logs read through its inverse, the prediction through it";
   a.found_on = a.channels;
   a.judged_on_every_channel = true;
-  for (int c = 0; c < static_cast<int>(data.y_names.size()); ++c) {
-    if (channel_group(y_name(data, c)) != group) continue;
-    const std::vector<double> v = sorted_values(data, c, true);  // the rows knot_levels reads
-    if (v.empty()) continue;
-    change.group_lowest = change.group_tops.empty() ? v.front() : std::min(change.group_lowest, v.front());
-    change.group_tops.push_back(v.back());
-  }
-  if (!a.group_extension) return;
   // The span of the levels the curve is fitted on (the plan's channels, on
   // the rows their knots come from).
   double fitted_lowest = 0, fitted_highest = 0;
@@ -1218,15 +1210,21 @@ void plan(const ResidualData& data, const Attribution& attribution, const Hypoth
     fitted_lowest = k == 0 ? level.front() : std::min(fitted_lowest, level.front());
     fitted_highest = k == 0 ? level.back() : std::max(fitted_highest, level.back());
   }
+  // The group's tops and lowest level; with a group extension, the other
+  // channels of the group take a copy where they carry load.
   for (int c = 0; c < static_cast<int>(data.y_names.size()); ++c) {
     const std::string& name = y_name(data, c);
-    if (channel_group(name) != group || std::find(a.channels.begin(), a.channels.end(), name) != a.channels.end())
-      continue;
+    if (channel_group(name) != group) continue;
     const std::vector<double> v = sorted_values(data, c, true);  // the rows knot_levels reads
-    if (CalibrationCurves::carries_load(v, fitted_highest - fitted_lowest, attribution.options.min_support))
-      change.applied_to.push_back(name);
-    else
-      change.at_rest.push_back(name);
+    if (a.group_extension && std::find(a.channels.begin(), a.channels.end(), name) == a.channels.end()) {
+      if (CalibrationCurves::carries_load(v, fitted_highest - fitted_lowest, attribution.options.min_support))
+        change.applied_to.push_back(name);
+      else
+        change.at_rest.push_back(name);
+    }
+    if (v.empty()) continue;
+    change.group_lowest = change.group_tops.empty() ? v.front() : std::min(change.group_lowest, v.front());
+    change.group_tops.push_back(v.back());
   }
   if (!change.at_rest.empty())
     a.description += "; no copy for " + join(change.at_rest) + " (at rest on the training rows)";
