@@ -1183,6 +1183,59 @@ TEST(FixCandidates, ByDefaultTheyReachDownToAShareOfOne) {
   EXPECT_EQ(significant(residual::candidates_view(absolute, residual::FixOptions{})), significant(absolute));
 }
 
+// A calibration curve's plan is one curve for its group's channels, so the
+// candidates take a curve at its group's evidence: the sum of the group's
+// significant curves' excess shares (augment.cc, planning_order). Modelled
+// on fresh curved-loadcell set 4448, where the loadcells' curves (each
+// diluted by the rows at rest) ranked below a cross-talk and a tendon's
+// curve, which took the curve's one place.
+TEST(FixCandidates, ACurveStandsAtItsGroupsSummedEvidence) {
+  residual::ResidualData data;
+  data.y_names = {"f4", "fc3", "fc4", "fc5"};
+  data.y_scale = Eigen::VectorXd::Ones(4);
+  residual::ResidualLog log;
+  log.seq.y = Eigen::MatrixXd::Zero(4, 40);
+  for (int t = 0; t < 40; ++t) log.seq.y.col(t) << 10.0 + t, 0.1 * t, 0.2 * t, 0.05 * t;  // every channel loaded
+  data.logs.push_back(std::move(log));
+  residual::Attribution screen;
+  screen.null = residual::NullCalibration{};
+  // (kind, target, source, excess share); every one passes Holm's test and the explained share's floor.
+  const auto add = [&](residual::EffectKind kind, int target, int source, double excess) {
+    residual::HypothesisResult r;
+    r.hypothesis = {kind, target, source, 0, 0, 0};
+    r.effect = residual::effect_info(kind).name;
+    r.label = r.effect + " on " + data.y_names[static_cast<std::size_t>(target)];
+    r.testable = true;
+    r.plausible = true;
+    r.parameter = 0.3;
+    r.p_adjusted = 1e-10;
+    r.explained = 0.3;
+    r.excess_share = excess;
+    screen.ranked.push_back(r);
+  };
+  add(residual::EffectKind::kCrosstalk, 2, 1, 4.0);  // fc3 -> fc4
+  add(residual::EffectKind::kSensorCurve, 0, -1, 3.0);  // the tendon's curve, one channel
+  add(residual::EffectKind::kSensorCurve, 1, -1, 2.5);  // the loadcells': 2.5 + 2.0 = 4.5 over the group
+  add(residual::EffectKind::kSensorCurve, 2, -1, 2.0);
+  screen = residual::with_null_floor(screen, 1.0);
+  const auto plans = residual::plan_candidates(data, screen, 2);
+  ASSERT_EQ(plans.size(), 2u);
+  EXPECT_EQ(plans[0].kind, residual::EffectKind::kSensorCurve) << plans[0].description;
+  EXPECT_EQ(plans[0].found_on, (std::vector<std::string>{"fc3", "fc4"})) << plans[0].description;
+  EXPECT_EQ(plans[1].kind, residual::EffectKind::kCrosstalk) << plans[1].description;
+  // The screen's statistic each plan shows stays its lead's own.
+  EXPECT_DOUBLE_EQ(plans[0].screen_statistic, 2.5);
+  // With fc3's curve below the floor of 1, the loadcells' 2.0 stay below the
+  // tendon's 3.0, which then takes the curve's place.
+  ASSERT_EQ(screen.ranked[2].hypothesis.target, 1);
+  screen.ranked[2].excess_share = 0.5;
+  screen = residual::with_null_floor(screen, 1.0);
+  const auto below = residual::plan_candidates(data, screen, 2);
+  ASSERT_EQ(below.size(), 2u);
+  EXPECT_EQ(below[0].kind, residual::EffectKind::kCrosstalk) << below[0].description;
+  EXPECT_EQ(below[1].found_on, std::vector<std::string>{"f4"}) << below[1].description;
+}
+
 // The drift probe (drift_probe.h) as pure code, its rows faked: the grid's
 // start in closed form, one probe per channel group that the sensor model
 // does not already drift, Holm's correction over the groups, and which group
