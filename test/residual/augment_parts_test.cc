@@ -1234,6 +1234,10 @@ TEST(FixCandidates, ACurveStandsAtItsGroupsSummedEvidence) {
   ASSERT_EQ(below.size(), 2u);
   EXPECT_EQ(below[0].kind, residual::EffectKind::kCrosstalk) << below[0].description;
   EXPECT_EQ(below[1].found_on, std::vector<std::string>{"f4"}) << below[1].description;
+  // A curve is a candidate once per group: the loadcells' comes third.
+  const auto three = residual::plan_candidates(data, screen, 3);
+  ASSERT_EQ(three.size(), 3u);
+  EXPECT_EQ(three[2].found_on, (std::vector<std::string>{"fc4", "fc3"})) << three[2].description;  // fc3 passes without the floors
 }
 
 // The drift probe (drift_probe.h) as pure code, its rows faked: the grid's

@@ -19,6 +19,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <tuple>
 #include <variant>
 
 #include "datalog/log_reader.h"
@@ -135,16 +136,19 @@ void expect_every_sensor_delay_is_a_dead_time(const Outcome& o) {
 
 // At most one of --fix's candidates per effect, besides a plan on its
 // family alone right after the same plan extended to its group; a
-// cross-talk once within a group and once between groups (two mechanisms,
-// plan_candidates).
+// cross-talk once within a group and once between groups, a calibration
+// curve once per group (two mechanisms, plan_candidates).
 void expect_one_candidate_per_effect(const std::vector<Augmentation>& candidates) {
-  std::set<std::pair<EffectKind, bool>> classes;
+  std::set<std::tuple<EffectKind, bool, std::string>> classes;
   for (std::size_t k = 0; k < candidates.size(); ++k) {
     const Augmentation& a = candidates[k];
     const auto* removal = std::get_if<CrosstalkRemoval>(&a.change);
     const bool between = removal != nullptr && !removal->pairs.empty() &&
                          channel_group(removal->pairs.front().target) != channel_group(removal->pairs.front().source);
-    EXPECT_TRUE(classes.insert({a.kind, between}).second || is_family_alone(candidates, k))
+    const auto* curves = std::get_if<CalibrationCurves>(&a.change);
+    const std::string curve_group =
+        curves != nullptr && !curves->curves.empty() ? channel_group(curves->curves.front().channel) : "";
+    EXPECT_TRUE(classes.insert({a.kind, between, curve_group}).second || is_family_alone(candidates, k))
         << "a second " << a.effect << (between ? " between groups" : "") << ": " << a.description;
   }
 }

@@ -297,22 +297,33 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   // cross-talk's one place on the tension leak's set 2242, where the
   // plant's f5 -> fc6 ranked fourth at gain 0.165 and was never tried
   // (docs/residual.md, "A cross-talk between groups is its own candidate").
+  // A calibration curve's class is its group as well: the curve of one
+  // kind of sensor and that of another are two mechanisms too, and on
+  // fresh sets a curve of the tendons f3/f4 (the model's misfit of the
+  // tendon it fits worst) took the curve's one place from the loadcells'
+  // (curve sets 4383, 4510, 4531; docs/residual.md, "A curve stands at its
+  // group's evidence").
   struct PlanClass {
     EffectKind kind;
     bool between_groups;
+    std::string curve_group;  // a calibration curve's group; else empty
     bool operator==(const PlanClass&) const = default;
   };
   const auto class_of_lead = [&](const HypothesisResult& r) {
     const bool crosstalk = r.hypothesis.kind == EffectKind::kCrosstalk;
     const std::string& target = data.y_names[static_cast<std::size_t>(r.hypothesis.target)];
     return PlanClass{r.hypothesis.kind,
-                     crosstalk && channel_group(target) != channel_group(source_name(r.hypothesis, data))};
+                     crosstalk && channel_group(target) != channel_group(source_name(r.hypothesis, data)),
+                     r.hypothesis.kind == EffectKind::kSensorCurve ? channel_group(target) : std::string()};
   };
   const auto class_of_plan = [](const Augmentation& a) {
     const auto* removal = std::get_if<CrosstalkRemoval>(&a.change);
     const bool between = a.kind == EffectKind::kCrosstalk && removal != nullptr && !removal->pairs.empty() &&
                          channel_group(removal->pairs.front().target) != channel_group(removal->pairs.front().source);
-    return PlanClass{a.kind, between};
+    const auto* curves = std::get_if<CalibrationCurves>(&a.change);
+    return PlanClass{a.kind, between,
+                     curves != nullptr && !curves->curves.empty() ? channel_group(curves->curves.front().channel)
+                                                                  : std::string()};
   };
   std::vector<PlanClass> leads;
   const auto plan_of = [&](const HypothesisResult& r, bool group_extension) {
