@@ -1448,20 +1448,21 @@ TEST(DecisionRivals, ACurveAndATimeDriftHaveRivalsInTheirGroupAndALoadDriftIsEac
   const auto tendon_curve = plan(EffectKind::kSensorCurve, {"f2"});
   const std::vector<residual::Augmentation> planned = {curve,      family,    tendon_led,  tendon,
                                                        time_drift, crosstalk, tendon_curve};
-  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 2, 4, 5}));
+  // A curve's: also the curves of the groups it does not hold (the tendon's, 6).
+  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 2, 4, 5, 6}));
   EXPECT_EQ(residual::decision_rivals(planned, 1), (Rivals{0, 4}));
   // A drift of a tendon and a loadcell: the curves and time drifts of either group.
   EXPECT_EQ(residual::decision_rivals(planned, 2), (Rivals{0, 4, 6}));
   EXPECT_EQ(residual::decision_rivals(planned, 3), (Rivals{6}));
   EXPECT_EQ(residual::decision_rivals(planned, 4), (Rivals{1, 2}));
-  EXPECT_EQ(residual::decision_rivals(planned, 6), (Rivals{2, 3}));
+  EXPECT_EQ(residual::decision_rivals(planned, 6), (Rivals{0, 2, 3}));
   // Another effect (whatever its group holds), an index out of range: none.
   EXPECT_TRUE(residual::decision_rivals(planned, 5).empty());
   EXPECT_TRUE(residual::decision_rivals(planned, planned.size()).empty());
   // A plan that cannot be added is no rival, and has none.
   auto unfixable = planned;
   unfixable[1].not_fixable = "no level";
-  EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{2, 4, 5}));
+  EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{2, 4, 5, 6}));
   EXPECT_TRUE(residual::decision_rivals(unfixable, 1).empty());
   // The drift probe's plans (indices 2 and 3 here) are a drift's rivals
   // (a load drift's or a drift with time's) whatever their group, and of
@@ -1470,9 +1471,9 @@ TEST(DecisionRivals, ACurveAndATimeDriftHaveRivalsInTheirGroupAndALoadDriftIsEac
   EXPECT_EQ(residual::decision_rivals(planned, 1, probed), (Rivals{0, 2, 3, 4}));
   EXPECT_EQ(residual::decision_rivals(planned, 2, probed), (Rivals{0, 3, 4, 6}));
   EXPECT_EQ(residual::decision_rivals(planned, 3, probed), (Rivals{2, 6}));
-  EXPECT_EQ(residual::decision_rivals(planned, 0, probed), (Rivals{1, 2, 4, 5}));
+  EXPECT_EQ(residual::decision_rivals(planned, 0, probed), (Rivals{1, 2, 4, 5, 6}));
   EXPECT_EQ(residual::decision_rivals(planned, 4, probed), (Rivals{1, 2, 3}));
-  EXPECT_EQ(residual::decision_rivals(planned, 6, probed), (Rivals{2, 3}));
+  EXPECT_EQ(residual::decision_rivals(planned, 6, probed), (Rivals{0, 2, 3}));
   EXPECT_TRUE(residual::decision_rivals(planned, 5, probed).empty());
   EXPECT_EQ(residual::decision_rivals(unfixable, 3, probed), (Rivals{2, 6}));
   unfixable[2].not_fixable = "no level";
@@ -1514,8 +1515,9 @@ TEST(DecisionRivals, ACrosstalkWithinAGroupHasItsGroupsCurvesAndLoadDriftsAsRiva
   EXPECT_TRUE(residual::decision_rivals(planned, 8).empty());
   // A friction's rivals are the curves of its group (stop 74).
   EXPECT_EQ(residual::decision_rivals(planned, 4), (Rivals{1}));
-  // A curve's rivals hold the cross-talks of its group, as before.
-  EXPECT_EQ(residual::decision_rivals(planned, 1), (Rivals{0, 2, 3, 4, 7, 8}));
+  // A curve's rivals hold the cross-talks of its group, as before, and the
+  // tendon's curve (5).
+  EXPECT_EQ(residual::decision_rivals(planned, 1), (Rivals{0, 2, 3, 4, 5, 7, 8}));
 }
 
 // Friction has the calibration curves of its groups as rivals (stop 74:
@@ -1545,8 +1547,9 @@ TEST(DecisionRivals, AFrictionHasTheCurvesOfItsGroupsAsRivals) {
   auto unfixable = planned;
   unfixable[5].not_fixable = "no level";
   EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{1}));
-  // A curve's rivals hold the frictions of its group, as before.
-  EXPECT_EQ(residual::decision_rivals(planned, 5), (Rivals{0, 3, 4}));
+  // A curve's rivals hold the frictions of its group, as before, and the
+  // curves of the groups it does not hold (f2, th1).
+  EXPECT_EQ(residual::decision_rivals(planned, 5), (Rivals{0, 2, 3, 4, 7}));
 }
 
 // A rail's rivals are the calibration curves of the groups it does not hold
@@ -1573,14 +1576,20 @@ TEST(DecisionRivals, ARailHasTheCurvesOfOtherGroupsAsRivalsThatGainedMoreThanIt)
   auto unfixable = planned;
   unfixable[1].not_fixable = "no level";
   EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{4}));
-  // A curve's rivals still hold the rails of its group.
-  EXPECT_EQ(residual::decision_rivals(planned, 2), (Rivals{0}));
+  // A curve's rivals still hold the rails of its group, and the curves of
+  // the groups it does not hold.
+  EXPECT_EQ(residual::decision_rivals(planned, 2), (Rivals{0, 1, 4}));
   // The gain a rival must exceed: the rail's own; 0 for any other choice,
   // and never below 0 (a rail that lost on the selection's rows).
-  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[0], 0.0045), 0.0045);
-  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[0], -0.2), 0.0);
-  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[1], 0.12), 0.0);
-  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[6], 0.3), 0.0);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[0], planned[1], 0.0045), 0.0045);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[0], planned[1], -0.2), 0.0);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[1], planned[0], 0.12), 0.0);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[6], planned[0], 0.3), 0.0);
+  // A curve's rival curve (of another group) must also gain more than the
+  // curve (stop 87); its other rivals need only have gained.
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[2], planned[1], 0.0001), 0.0001);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[2], planned[1], -0.01), 0.0);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[2], planned[0], 0.0001), 0.0);
 }
 
 // A model of two y channels, a and b, of standard deviations 2 and 4.

@@ -460,7 +460,8 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
   const Augmentation& a = planned[chosen];
   const auto addable = [](const Augmentation& p) { return p.not_fixable.empty() && !p.channels.empty(); };
   const auto is_probe = [&](std::size_t k) { return std::find(probed.begin(), probed.end(), k) != probed.end(); };
-  // A curve's rivals: any other effect; a drift with time's: a load drift;
+  // A curve's rivals: any other effect (and the curves of other groups,
+  // below); a drift with time's: a load drift;
   // a load drift's: a curve or a drift with time; a cross-talk within a
   // group's (one that stands in for the group's curve: its richer account):
   // a curve or a load drift; a friction's: a curve; a rail's: a curve of
@@ -489,6 +490,13 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
   };
   // A rail's rivals are of the other groups; every other choice's share one of its groups.
   const bool other_groups = a.kind == EffectKind::kSaturation;
+  // A curve's rivals also: the curves of the groups it does not hold (each
+  // group's curve its own candidate, plan_candidates), when they gained
+  // more than it (rival_gain_floor).
+  const auto other_groups_curve = [&](const Augmentation& p) {
+    return a.kind == EffectKind::kSensorCurve && p.kind == EffectKind::kSensorCurve && addable(p) &&
+           !groups_shared(p);
+  };
   if (!addable(a)) return rivals;
   // A drift's rivals also: the drift probe's plans, of any group.
   const bool drift = a.kind == EffectKind::kDriftLoad || a.kind == EffectKind::kDriftTime;
@@ -498,14 +506,15 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
       rivals.push_back(k);
       continue;
     }
-    if (!is_rival(planned[k])) continue;
-    if (groups_shared(planned[k]) != other_groups) rivals.push_back(k);
+    if (other_groups_curve(planned[k]) || (is_rival(planned[k]) && groups_shared(planned[k]) != other_groups))
+      rivals.push_back(k);
   }
   return rivals;
 }
 
-double rival_gain_floor(const Augmentation& chosen, double chosen_gain) {
-  return chosen.kind == EffectKind::kSaturation ? std::max(chosen_gain, 0.0) : 0.0;
+double rival_gain_floor(const Augmentation& chosen, const Augmentation& rival, double chosen_gain) {
+  const bool curves = chosen.kind == EffectKind::kSensorCurve && rival.kind == EffectKind::kSensorCurve;
+  return chosen.kind == EffectKind::kSaturation || curves ? std::max(chosen_gain, 0.0) : 0.0;
 }
 
 bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k) {
@@ -1012,9 +1021,9 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     }
     // Rivals (decision_rivals): those that gained on the selection's rows
     // too (more than rival_gain_floor) are tested beside the choice.
-    const double gain_floor = rival_gain_floor(planned[chosen], result.candidates[chosen].selection.mean);
     for (const std::size_t k : decision_rivals(planned, chosen, probed)) {
       if (!judged_rows[k]) judge(k);
+      const double gain_floor = rival_gain_floor(planned[chosen], planned[k], result.candidates[chosen].selection.mean);
       if (result.candidates[k].selection.mean > gain_floor) rivals.push_back(k);
     }
   }

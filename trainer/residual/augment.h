@@ -532,8 +532,12 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 // once the loadcells it reads are curved, and applied without the
 // loadcells' curve, which gained 4-54 times more on the selection's rows,
 // ever being tested; a rail's rivals must also gain more than it:
-// rival_gain_floor); for any other effect none. In
-// `planned`'s order. On the
+// rival_gain_floor); when it is a calibration curve, also every
+// calibration curve of a group it does not hold that gained more than it
+// (stop 87: with a curve a candidate once per group, a curve of the finger
+// lengths was chosen on curve set 4377 for the consistency of its gain,
+// 1e-4, where the loadcells' curve gained 0.027); for any other effect
+// none. In `planned`'s order. On the
 // training rows a curve of a channel's own level explains part of any
 // effect's residual on a channel that follows the load, and a load drift,
 // a drift with time and a curve all follow a grasp's load through a log;
@@ -550,9 +554,10 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
 // rows at its level alone, a small and consistent gain; a curve elsewhere
 // that gained less is no larger account of the residual, and on rail logs
 // the tendons' curves gained 1e-4 where the rail gained 0.004-0.085,
-// stop 70-74's 91 saturation=2 sets);
+// stop 70-74's 91 saturation=2 sets); for a calibration curve and a
+// rival curve (of another group), the same;
 // for any other choice 0 (a rival that gained at all).
-double rival_gain_floor(const Augmentation& chosen, double chosen_gain);
+double rival_gain_floor(const Augmentation& chosen, const Augmentation& rival, double chosen_gain);
 
 // Whether planned[k] of plan_candidates() is a family alone: the plan right
 // after the same plan extended to its group.
