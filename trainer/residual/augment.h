@@ -476,9 +476,11 @@ std::string why_not_fixable(const ResidualData& data, const Attribution& attribu
 
 // The screen's candidates for --fix: the augmentations (each with its
 // family: the effect's plan, effects.cc) of the significant hypotheses in
-// ranking order that --fix can add (why_not_fixable), the best of each
-// effect (of a cross-talk: the best within a group and the best between
-// groups, two mechanisms), at most `count`; a plan that finds nothing to add (it sets
+// ranking order (a calibration curve at its group's summed statistic: its
+// plan is one curve for the group) that --fix can add (why_not_fixable),
+// the best of each effect (of a cross-talk: the best within a group and
+// the best between groups, two mechanisms; of a curve: the best of each
+// group), at most `count`; a plan that finds nothing to add (it sets
 // not_fixable) is skipped like an unfixable hypothesis. A plan extended to
 // its group is followed by the same plan without the extension (the family
 // alone), as one more candidate within `count`, which fix()'s selection
