@@ -417,7 +417,16 @@
 # fine-tuned re-run with the final code; 4535-4554 clean sets, 4555-4559
 # two effects, 4560-4569 the gain wobble, 4570-4579 a sixth block of
 # every effect at its larger strength (stop 85's code re-run where a plan
-# left a channel at rest). Next unused: 4580 on.
+# left a channel at rest). Stop 87 (a curve at its group's summed excess
+# share, once per group, and the curves of other groups as a chosen
+# curve's rivals): development the curve sets 4282, 4368, 4383, 4447,
+# 4448, 4518, 4522, 4523, 4524, 4531 and 4576 (the diagnosis) and the six
+# every-effect blocks above (4280-4289, 4365-4384, 4440-4449, 4505-4514,
+# 4570-4579; each step re-run where it can change the plans); 4580-4599
+# sensor-curve=0.7 and 4600-4609 every effect at its larger strength
+# measured with the final code, and stop 86's code re-run on them;
+# 4610-4629 clean sets, 4630-4634 two effects, 4635-4644 the gain wobble.
+# Next unused: 4645 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -147,7 +147,9 @@
 # delay's steps from its group; 0 of 20). Stop 85: 4470-4489 with its
 # final code (the curve refitted during fine-tuning; 0 of 20). Stop 86:
 # 4535-4554 with its final code (the curve's copy only where a channel
-# carries load; 0 of 20). Next unused seed: 4580
+# carries load; 0 of 20). Stop 87: 4610-4629 with its final code (a
+# curve at its group's summed excess share, once per group; 0 of 20).
+# Next unused seed: 4645
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

@@ -68,7 +68,9 @@
 # Stop 85: 4490-4494 with its final code and stop 84's (the curve
 # refitted during fine-tuning; --candidates 5). Stop 86: 4555-4559 with
 # its final code and stop 85's (the curve's copy only where a channel
-# carries load; --candidates 5).
+# carries load; --candidates 5). Stop 87: 4630-4634 with its final code
+# (a curve at its group's summed excess share, once per group;
+# --candidates 5).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]... [--decision-loss L] [--decision-scale S] [--fix-selection R]

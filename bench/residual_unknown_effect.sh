@@ -60,7 +60,9 @@
 # confirmed, 3 unexplained); 4495-4504 (stop 85's final code, the curve
 # refitted during fine-tuning: 0 of 10 confirmed, 0 unexplained);
 # 4560-4569 (stop 86's final code, the curve's copy only where a channel
-# carries load: 0 of 10 confirmed, 0 unexplained).
+# carries load: 0 of 10 confirmed, 0 unexplained); 4635-4644 (stop 87's
+# final code, a curve at its group's summed excess share, once per group:
+# 0 of 10 confirmed, 5 unexplained).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R]

@@ -138,7 +138,7 @@ void expect_every_sensor_delay_is_a_dead_time(const Outcome& o) {
 // family alone right after the same plan extended to its group; a
 // cross-talk once within a group and once between groups, a calibration
 // curve once per group (two mechanisms, plan_candidates).
-void expect_one_candidate_per_effect(const std::vector<Augmentation>& candidates) {
+void expect_one_candidate_per_class(const std::vector<Augmentation>& candidates) {
   std::set<std::tuple<EffectKind, bool, std::string>> classes;
   for (std::size_t k = 0; k < candidates.size(); ++k) {
     const Augmentation& a = candidates[k];
@@ -637,7 +637,7 @@ TEST(PlantEffects, CommandsActingLateAreNotAlignedAsASensorDelay) {
   EXPECT_GE(delayed_groups.size(), 2u);
   expect_every_sensor_delay_is_a_dead_time(o);
   const auto candidates = plan_candidates(o.data, o.attribution, 5);
-  expect_one_candidate_per_effect(candidates);
+  expect_one_candidate_per_class(candidates);
   EXPECT_TRUE(std::any_of(candidates.begin(), candidates.end(),
                           [](const Augmentation& a) { return a.kind == EffectKind::kInputDelay; }));
   for (const auto& a : candidates) EXPECT_NE(a.kind, EffectKind::kSensorDelay) << a.description;
@@ -739,7 +739,7 @@ TEST(PlantEffects, ADeadTimeSeenOnTheLoadcellsAloneIsNotAlignedAsALoadcellDelay)
   }
   expect_every_sensor_delay_is_a_dead_time(o);
   const auto candidates = plan_candidates(o.data, o.attribution, 5);
-  expect_one_candidate_per_effect(candidates);
+  expect_one_candidate_per_class(candidates);
   ASSERT_FALSE(candidates.empty());
   for (const auto& a : candidates) EXPECT_NE(a.kind, EffectKind::kSensorDelay) << a.description;
   EXPECT_EQ(candidates.front().kind, EffectKind::kInputDelay) << candidates.front().description;
@@ -758,7 +758,7 @@ TEST(PlantEffects, ADeadTimeIsOneCandidateWhateverLedToIt) {
   const auto candidates = plan_candidates(o.data, o.attribution, 5);
   ASSERT_FALSE(candidates.empty());
   EXPECT_EQ(candidates.front().kind, EffectKind::kInputDelay) << candidates.front().description;
-  expect_one_candidate_per_effect(candidates);
+  expect_one_candidate_per_class(candidates);
 }
 
 // The mirror: loadcells reported 1 step late, on logs of seed 874, are still

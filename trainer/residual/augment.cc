@@ -240,27 +240,27 @@ Augmentation planned_for(const ResidualData& data, const Attribution& attributio
 
 // The significant hypotheses in the order plan_candidates plans them: the
 // screen's (floor_statistic), except that a calibration curve stands at its
-// group's pooled statistic, the sum of floor_statistic over the group's
+// group's summed excess share, the sum of floor_statistic over the group's
 // significant curves. A curve's plan is one curve for the group's channels
 // (effects.cc), so the evidence for it is the group's; the screen tests it
 // channel by channel, where a loadcell at rest through most grasps dilutes
-// each channel's share. On the fresh curve sets 4282, 4368, 4383, 4447 and
-// 4448 (development of this rule) no loadcell curve reached the five
+// each channel's share. On stop 86's curve sets 4282, 4368, 4383, 4447 and
+// 4448 (development sets of this rule) no loadcell curve reached the five
 // candidates behind the tendons' curve of one channel and cross-talks
-// (docs/residual.md, "A curve stands at its group's evidence").
+// (docs/residual.md, "A curve stands at its group's summed excess share").
 std::vector<const HypothesisResult*> planning_order(const ResidualData& data, const Attribution& attribution) {
-  std::map<std::string, double> pooled_curve;  // group -> summed floor_statistic of its significant curves
+  std::map<std::string, double> summed_curve_share;  // group -> summed floor_statistic of its significant curves
   std::vector<const HypothesisResult*> order;
   for (const auto& r : attribution.ranked) {
     if (!r.significant) continue;
     order.push_back(&r);
     if (r.hypothesis.kind == EffectKind::kSensorCurve)
-      pooled_curve[channel_group(data.y_names[static_cast<std::size_t>(r.hypothesis.target)])] +=
+      summed_curve_share[channel_group(data.y_names[static_cast<std::size_t>(r.hypothesis.target)])] +=
           floor_statistic(attribution, r);
   }
   const auto key = [&](const HypothesisResult* r) {
     if (r->hypothesis.kind != EffectKind::kSensorCurve) return floor_statistic(attribution, *r);
-    return pooled_curve[channel_group(data.y_names[static_cast<std::size_t>(r->hypothesis.target)])];
+    return summed_curve_share[channel_group(data.y_names[static_cast<std::size_t>(r->hypothesis.target)])];
   };
   std::stable_sort(order.begin(), order.end(),
                    [&](const HypothesisResult* a, const HypothesisResult* b) { return key(a) > key(b); });
@@ -273,8 +273,9 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   std::vector<Augmentation> out;
   const auto winner = attribution.winner();
   if (!winner || count < 1) return out;
-  // The significant hypotheses whose effect --fix can add, in ranking order,
-  // one per effect (the best of each, with its family): on fresh logs the
+  // The significant hypotheses whose effect --fix can add, in ranking order
+  // (planning_order: a curve at its group's summed excess share), one per
+  // class (the best of each, with its family; PlanClass): on fresh logs the
   // model's own misfit between neighbouring channels can fill the top of the
   // ranking with pairs of one effect (cross-talk fc1 -> fc2, fc2 -> fc1,
   // fc4 -> fc3 above a 2-step sensor delay; docs/residual.md). A sensor delay on a
@@ -285,9 +286,6 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   // where sensor delays are significant on several groups beside an input
   // delay, is skipped and said (why_not_fixable); a sensor delay that shows
   // on other groups too is planned as the commands' dead time.
-  // Why the winner cannot be added; known before the loop, since a curve
-  // may be planned before it (planning_order).
-  std::string winner_not_fixable = why_not_fixable(data, attribution, *winner);
   // A candidate's class: its effect, and for a cross-talk whether its source
   // is in another group than its target. Between groups it is a mechanical
   // path (a tendon into a palm loadcell), planned as its pair alone; within
@@ -302,7 +300,7 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   // fresh sets a curve of the tendons f3/f4 (the model's misfit of the
   // tendon it fits worst) took the curve's one place from the loadcells'
   // (curve sets 4383, 4510, 4531; docs/residual.md, "A curve stands at its
-  // group's evidence").
+  // group's summed excess share").
   struct PlanClass {
     EffectKind kind;
     bool between_groups;
@@ -329,12 +327,15 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   const auto plan_of = [&](const HypothesisResult& r, bool group_extension) {
     return planned_for(data, attribution, r, group_extension);
   };
+  // Why the winner cannot be added (its effect, or its plan finds nothing
+  // to add); known before the loop, since a curve may be planned before it
+  // (planning_order).
+  std::string winner_not_fixable = why_not_fixable(data, attribution, *winner);
+  if (winner_not_fixable.empty()) winner_not_fixable = plan_of(*winner, true).not_fixable;
   for (const HypothesisResult* lead_result : planning_order(data, attribution)) {
     const HypothesisResult& r = *lead_result;
     if (static_cast<int>(out.size()) >= count) break;
-    const std::string why = why_not_fixable(data, attribution, r);
-    if (r.label == winner->label) winner_not_fixable = why;
-    if (!why.empty()) continue;
+    if (!why_not_fixable(data, attribution, r).empty()) continue;
     // One candidate per class (PlanClass): by the class of the hypothesis
     // that led to a candidate, and by the class planned (a sensor delay that
     // shows on other groups plans a dead time: effects.cc). A lead whose plan
@@ -345,17 +346,14 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
     const PlanClass lead = class_of_lead(r);
     if (planned(lead) || std::find(leads.begin(), leads.end(), lead) != leads.end()) continue;
     Augmentation a = plan_of(r, true);
-    if (!a.not_fixable.empty()) {  // the plan found nothing to add (a curve without two distinct levels)
-      if (r.label == winner->label) winner_not_fixable = a.not_fixable;
-      continue;
-    }
+    if (!a.not_fixable.empty()) continue;  // the plan found nothing to add (a curve without two distinct levels)
     if (planned(class_of_plan(a))) {
       leads.push_back(lead);
       continue;
     }
     if (out.empty() && r.label != winner->label && !winner_not_fixable.empty())
       a.description = "the winner (" + winner->effect + ": " + winner->label + ") is not added (" +
-                      winner_not_fixable + "); the best significant effect that can be: " + r.label + "; " +
+                      winner_not_fixable + "); the first significant effect that can be: " + r.label + "; " +
                       a.description;
     leads.push_back(lead);
     const bool extended = !a.extended_channels.empty();
@@ -368,7 +366,7 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
     Augmentation a;
     a.kind = winner->hypothesis.kind;
     a.effect = winner->effect;
-    a.not_fixable = winner_not_fixable.empty() ? why_not_fixable(data, attribution, *winner) : winner_not_fixable;
+    a.not_fixable = winner_not_fixable;
     a.description = winner->label;
     out.push_back(std::move(a));
   }
@@ -541,9 +539,13 @@ std::vector<Augmentation> other_account_plans(const ResidualData& data, const At
   };
   for (const Augmentation& a : planned)
     if (a.kind == *other && a.not_fixable.empty() && holds(a.channels, lead)) out.push_back(a);
+  // Else the plans that hold a channel it was found on, of one group (the
+  // first such plan's: a curve is a candidate once per group, and the
+  // account is one plan and its wider form).
   if (out.empty())
     for (const Augmentation& a : planned)
-      if (a.kind == *other && a.not_fixable.empty() &&
+      if (a.kind == *other && a.not_fixable.empty() && !a.channels.empty() &&
+          (out.empty() || channel_group(a.channels.front()) == channel_group(out.front().channels.front())) &&
           std::any_of(a.channels.begin(), a.channels.end(), [&](const std::string& c) { return holds(found_on, c); }))
         out.push_back(a);
   if (out.empty()) {

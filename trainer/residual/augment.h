@@ -162,7 +162,8 @@ struct FixOptions {
   // channel in its own residual's unit (stop 61)").
   SelectionRule selection = SelectionRule::kScreenOrder;
   // How many of the screen's candidates may be tried (plan_candidates: the
-  // best of each effect, and a plan extended to its group also on its
+  // best of each class (an effect; a cross-talk within or between groups, a
+  // curve per group), and a plan extended to its group also on its
   // family alone, each one of the `candidates`): each is re-estimated,
   // added and fine-tuned on the first 75 % of the training rows and judged
   // on the rest against the control; the first significant there, else the
@@ -511,7 +512,8 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 // The plans the held-out rows decide between with the selection's choice
 // planned[chosen] (docs/residual.md, "Rivals: the held-out rows decide",
 // stop 70), each an addable plan that holds a channel of one of
-// planned[chosen]'s groups (a rail's: of none of them, below): when
+// planned[chosen]'s groups (a rail's: of none of them, below; a curve's
+// also the curves of none of them, below): when
 // planned[chosen] is a calibration curve,
 // every plan of another effect; when it is a drift with time, every load
 // drift; when it is a load drift, every calibration curve and drift with
@@ -535,11 +537,12 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 // loadcells' curve, which gained 4-54 times more on the selection's rows,
 // ever being tested; a rail's rivals must also gain more than it:
 // rival_gain_floor); when it is a calibration curve, also every
-// calibration curve of a group it does not hold that gained more than it
-// (stop 87: with a curve a candidate once per group, a curve of the finger
-// lengths was chosen on curve set 4377 for the consistency of its gain,
-// 1e-4, where the loadcells' curve gained 0.027); for any other effect
-// none. In `planned`'s order. On the
+// calibration curve of a group it does not hold (which fix() tests only
+// when it gained more than the curve: rival_gain_floor; stop 87: with a
+// curve a candidate once per group, a curve of the finger lengths was
+// chosen on curve set 4377 for the consistency of its gain, 1e-4, where
+// the loadcells' curve gained 0.027); for any other effect none. In
+// `planned`'s order. On the
 // training rows a curve of a channel's own level explains part of any
 // effect's residual on a channel that follows the load, and a load drift,
 // a drift with time and a curve all follow a grasp's load through a log;
@@ -881,7 +884,10 @@ struct FixResult {
   std::optional<RicherAccount> richer;
   // The rivals tested beside the selection's choice (decision_rivals(): a
   // curve and any other effect, a load drift and a curve or a drift with
-  // time, of one group), those that gained on the selection's rows too.
+  // time, of one group; a rail and a curve of other groups; a curve and the
+  // curves of other groups), those that gained on the selection's rows too
+  // (more than the choice, for a rail's and a curve's other groups:
+  // rival_gain_floor).
   // Each is judged as the decision judges (every fold, against
   // `reference`, a curve also on its own channels), and the choice and its
   // m - 1 rivals are confirmed at Holm's levels for m tests (the i-th
