@@ -20,17 +20,20 @@
 #                   choose the curve itself: stop 74's curve shape, stop
 #                   82's curve applied to the rest of its group. 3889 is a
 #                   development set of stop 81.)
-#   4094 friction   until stop 74 a chosen friction had no rivals. Here the
-#                   selection takes friction, the decision confirms it (p
-#                   0.0003), and the curve of fc0, fc1, fc2, fc4 and fc7,
-#                   applied to the rest of the loadcells, tested beside it
+#   4449 friction   until stop 74 a chosen friction had no rivals. Here the
+#                   selection takes friction, the decision confirms it, and
+#                   the curve of fc1, fc4, fc7 and fc3, applied to the rest
+#                   of the loadcells that carry load, tested beside it
 #                   since stop 74 ("Friction's rivals"), is confirmed (p
-#                   5.2e-10) and applied. Until stop 81 this case ran seed
+#                   9.8e-11) and applied. Until stop 81 this case ran seed
 #                   3892; since stop 82 the curve applied to the rest of its
 #                   group ("The curve applied to the rest of its group")
 #                   gains more on the selection's rows there, and the
-#                   selection chooses it itself. 4094 is a fresh curve set
-#                   of stop 81, where that variant was measured.
+#                   selection chooses it itself. Stops 82-86 ran 4094,
+#                   where since stop 87 the curve, at its group's summed
+#                   excess share, is chosen itself ("A curve stands at its
+#                   group's summed excess share"). 4449 is a curve set of
+#                   stop 85's block, a development set of stop 87.
 #   3797 saturation until stop 75 a chosen rail had no rivals. Here the
 #                   selection takes a lower rail of the finger lengths l3 and
 #                   l4 (p 0.01, a gain of 0.002; the loadcells' curve gained
