@@ -42,7 +42,11 @@
 #                   network overshoots on curved loadcell readings), and the
 #                   curve of fc3, fc1, fc0, fc2, fc4 and fc7, another group's,
 #                   tested beside it since stop 75 ("A rail's rivals"), is
-#                   confirmed (p 2e-10) and applied.
+#                   confirmed (p 2e-10) and applied. Run until stop 86:
+#                   since stop 87 the selection chooses the curve itself
+#                   there, and on none of 150 curve sets of the final code
+#                   (4280-4609's blocks, 4450-4469, 4515-4534, 4580-4599
+#                   and stop 82's 4130-4149) a rail.
 #   Until stop 79 these two cases ran seeds 3319 and 3320. Since stop 80
 #   the curve is fitted on the network's error over windows of its N_train
 #   steps ("The curve fitted on the loss the network was trained on"), and
