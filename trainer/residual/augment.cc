@@ -1,9 +1,9 @@
 #include "trainer/residual/augment.h"
 
 #include <algorithm>
-#include <map>
 #include <cmath>
 #include <initializer_list>
+#include <map>
 #include <memory>
 #include <cstdio>
 #include <stdexcept>
