@@ -292,8 +292,8 @@ int run_residual(int argc, char** argv) {
                               "calibration curve (the other effects of its group), drift with time (the load drifts of its\n"
                               "group) or load drift (the curves and drifts with time of its groups), and of either drift\n"
                               "the drift probe's plans of any group, cross-talk within a group (the curves and load\n"
-                              "drifts of its group), friction (the curves of its groups) or a rail (the curves of the\n"
-                              "groups it does not hold, that gained more than the rail), that gained on those rows\n"
+                              "drifts of its group) or friction (the curves of its groups), and of any choice every\n"
+                              "plan of the groups it does not hold that gained more than it, that gained on those rows\n"
                               "too are tested beside it on the held-out rows, all at Holm's levels, and of those\n"
                               "confirmed the one that predicts the channels any of them changes best is applied", "5");
   opt.value("fix-min-excess-null", "S",

@@ -1438,7 +1438,8 @@ TEST(DriftProbe, ALoadDriftOfItsGroupGivesWayToItsPlanAndNothingElseDoes) {
 
 // A curve's rivals are the other effects of its group, a time drift's the
 // load drifts of its group, a load drift's the curves and time drifts of
-// its groups; another effect has none.
+// its groups; another effect has none in its groups. Every choice's rivals
+// also hold every plan of the groups it does not hold (stop 88).
 TEST(DecisionRivals, ACurveAndATimeDriftHaveRivalsInTheirGroupAndALoadDriftIsEachsRival) {
   const auto plan = planned_on;
   using residual::EffectKind;
@@ -1452,42 +1453,46 @@ TEST(DecisionRivals, ACurveAndATimeDriftHaveRivalsInTheirGroupAndALoadDriftIsEac
   const auto tendon_curve = plan(EffectKind::kSensorCurve, {"f2"});
   const std::vector<residual::Augmentation> planned = {curve,      family,    tendon_led,  tendon,
                                                        time_drift, crosstalk, tendon_curve};
-  // A curve's: also the curves of the groups it does not hold (the tendon's, 6).
-  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 2, 4, 5, 6}));
-  EXPECT_EQ(residual::decision_rivals(planned, 1), (Rivals{0, 4}));
-  // A drift of a tendon and a loadcell: the curves and time drifts of either group.
+  // A curve's: the other effects of its group, and every plan of the
+  // groups it does not hold (the tendon's drift 3 and curve 6).
+  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(residual::decision_rivals(planned, 1), (Rivals{0, 3, 4, 6}));
+  // A drift of a tendon and a loadcell: the curves and time drifts of
+  // either group (it holds every plan's group).
   EXPECT_EQ(residual::decision_rivals(planned, 2), (Rivals{0, 4, 6}));
-  EXPECT_EQ(residual::decision_rivals(planned, 3), (Rivals{6}));
-  EXPECT_EQ(residual::decision_rivals(planned, 4), (Rivals{1, 2}));
-  EXPECT_EQ(residual::decision_rivals(planned, 6), (Rivals{0, 2, 3}));
-  // Another effect (whatever its group holds), an index out of range: none.
-  EXPECT_TRUE(residual::decision_rivals(planned, 5).empty());
+  EXPECT_EQ(residual::decision_rivals(planned, 3), (Rivals{0, 1, 4, 5, 6}));
+  EXPECT_EQ(residual::decision_rivals(planned, 4), (Rivals{1, 2, 3, 6}));
+  EXPECT_EQ(residual::decision_rivals(planned, 6), (Rivals{0, 1, 2, 3, 4, 5}));
+  // Another effect: none of its group, the plans of the other groups.
+  EXPECT_EQ(residual::decision_rivals(planned, 5), (Rivals{3, 6}));
+  // An index out of range: none.
   EXPECT_TRUE(residual::decision_rivals(planned, planned.size()).empty());
   // A plan that cannot be added is no rival, and has none.
   auto unfixable = planned;
   unfixable[1].not_fixable = "no level";
-  EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{2, 4, 5, 6}));
+  EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{2, 3, 4, 5, 6}));
   EXPECT_TRUE(residual::decision_rivals(unfixable, 1).empty());
   // The drift probe's plans (indices 2 and 3 here) are a drift's rivals
   // (a load drift's or a drift with time's) whatever their group, and of
   // nothing else beyond the rules above.
   const Rivals probed = {2, 3};
-  EXPECT_EQ(residual::decision_rivals(planned, 1, probed), (Rivals{0, 2, 3, 4}));
+  EXPECT_EQ(residual::decision_rivals(planned, 1, probed), (Rivals{0, 2, 3, 4, 6}));
   EXPECT_EQ(residual::decision_rivals(planned, 2, probed), (Rivals{0, 3, 4, 6}));
-  EXPECT_EQ(residual::decision_rivals(planned, 3, probed), (Rivals{2, 6}));
-  EXPECT_EQ(residual::decision_rivals(planned, 0, probed), (Rivals{1, 2, 4, 5, 6}));
-  EXPECT_EQ(residual::decision_rivals(planned, 4, probed), (Rivals{1, 2, 3}));
-  EXPECT_EQ(residual::decision_rivals(planned, 6, probed), (Rivals{0, 2, 3}));
-  EXPECT_TRUE(residual::decision_rivals(planned, 5, probed).empty());
-  EXPECT_EQ(residual::decision_rivals(unfixable, 3, probed), (Rivals{2, 6}));
+  EXPECT_EQ(residual::decision_rivals(planned, 3, probed), (Rivals{0, 1, 2, 4, 5, 6}));
+  EXPECT_EQ(residual::decision_rivals(planned, 0, probed), (Rivals{1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(residual::decision_rivals(planned, 4, probed), (Rivals{1, 2, 3, 6}));
+  EXPECT_EQ(residual::decision_rivals(planned, 6, probed), (Rivals{0, 1, 2, 3, 4, 5}));
+  EXPECT_EQ(residual::decision_rivals(planned, 5, probed), (Rivals{3, 6}));
+  EXPECT_EQ(residual::decision_rivals(unfixable, 3, probed), (Rivals{0, 2, 4, 5, 6}));
   unfixable[2].not_fixable = "no level";
-  EXPECT_EQ(residual::decision_rivals(unfixable, 3, probed), (Rivals{6}));
+  EXPECT_EQ(residual::decision_rivals(unfixable, 3, probed), (Rivals{0, 4, 5, 6}));
 }
 
 // A cross-talk within a group stands in for the group's calibration curve
-// (its richer account): its rivals are the curves and load drifts of its
-// group, not the drift probe's plans of another group. A cross-talk between
-// groups (a tension leaking into a loadcell) has none.
+// (its richer account): its rivals in its group are the group's curves and
+// load drifts. A cross-talk between groups (a tension leaking into a
+// loadcell) has none in its group. Either has the plans of the groups it
+// does not hold (stop 88), the drift probe's too.
 TEST(DecisionRivals, ACrosstalkWithinAGroupHasItsGroupsCurvesAndLoadDriftsAsRivals) {
   const auto plan = planned_on;
   using residual::EffectKind;
@@ -1513,21 +1518,23 @@ TEST(DecisionRivals, ACrosstalkWithinAGroupHasItsGroupsCurvesAndLoadDriftsAsRiva
       between,
       mixed,
   };
-  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 2}));
-  EXPECT_EQ(residual::decision_rivals(planned, 0, {6}), (Rivals{1, 2}));
-  EXPECT_TRUE(residual::decision_rivals(planned, 7).empty());
-  EXPECT_TRUE(residual::decision_rivals(planned, 8).empty());
-  // A friction's rivals are the curves of its group (stop 74).
-  EXPECT_EQ(residual::decision_rivals(planned, 4), (Rivals{1}));
+  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 2, 5, 6}));
+  EXPECT_EQ(residual::decision_rivals(planned, 0, {6}), (Rivals{1, 2, 5, 6}));
+  EXPECT_EQ(residual::decision_rivals(planned, 7), (Rivals{5, 6}));
+  EXPECT_EQ(residual::decision_rivals(planned, 8), (Rivals{5, 6}));
+  // A friction's rivals are the curves of its group (stop 74), and the
+  // plans of the other groups.
+  EXPECT_EQ(residual::decision_rivals(planned, 4), (Rivals{1, 5, 6}));
   // A curve's rivals hold the cross-talks of its group, as before, and the
-  // tendon's curve (5).
-  EXPECT_EQ(residual::decision_rivals(planned, 1), (Rivals{0, 2, 3, 4, 5, 7, 8}));
+  // plans of the other groups (5, 6).
+  EXPECT_EQ(residual::decision_rivals(planned, 1), (Rivals{0, 2, 3, 4, 5, 6, 7, 8}));
 }
 
 // Friction has the calibration curves of its groups as rivals (stop 74:
 // on curve logs friction of a tendon's command on its loadcell was chosen
 // where the curves' gain on the selection's rows was larger but noisier),
-// and nothing else: not a drift, a cross-talk or a curve of another group.
+// and nothing else of its groups: not a drift or a cross-talk; beyond
+// them every plan (stop 88).
 TEST(DecisionRivals, AFrictionHasTheCurvesOfItsGroupsAsRivals) {
   const auto plan = planned_on;
   using residual::EffectKind;
@@ -1542,25 +1549,26 @@ TEST(DecisionRivals, AFrictionHasTheCurvesOfItsGroupsAsRivals) {
       plan(EffectKind::kFriction, {"f0", "th0"}),
       plan(EffectKind::kSensorCurve, {"th1"}),
   };
-  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 5}));
-  // Of each group it holds.
-  EXPECT_EQ(residual::decision_rivals(planned, 6), (Rivals{2, 7}));
-  // The drift probe's plans are a drift's rivals only.
-  EXPECT_EQ(residual::decision_rivals(planned, 0, {3}), (Rivals{1, 5}));
+  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 2, 5, 6, 7}));
+  // Of each group it holds, and every plan of the loadcells.
+  EXPECT_EQ(residual::decision_rivals(planned, 6), (Rivals{0, 1, 2, 3, 4, 5, 7}));
+  // In its groups, a drift probe's plan is a rival of a drift only.
+  EXPECT_EQ(residual::decision_rivals(planned, 0, {3}), (Rivals{1, 2, 5, 6, 7}));
   // A curve that cannot be added is no rival.
   auto unfixable = planned;
   unfixable[5].not_fixable = "no level";
-  EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{1}));
+  EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{1, 2, 6, 7}));
   // A curve's rivals hold the frictions of its group, as before, and the
-  // curves of the groups it does not hold (f2, th1).
-  EXPECT_EQ(residual::decision_rivals(planned, 5), (Rivals{0, 2, 3, 4, 7}));
+  // plans of the groups it does not hold (f2, the tendon's friction, th1).
+  EXPECT_EQ(residual::decision_rivals(planned, 5), (Rivals{0, 2, 3, 4, 6, 7}));
 }
 
-// A rail's rivals are the calibration curves of the groups it does not hold
-// (stop 75: a lower rail of the finger lengths chosen on curve logs), and
-// they must have gained more than the rail on the selection's rows; every
-// other choice's rivals need only have gained.
-TEST(DecisionRivals, ARailHasTheCurvesOfOtherGroupsAsRivalsThatGainedMoreThanIt) {
+// A rail's rivals are the plans of the groups it does not hold (stop 75:
+// a lower rail of the finger lengths chosen on curve logs, the curves of
+// other groups; since stop 88 every plan there, as for every choice), and
+// they must have gained more than the rail on the selection's rows; a
+// rival that holds one of the choice's groups need only have gained.
+TEST(DecisionRivals, ARailHasThePlansOfOtherGroupsAsRivalsThatGainedMoreThanIt) {
   const auto plan = planned_on;
   using residual::EffectKind;
   using Rivals = std::vector<std::size_t>;
@@ -1573,27 +1581,33 @@ TEST(DecisionRivals, ARailHasTheCurvesOfOtherGroupsAsRivalsThatGainedMoreThanIt)
       plan(EffectKind::kSaturation, {"fc3"}),
       plan(EffectKind::kDriftLoad, {"fc1"}),
   };
-  // Curves of other groups only: not the lengths' own curve, no other effect.
-  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 4}));
-  // A curve that holds a group of the rail's is no rival: the loadcells' rail.
-  EXPECT_EQ(residual::decision_rivals(planned, 5), (Rivals{2}));
+  // Every plan of the other groups; not the lengths' own curve.
+  EXPECT_EQ(residual::decision_rivals(planned, 0), (Rivals{1, 3, 4, 5, 6}));
+  // The loadcells' rail has no rival in its group, and the curve of f2 and
+  // fc0 holds one of its channels' group (fc).
+  EXPECT_EQ(residual::decision_rivals(planned, 5), (Rivals{0, 2}));
   auto unfixable = planned;
   unfixable[1].not_fixable = "no level";
-  EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{4}));
-  // A curve's rivals still hold the rails of its group, and the curves of
+  EXPECT_EQ(residual::decision_rivals(unfixable, 0), (Rivals{3, 4, 5, 6}));
+  // A curve's rivals still hold the rails of its group, and the plans of
   // the groups it does not hold.
-  EXPECT_EQ(residual::decision_rivals(planned, 2), (Rivals{0, 1, 4}));
-  // The gain a rival must exceed: the rail's own; 0 for any other choice,
-  // and never below 0 (a rail that lost on the selection's rows).
-  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[0], planned[1], 0.0045), 0.0045);
-  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[0], planned[1], -0.2), 0.0);
-  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[1], planned[0], 0.12), 0.0);
-  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[6], planned[0], 0.3), 0.0);
-  // A curve's rival curve (of another group) must also gain more than the
-  // curve (stop 87); its other rivals need only have gained.
-  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[2], planned[1], 0.0001), 0.0001);
-  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[2], planned[1], -0.01), 0.0);
-  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[2], planned[0], 0.0001), 0.0);
+  EXPECT_EQ(residual::decision_rivals(planned, 2), (Rivals{0, 1, 3, 4, 5, 6}));
+  // The gain a rival of the groups the choice does not hold must exceed:
+  // the choice's own, never below 0 (a choice that lost on the selection's
+  // rows), whatever the two effects.
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[0], planned[1], 0.0045, false), 0.0045);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[0], planned[1], -0.2, false), 0.0);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[1], planned[0], 0.12, false), 0.12);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[2], planned[1], 0.0001, false), 0.0001);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[2], planned[1], -0.01, false), 0.0);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[6], planned[0], 0.3, false), 0.3);
+  // A rival that holds one of the choice's groups need only have gained.
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[2], planned[0], 0.0001, false), 0.0);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[6], planned[1], 0.3, false), 0.0);
+  // So need the drift probe's plans of a drift, of any group; of another
+  // choice they are plans like any other.
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[6], planned[0], 0.3, true), 0.0);
+  EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[1], planned[0], 0.12, true), 0.12);
 }
 
 // A model of two y channels, a and b, of standard deviations 2 and 4.

@@ -434,6 +434,15 @@ bool load_drift_of_group(const Augmentation& a, const std::string& group) {
 bool none_addable(const std::vector<Augmentation>& planned) {
   return planned.empty() || !planned.front().not_fixable.empty();
 }
+
+// Whether plan `b` changes a channel of a group one of plan `a`'s channels is in.
+bool shares_a_group(const Augmentation& a, const Augmentation& b) {
+  return std::any_of(a.channels.begin(), a.channels.end(), [&](const std::string& name) {
+    const std::string group = channel_group(name);
+    return std::any_of(b.channels.begin(), b.channels.end(),
+                       [&](const std::string& other) { return channel_group(other) == group; });
+  });
+}
 }  // namespace
 
 ProbePlace drift_probe_place(const std::vector<Augmentation>& planned, const std::string& group) {
@@ -458,12 +467,11 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
   const Augmentation& a = planned[chosen];
   const auto addable = [](const Augmentation& p) { return p.not_fixable.empty() && !p.channels.empty(); };
   const auto is_probe = [&](std::size_t k) { return std::find(probed.begin(), probed.end(), k) != probed.end(); };
-  // A curve's rivals: any other effect (and the curves of other groups,
-  // below); a drift with time's: a load drift;
-  // a load drift's: a curve or a drift with time; a cross-talk within a
-  // group's (one that stands in for the group's curve: its richer account):
-  // a curve or a load drift; a friction's: a curve; a rail's: a curve of
-  // a group the rail does not hold; any other effect's: none.
+  // In the choice's groups, a curve's rivals: any other effect; a drift
+  // with time's: a load drift; a load drift's: a curve or a drift with
+  // time; a cross-talk within a group's (one that stands in for the group's
+  // curve: its richer account): a curve or a load drift; a friction's: a
+  // curve; any other effect's: none. Beyond them, below: every plan.
   const auto richer = effect_info(a.kind).richer;
   const bool stands_in_for_curve = richer && richer(a) == EffectKind::kSensorCurve;
   const auto is_rival = [&](const Augmentation& p) {
@@ -475,44 +483,26 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
       case EffectKind::kCrosstalk:
         return stands_in_for_curve && (p.kind == EffectKind::kSensorCurve || p.kind == EffectKind::kDriftLoad);
       case EffectKind::kFriction: return p.kind == EffectKind::kSensorCurve;
-      case EffectKind::kSaturation: return p.kind == EffectKind::kSensorCurve;
       default: return false;
     }
-  };
-  const auto groups_shared = [&](const Augmentation& p) {
-    return std::any_of(a.channels.begin(), a.channels.end(), [&](const std::string& name) {
-      const std::string group = channel_group(name);
-      return std::any_of(p.channels.begin(), p.channels.end(),
-                         [&](const std::string& other) { return channel_group(other) == group; });
-    });
-  };
-  // A rail's rivals are of the other groups; every other choice's share one of its groups.
-  const bool other_groups = a.kind == EffectKind::kSaturation;
-  // A curve's rivals also: the curves of the groups it does not hold (each
-  // group's curve its own candidate, plan_candidates), when they gained
-  // more than it (rival_gain_floor).
-  const auto other_groups_curve = [&](const Augmentation& p) {
-    return a.kind == EffectKind::kSensorCurve && p.kind == EffectKind::kSensorCurve && addable(p) &&
-           !groups_shared(p);
   };
   if (!addable(a)) return rivals;
   // A drift's rivals also: the drift probe's plans, of any group.
   const bool drift = a.kind == EffectKind::kDriftLoad || a.kind == EffectKind::kDriftTime;
   for (std::size_t k = 0; k < planned.size(); ++k) {
-    if (k == chosen) continue;
-    if (drift && is_probe(k) && addable(planned[k])) {
-      rivals.push_back(k);
-      continue;
-    }
-    if (other_groups_curve(planned[k]) || (is_rival(planned[k]) && groups_shared(planned[k]) != other_groups))
-      rivals.push_back(k);
+    if (k == chosen || !addable(planned[k])) continue;
+    // Every choice's rivals also: every plan of the groups it does not
+    // hold, which fix() tests only when it gained more than the choice
+    // (rival_gain_floor).
+    if ((drift && is_probe(k)) || !shares_a_group(a, planned[k]) || is_rival(planned[k])) rivals.push_back(k);
   }
   return rivals;
 }
 
-double rival_gain_floor(const Augmentation& chosen, const Augmentation& rival, double chosen_gain) {
-  const bool curves = chosen.kind == EffectKind::kSensorCurve && rival.kind == EffectKind::kSensorCurve;
-  return chosen.kind == EffectKind::kSaturation || curves ? std::max(chosen_gain, 0.0) : 0.0;
+double rival_gain_floor(const Augmentation& chosen, const Augmentation& rival, double chosen_gain, bool probed) {
+  const bool drift = chosen.kind == EffectKind::kDriftLoad || chosen.kind == EffectKind::kDriftTime;
+  if (drift && probed) return 0.0;
+  return shares_a_group(chosen, rival) ? 0.0 : std::max(chosen_gain, 0.0);
 }
 
 bool is_family_alone(const std::vector<Augmentation>& planned, std::size_t k) {
@@ -1025,7 +1015,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     // too (more than rival_gain_floor) are tested beside the choice.
     for (const std::size_t k : decision_rivals(planned, chosen, probed)) {
       if (!judged_rows[k]) judge(k);
-      const double gain_floor = rival_gain_floor(planned[chosen], planned[k], result.candidates[chosen].selection.mean);
+      const double gain_floor = rival_gain_floor(planned[chosen], planned[k], result.candidates[chosen].selection.mean,
+                                                 result.candidates[k].from_drift_probe);
       if (result.candidates[k].selection.mean > gain_floor) rivals.push_back(k);
     }
   }

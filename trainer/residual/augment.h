@@ -511,10 +511,15 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 
 // The plans the held-out rows decide between with the selection's choice
 // planned[chosen] (docs/residual.md, "Rivals: the held-out rows decide",
-// stop 70), each an addable plan that holds a channel of one of
-// planned[chosen]'s groups (a rail's: of none of them, below; a curve's
-// also the curves of none of them, below): when
-// planned[chosen] is a calibration curve,
+// stop 70), each an addable plan: every plan that holds no channel of
+// planned[chosen]'s groups (which fix() tests only when it gained more
+// than the choice, but a drift's probe plans when they gained at all:
+// rival_gain_floor; stop 88: on friction sets 4602 and 4609 a curve of
+// two or three finger lengths was chosen as the clearest gain and
+// not confirmed, and friction, which gained more there, was never
+// tested; this holds a rail's rivals, the curves of other groups, stop
+// 75, and a curve's there, stop 87: both below), and of those that hold one:
+// when planned[chosen] is a calibration curve,
 // every plan of another effect; when it is a drift with time, every load
 // drift; when it is a load drift, every calibration curve and drift with
 // time; and for either drift also the drift probe's plans (`probed`: their
@@ -529,20 +534,16 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 // logs friction of one tendon's command on its loadcell was chosen because
 // its gain on the selection's rows was significant and the curves' larger,
 // noisier gain was not, and friction's simpler account, the curve of its
-// lead channel, was often not planned); when it is a rail, every
-// calibration curve of a group the rail does not hold (stop 75: on curve
-// logs a lower rail of the finger lengths was chosen for the consistency
-// of its small gain, a length's contact stop that the network overshoots
-// once the loadcells it reads are curved, and applied without the
-// loadcells' curve, which gained 4-54 times more on the selection's rows,
-// ever being tested; a rail's rivals must also gain more than it:
-// rival_gain_floor); when it is a calibration curve, also every
-// calibration curve of a group it does not hold (which fix() tests only
-// when it gained more than the curve: rival_gain_floor; stop 87: with a
-// curve a candidate once per group, a curve of the finger lengths was
-// chosen on curve set 4377 for the consistency of its gain, 1e-4, where
-// the loadcells' curve gained 0.027); for any other effect none. In
-// `planned`'s order. On the
+// lead channel, was often not planned); for any other effect none (a
+// rail: stop 75, on curve logs a lower rail of the finger lengths was
+// chosen for the consistency of its small gain, a length's contact stop
+// that the network overshoots once the loadcells it reads are curved, and
+// applied without the loadcells' curve, which gained 4-54 times more on
+// the selection's rows, ever being tested: its rivals are of the other
+// groups; a curve: stop 87, with a curve a candidate once per group, a
+// curve of the finger lengths was chosen on curve set 4377 for the
+// consistency of its gain, 7e-5, where the loadcells' curve gained
+// 0.027). In `planned`'s order. On the
 // training rows a curve of a channel's own level explains part of any
 // effect's residual on a channel that follows the load, and a load drift,
 // a drift with time and a curve all follow a grasp's load through a log;
@@ -555,14 +556,14 @@ std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planne
 
 // The mean loss difference on the selection's rows (CandidateTrial::
 // selection) a rival of `chosen` must exceed to be tested beside it, given
-// chosen's own (`chosen_gain`): for a rail, its own gain (a rail clips the
-// rows at its level alone, a small and consistent gain; a curve elsewhere
-// that gained less is no larger account of the residual, and on rail logs
-// the tendons' curves gained 1e-4 where the rail gained 0.004-0.085,
-// stop 70-74's 91 saturation=2 sets); for a calibration curve and a
-// rival curve (of another group), the same;
-// for any other choice 0 (a rival that gained at all).
-double rival_gain_floor(const Augmentation& chosen, const Augmentation& rival, double chosen_gain);
+// chosen's own (`chosen_gain`): for a rival that holds no channel of
+// chosen's groups, chosen's gain, never below 0 (a plan elsewhere that
+// gained less is no larger account of the residual: on rail logs the
+// tendons' curves gained 1e-4 where the rail gained 0.004-0.085, stop
+// 70-74's 91 saturation=2 sets); for a rival in chosen's groups, and for
+// the drift probe's plans of any group when chosen is a drift (`probed`:
+// the rival is one), 0 (a rival that gained at all).
+double rival_gain_floor(const Augmentation& chosen, const Augmentation& rival, double chosen_gain, bool probed);
 
 // Whether planned[k] of plan_candidates() is a family alone: the plan right
 // after the same plan extended to its group.
@@ -884,10 +885,10 @@ struct FixResult {
   std::optional<RicherAccount> richer;
   // The rivals tested beside the selection's choice (decision_rivals(): a
   // curve and any other effect, a load drift and a curve or a drift with
-  // time, of one group; a rail and a curve of other groups; a curve and the
-  // curves of other groups), those that gained on the selection's rows too
-  // (more than the choice, for a rail's and a curve's other groups:
-  // rival_gain_floor).
+  // time, of one group; any choice and every plan of the groups it does
+  // not hold), those that gained on the selection's rows too (more than
+  // the choice, for a plan of the groups it does not hold but the drift
+  // probe's as a drift's rivals: rival_gain_floor).
   // Each is judged as the decision judges (every fold, against
   // `reference`, a curve also on its own channels), and the choice and its
   // m - 1 rivals are confirmed at Holm's levels for m tests (the i-th
