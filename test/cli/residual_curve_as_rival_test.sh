@@ -33,7 +33,13 @@
 #                   where since stop 87 the curve, at its group's summed
 #                   excess share, is chosen itself ("A curve stands at its
 #                   group's summed excess share"). 4449 is a curve set of
-#                   stop 85's block, a development set of stop 87.
+#                   stop 85's block, a development set of stop 87. Run
+#                   until stop 87: on stop 88's VM the selection chooses
+#                   the curve itself there, with stop 87's code too (a
+#                   statistic of 1.63 against friction's 1.30 on the
+#                   selection's rows), where stop 87's VM chose friction,
+#                   and none of the 40 curve sets run on stop 88's VM
+#                   chose friction.
 #   3797 saturation until stop 75 a chosen rail had no rivals. Here the
 #                   selection takes a lower rail of the finger lengths l3 and
 #                   l4 (p 0.01, a gain of 0.002; the loadcells' curve gained
