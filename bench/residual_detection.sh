@@ -426,7 +426,13 @@
 # sensor-curve=0.7 and 4600-4609 every effect at its larger strength
 # measured with the final code, and stop 86's code re-run on them;
 # 4610-4629 clean sets, 4630-4634 two effects, 4635-4644 the gain wobble.
-# Next unused: 4645 on.
+# Stop 88 (every choice's rivals also the plans of the groups it does not
+# hold that gained more than it): development 4600-4609 (stop 87's fresh
+# block, re-run with stop 87's code and then with the rule); 4645-4654
+# every effect at its larger strength measured with the final code, and
+# stop 87's code on the same logs; 4655-4674 clean sets, 4675-4679 two
+# effects, 4680-4689 the gain wobble.
+# Next unused: 4690 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

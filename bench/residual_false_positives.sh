@@ -149,7 +149,9 @@
 # 4535-4554 with its final code (the curve's copy only where a channel
 # carries load; 0 of 20). Stop 87: 4610-4629 with its final code (a
 # curve at its group's summed excess share, once per group; 0 of 20).
-# Next unused seed: 4645
+# Stop 88: 4655-4674 with its final code (every choice's rivals also the
+# plans of the groups it does not hold that gained more; 0 of 20).
+# Next unused seed: 4690
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

@@ -70,6 +70,8 @@
 # its final code and stop 85's (the curve's copy only where a channel
 # carries load; --candidates 5). Stop 87: 4630-4634 with its final code
 # (a curve at its group's summed excess share, once per group;
+# --candidates 5). Stop 88: 4675-4679 with its final code (every choice's
+# rivals also the plans of the groups it does not hold that gained more;
 # --candidates 5).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]

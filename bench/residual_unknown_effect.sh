@@ -62,7 +62,9 @@
 # 4560-4569 (stop 86's final code, the curve's copy only where a channel
 # carries load: 0 of 10 confirmed, 0 unexplained); 4635-4644 (stop 87's
 # final code, a curve at its group's summed excess share, once per group:
-# 0 of 10 confirmed, 5 unexplained).
+# 0 of 10 confirmed, 5 unexplained); 4680-4689 (stop 88's final code,
+# every choice's rivals also the plans of the groups it does not hold that
+# gained more: 0 of 10 confirmed, 5 unexplained).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R]
