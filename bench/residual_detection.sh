@@ -431,8 +431,9 @@
 # block, re-run with stop 87's code and then with the rule); 4645-4654
 # every effect at its larger strength measured with the final code, and
 # stop 87's code on the same logs; 4655-4674 clean sets, 4675-4679 two
-# effects, 4680-4689 the gain wobble.
-# Next unused: 4690 on.
+# effects, 4680-4689 the gain wobble; 4690-4709 sensor-curve=0.7 with
+# both codes (a search for a set where the selection chooses friction).
+# Next unused: 4710 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

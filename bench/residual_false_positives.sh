@@ -151,7 +151,7 @@
 # curve at its group's summed excess share, once per group; 0 of 20).
 # Stop 88: 4655-4674 with its final code (every choice's rivals also the
 # plans of the groups it does not hold that gained more; 0 of 20).
-# Next unused seed: 4690
+# Next unused seed: 4710
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
