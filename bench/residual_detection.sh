@@ -433,7 +433,7 @@
 # stop 87's code on the same logs; 4655-4674 clean sets, 4675-4679 two
 # effects, 4680-4689 the gain wobble; 4690-4709 sensor-curve=0.7 with
 # both codes (a search for a set where the selection chooses friction).
-# Stop 89 (no change to the loop; six changes tried on development sets
+# Stop 89 (no change to the loop; six changes examined on development sets
 # and not kept: docs/residual.md): 4710-4719 and 4720-4729 every effect at
 # its larger strength measured with stop 88's code (4710-4719 then read
 # for the drift probe's level, development from there on); 4730-4749

@@ -3,24 +3,33 @@
 fresh sets (not a test): how often the bar's rule passes, with a 95 %
 interval, and what that rate makes of the bar itself (9 of 10 in one block).
 
-  residual_pass_rates.py RUNS_FILE...
+  residual_pass_rates.py [--case EFFECT=STRENGTH]... RUNS_FILE...
 
 RUNS_FILE: a runs.txt of bench/residual_detection.sh (its lines, written by
 bench/residual_run_line.py). A run passes when it is named, cut by 30 % and
-below the fine-tune-only control (the table's last column). Blocks run with
-different code must not be pooled: pass only files of one code, on seeds
-nothing was chosen on.
+below the fine-tune-only control (the last column of residual_run_line.py's
+table); a run whose `hadynet residual` failed ("residual failed") counts as
+a run that did not pass. A set (case and seed) may appear once over all the
+files. Blocks run with different code must not be pooled: pass only files
+of one code, on seeds nothing was chosen on.
 
-Prints, per effect=strength: passes / runs; the Wilson score interval at
-95 % (binomial, runs taken as independent); and P(>= 9 of 10), the chance
-that a block of 10 fresh sets meets the bar at the observed rate (on the
-last row, that every effect meets it in one block: the product).
+--case EFFECT=STRENGTH: only these cases (repeatable; default: every case
+in the files). The bar is at the larger strengths, so a run of all sixteen
+cases is read with the eight larger ones named here.
+
+Prints a table, cases in name order: passed / runs; the Wilson score
+interval at 95 % (binomial, runs taken as independent); and P(>= 9 of 10),
+the chance that a block of 10 fresh sets meets the bar at the observed rate
+(on the last row, that every case meets it in one block: the product,
+cases taken as independent). Exit status 2 for bad arguments or files, or
+when the files hold no run of the cases asked for.
 """
 import math
 import re
 import sys
 
 LINE = re.compile(r"(\S+) seed (\d+): named (yes|no) +cut (yes|no) .*<control (yes|no)")
+FAILED = re.compile(r"(\S+) seed (\d+): residual failed")  # residual_detection.sh's line for a failed run
 Z95 = 1.959964  # two-sided 95 % normal quantile
 
 
@@ -39,39 +48,76 @@ def at_least(k, n, p):
     return sum(math.comb(n, i) * p**i * (1 - p) ** (n - i) for i in range(k, n + 1))
 
 
-def rates(paths):
-    counts = {}  # case -> [runs, passes]; a (case, seed) counted once
-    seen = set()
+def count(paths, cases=None):
+    """{case: [runs, passes]} over the files; ValueError for a set seen twice."""
+    counts = {}
+    where = {}  # (case, seed) -> the file it was first seen in
     for path in paths:
-        for line in open(path):
-            m = LINE.match(line)
-            if not m:
-                continue
-            key = (m.group(1), m.group(2))
-            if key in seen:
-                sys.exit(f"{path}: {key[0]} seed {key[1]} is in more than one file")
-            seen.add(key)
-            c = counts.setdefault(m.group(1), [0, 0])
-            c[0] += 1
-            c[1] += m.group(3) == "yes" and m.group(4) == "yes" and m.group(5) == "yes"
+        with open(path) as f:
+            for line in f:
+                m = LINE.match(line)
+                failed = None if m else FAILED.match(line)
+                if not m and not failed:
+                    continue
+                key = ((m or failed).group(1), (m or failed).group(2))
+                if cases and key[0] not in cases:
+                    continue
+                if key in where:
+                    raise ValueError(f"{key[0]} seed {key[1]} is counted twice: in {where[key]} and in {path}")
+                where[key] = path
+                c = counts.setdefault(key[0], [0, 0])
+                c[0] += 1
+                c[1] += bool(m) and m.group(3) == "yes" and m.group(4) == "yes" and m.group(5) == "yes"
+    return counts
+
+
+def rates(counts):
     out = ["| effect=strength | passed / runs | 95 % interval (Wilson) | P(>= 9 of 10) at that rate |",
            "|---|---|---|---|"]
     total = [0, 0]
-    every = 1.0  # P(every effect >= 9 of 10 in one block), the effects' blocks independent
-    for case, (runs, passes) in counts.items():
+    every = 1.0  # P(every case >= 9 of 10 in one block), the cases independent
+    for case, (runs, passes) in sorted(counts.items()):
         low, high = wilson(passes, runs)
         out.append(f"| {case} | {passes} / {runs} | {low:.2f}-{high:.2f} | {at_least(9, 10, passes / runs):.2f} |")
         total[0] += runs
         total[1] += passes
         every *= at_least(9, 10, passes / runs)
-    if total[0]:
-        low, high = wilson(total[1], total[0])
-        out.append(f"| every effect | {total[1]} / {total[0]} | {low:.2f}-{high:.2f} | {every:.2f} (all at once) |")
+    low, high = wilson(total[1], total[0])
+    out.append(f"| every effect | {total[1]} / {total[0]} | {low:.2f}-{high:.2f} | {every:.2f} (all at once) |")
     return "\n".join(out)
 
 
-if __name__ == "__main__":
-    if len(sys.argv) < 2 or sys.argv[1] in ("-h", "--help"):
+def main(argv):
+    if len(argv) == 1 and argv[0] in ("-h", "--help"):
         print(__doc__)
-        sys.exit(0 if len(sys.argv) == 2 else 2)
-    print(rates(sys.argv[1:]))
+        return 0
+    cases, paths = [], []
+    i = 0
+    while i < len(argv):
+        if argv[i] == "--case" and i + 1 < len(argv):
+            cases.append(argv[i + 1])
+            i += 2
+        elif argv[i].startswith("-"):
+            print(__doc__)
+            return 2
+        else:
+            paths.append(argv[i])
+            i += 1
+    if not paths:
+        print(__doc__)
+        return 2
+    try:
+        counts = count(paths, cases)
+    except (OSError, ValueError) as e:
+        print(f"residual_pass_rates: {e}", file=sys.stderr)
+        return 2
+    if not counts:
+        print(f"residual_pass_rates: no run{' of ' + ', '.join(cases) if cases else ''} in {', '.join(paths)}",
+              file=sys.stderr)
+        return 2
+    print(rates(counts))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
