@@ -433,12 +433,18 @@
 # stop 87's code on the same logs; 4655-4674 clean sets, 4675-4679 two
 # effects, 4680-4689 the gain wobble; 4690-4709 sensor-curve=0.7 with
 # both codes (a search for a set where the selection chooses friction).
-# Stop 89 (no change to the loop; six changes examined on development sets
-# and not kept: docs/residual.md): 4710-4719 and 4720-4729 every effect at
-# its larger strength measured with stop 88's code (4710-4719 then read
-# for the drift probe's level, development from there on); 4730-4749
-# clean sets. bench/residual_pass_rates.py pools blocks of one code.
-# Next unused: 4750 on.
+# Stop 89 (a chosen curve whose group tops out together has the rail of
+# its lead channel as a rival; six other changes examined on development
+# sets and not kept: docs/residual.md): 4710-4719 and 4720-4729 every
+# effect at its larger strength measured with stop 88's code (4710-4719
+# then development: the drift probe's level read and the rail's rule found
+# on 4713 and 4715, its curve-chosen runs and those of 4600-4609,
+# 4645-4654 and 4690-4709 re-run with the rule; 4720-4729's curve-chosen
+# runs re-run with it too);
+# 4730-4749 clean sets (stop 88's code); 4750-4759 saturation=2 and
+# 4760-4769 sensor-curve=0.7 measured with the final code and stop 88's on
+# the same logs. bench/residual_pass_rates.py pools blocks of one code.
+# Next unused: 4790 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

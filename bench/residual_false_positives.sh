@@ -151,8 +151,9 @@
 # curve at its group's summed excess share, once per group; 0 of 20).
 # Stop 88: 4655-4674 with its final code (every choice's rivals also the
 # plans of the groups it does not hold that gained more; 0 of 20).
-# Stop 89: 4730-4749 with stop 88's code (no change to the loop; 0 of 20).
-# Next unused seed: 4750
+# Stop 89: 4730-4749 with stop 88's code (0 of 20); 4770-4789 with its
+# final code (a chosen curve's rail among its rivals; 0 of 20).
+# Next unused seed: 4790
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

@@ -173,6 +173,7 @@ void print_fix(const rs::FixResult& fixed) {
       if (c.below_screen_floor) std::printf(" below the screen's floor (%.2g);", c.screen_statistic);
       if (c.from_drift_probe) std::printf(" the drift probe's;");
       if (c.from_earlier_round) std::printf(" an earlier round's;");
+      if (c.rail_of_chosen_curve) std::printf(" the chosen curve's rail;");
       if (c.group_drift_gain)
         std::printf(" the drift probe's plan of its group %s (DM %.2f);",
                     c.gave_way_to_group_drift ? "predicts better: gave way" : "not preferred", c.group_drift_gain->stat);
@@ -289,7 +290,8 @@ int run_residual(int argc, char** argv) {
                               "beyond K when every place is taken); a load drift of its group chosen on the training\n"
                               "rows gives way to it when it gains there\n"
                               "too and predicts the channels either changes better there; the rivals of a chosen\n"
-                              "calibration curve (the other effects of its group), drift with time (the load drifts of its\n"
+                              "calibration curve (the other effects of its group; when its group tops out together, a\n"
+                              "rail's signature, also the rail of its lead channel), drift with time (the load drifts of its\n"
                               "group) or load drift (the curves and drifts with time of its groups), and of either drift\n"
                               "the drift probe's plans of any group, cross-talk within a group (the curves and load\n"
                               "drifts of its group) or friction (the curves of its groups), and of any choice every\n"

@@ -191,6 +191,7 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                             {"below_screen_floor", c.below_screen_floor},
                             {"from_drift_probe", c.from_drift_probe},
                             {"from_earlier_round", c.from_earlier_round},
+                            {"rail_of_chosen_curve", c.rail_of_chosen_curve},
                             {"group_drift_gain", c.group_drift_gain
                                                      ? json{{"statistic", c.group_drift_gain->stat},
                                                             {"p_value", c.group_drift_gain->p_value},

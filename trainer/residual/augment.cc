@@ -1011,6 +1011,45 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
         chosen = g;
       }
     }
+    // A chosen calibration curve whose group's channels top out together
+    // on the training rows (CalibrationCurves::tops_together: a rail's
+    // signature) has the upper rail of its lead channel (its simpler
+    // account's plans: the rail extended to its group, then its family
+    // alone, in plan_candidates()' order) among its rivals, planned here
+    // when no candidate is that rail: the simpler account asks for the rail
+    // only once the curve is confirmed, and a curve fitted to a rail's data
+    // can fail where the rail would not. Only an upper rail: the tops are
+    // the group's highest levels.
+    if (const auto* curves = std::get_if<CalibrationCurves>(&planned[chosen].change);
+        curves != nullptr && CalibrationCurves::tops_together(curves->group_tops, curves->group_lowest)) {
+      std::vector<Augmentation> rails = simpler_plans(data, with_null_floor(attribution, 0), planned, chosen);
+      const auto upper = [](const Augmentation& a) {
+        const auto* clips = std::get_if<OutputClips>(&a.change);
+        return clips != nullptr && !clips->clips.empty() &&
+               std::all_of(clips->clips.begin(), clips->clips.end(), [](const OutputClip& c) { return c.side > 0; });
+      };
+      const auto is_candidate = [&](const Augmentation& rail) {
+        return std::any_of(planned.begin(), planned.end(), [&](const Augmentation& a) {
+          return a.kind == rail.kind && a.channels == rail.channels;
+        });
+      };
+      if (!rails.empty() && std::all_of(rails.begin(), rails.end(), upper) &&
+          std::none_of(rails.begin(), rails.end(), is_candidate)) {
+        std::reverse(rails.begin(), rails.end());  // simpler_plans: fewest channels first
+        for (Augmentation& rail : rails) {
+          planned.push_back(std::move(rail));
+          CandidateTrial c;
+          c.effect = planned.back().effect;
+          c.description = planned.back().description;
+          c.channels = channels_of(planned.back());
+          c.screen_statistic = planned.back().screen_statistic;
+          c.rail_of_chosen_curve = true;
+          result.candidates.push_back(std::move(c));
+          judged_rows.emplace_back();
+        }
+        result.candidate_plans = planned;
+      }
+    }
     // Rivals (decision_rivals): those that gained on the selection's rows
     // too (more than rival_gain_floor) are tested beside the choice.
     for (const std::size_t k : decision_rivals(planned, chosen, probed)) {

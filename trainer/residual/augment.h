@@ -550,7 +550,12 @@ bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::siz
 // rows after them tell them apart (a load drift has grown with the load, a
 // curve has not, a delay's or a leak's residual is not a static map):
 // fix() tests those that gained on the selection's rows beside
-// planned[chosen], all at Holm's levels (FixResult::rivals).
+// planned[chosen], all at Holm's levels (FixResult::rivals). A chosen
+// curve whose group tops out together (CalibrationCurves::tops_together)
+// has the upper rail of its lead channel among them: fix() adds that rail
+// (its simpler account's plans) to `planned` after the selection when no
+// candidate is it (CandidateTrial::rail_of_chosen_curve; stop 89, rail sets
+// where the screen proposed only curves and the chosen one was rejected).
 std::vector<std::size_t> decision_rivals(const std::vector<Augmentation>& planned, std::size_t chosen,
                                          const std::vector<std::size_t>& probed = {});
 
@@ -666,6 +671,12 @@ struct CandidateTrial {
   // Proposed by an earlier round's screen (FixOptions::earlier_candidates):
   // its screen_statistic is that round's.
   bool from_earlier_round = false;
+  // Planned after the selection as the upper rail of a chosen calibration
+  // curve whose group tops out together (fix(): a rail's signature), to be
+  // its rival (the rail extended to its group and its family alone); not
+  // one of the screen's candidates, and planned without the candidates'
+  // floor (below_screen_floor stays false).
+  bool rail_of_chosen_curve = false;
   // Chosen by the selection, a load drift of the drift probe's group
   // (gives_way_to_group_drift): on the selection's judged rows, this plan's
   // loss minus the probe plan's, over the channels either changes (each
@@ -785,7 +796,7 @@ struct FixResult {
   // FixOptions::min_excess_null, at most the screen's floor); none without a
   // null (the screen's absolute floors).
   std::optional<double> candidates_floor;
-  std::vector<CandidateTrial> candidates;          // the screen's candidates, in its order (then the probe's, then an earlier round's)
+  std::vector<CandidateTrial> candidates;          // the screen's candidates, in its order (then the probe's, then an earlier round's, then the chosen curve's rail)
   std::vector<Augmentation> candidate_plans;       // candidates[k]'s plan, before any re-estimation
   // The drift probes (drift_probe.h), run when the logs are long enough for
   // the selection's rows and the screen proposes a load drift or leaves a
