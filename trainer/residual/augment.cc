@@ -933,12 +933,17 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // rivals, each at Holm's levels: decision_rivals).
   std::size_t chosen = 0;
   std::vector<std::size_t> rivals;  // decision_rivals() that gained: tested beside the choice
-  for (std::size_t k = 0; k < planned.size(); ++k) {
+  // A plan's record among the candidates, before it is judged.
+  const auto trial_of = [&](const Augmentation& plan) {
     CandidateTrial c;
-    c.effect = planned[k].effect;
-    c.description = planned[k].description;
-    c.channels = channels_of(planned[k]);
-    c.screen_statistic = planned[k].screen_statistic;
+    c.effect = plan.effect;
+    c.description = plan.description;
+    c.channels = channels_of(plan);
+    c.screen_statistic = plan.screen_statistic;
+    return c;
+  };
+  for (std::size_t k = 0; k < planned.size(); ++k) {
+    CandidateTrial c = trial_of(planned[k]);
     c.from_drift_probe = std::find(probed.begin(), probed.end(), k) != probed.end();
     c.from_earlier_round = k >= first_earlier;
     c.below_screen_floor = !c.from_drift_probe && !c.from_earlier_round && attribution.null &&
@@ -1038,11 +1043,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
         std::reverse(rails.begin(), rails.end());  // simpler_plans: fewest channels first
         for (Augmentation& rail : rails) {
           planned.push_back(std::move(rail));
-          CandidateTrial c;
-          c.effect = planned.back().effect;
-          c.description = planned.back().description;
-          c.channels = channels_of(planned.back());
-          c.screen_statistic = planned.back().screen_statistic;
+          CandidateTrial c = trial_of(planned.back());
           c.rail_of_chosen_curve = true;
           result.candidates.push_back(std::move(c));
           judged_rows.emplace_back();
