@@ -304,6 +304,13 @@ int run_residual(int argc, char** argv) {
             "decision on held-out rows against fine-tuning alone guards what is applied (docs/residual.md,\n"
             "\"Candidates down to 1 by default\"); never above --min-excess-null",
             num("%g", rs::kDefaultFixMinExcessNull));
+  opt.value("fix-upper-rail-floor", "S",
+            "with --fix and a null: an upper rail (the readings of a channel clipped at their top) is a\n"
+            "candidate down to S times its channel's clean residual level beyond the null, below the\n"
+            "candidates' floor (--fix-min-excess-null), when the screen finds it at Holm's level with its\n"
+            "share of the held-out residual variance (docs/residual.md, \"An upper rail below the\n"
+            "candidates' floor\"); never above the candidates' floor",
+            num("%g", rs::kDefaultFixUpperRailFloor));
   opt.value("drift-probe-alpha", "A",
             "with --fix: the drift probe's family-wise level (Holm over the channel groups whose fitted rate\n"
             "is positive; see --candidates); 0: no probe",
@@ -399,7 +406,26 @@ int run_residual(int argc, char** argv) {
     fix_min_excess = opt.get_double("fix-min-excess-null", 0.0, 1e6);
     if (!fix_min_excess) return 2;
   }
+  std::optional<double> fix_upper_rail_floor;  // given; else FixOptions' default
+  if (opt.has("fix-upper-rail-floor")) {
+    fix_upper_rail_floor = opt.get_double("fix-upper-rail-floor", 0.0, 1e6);
+    if (!fix_upper_rail_floor) return 2;
+  }
   if (!fix_epochs || !fix_lr || !fix_seed || !rounds || !candidates || !folds || !drift_probe_alpha) return 2;
+  if (opt.has("fix-upper-rail-floor") && !opt.has("fix")) {
+    std::fprintf(stderr, "hadynet residual: --fix-upper-rail-floor needs --fix\n");
+    return 2;
+  }
+  if (opt.has("fix-upper-rail-floor") && no_reference) {
+    std::fprintf(stderr, "hadynet residual: --fix-upper-rail-floor needs a null (not --reference none)\n");
+    return 2;
+  }
+  if (const double candidates_floor = fix_min_excess ? *fix_min_excess : std::min(rs::kDefaultFixMinExcessNull, *min_excess);
+      fix_upper_rail_floor && *fix_upper_rail_floor > candidates_floor) {
+    std::fprintf(stderr, "hadynet residual: --fix-upper-rail-floor %g is above the candidates' floor %g\n"
+                 "(--fix-min-excess-null): an upper rail's floor can only be lower\n", *fix_upper_rail_floor, candidates_floor);
+    return 2;
+  }
   if (opt.has("fix-min-excess-null") && !opt.has("fix")) {
     std::fprintf(stderr, "hadynet residual: --fix-min-excess-null needs --fix\n");
     return 2;
@@ -492,6 +518,7 @@ int run_residual(int argc, char** argv) {
     fo.decision_pooling = *decision_pooling;
     fo.selection = *selection;
     if (fix_min_excess) fo.min_excess_null = fix_min_excess;
+    if (fix_upper_rail_floor) fo.upper_rail_floor = fix_upper_rail_floor;
     fo.reference = &reference;
     fo.reference_pb_choice = stored_null ? "state" : "auto";
     fo.library = ao.library;

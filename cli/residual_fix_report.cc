@@ -63,6 +63,7 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
             {"seed", o.seed},
             {"min_excess_null", o.min_excess_null ? json(*o.min_excess_null) : json(nullptr)},
             {"candidates_floor", f.candidates_floor ? json(*f.candidates_floor) : json(nullptr)},
+            {"upper_rail_floor", f.upper_rail_floor ? json(*f.upper_rail_floor) : json(nullptr)},
             {"before", held_out_json(f.before)}};
   if (f.augmentation) {
     const rs::Augmentation& a = *f.augmentation;

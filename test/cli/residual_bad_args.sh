@@ -96,6 +96,15 @@ expect 2 "--fix-selection is screen-order or every-channel, not 'best'" "$model"
   --json out.json
 expect 2 "--fix-min-excess-null 4 is above the screen's --min-excess-null 3" "$model" good.csv --fix \
   --fix-min-excess-null 4 --json out.json
+expect 2 "--fix-upper-rail-floor needs --fix" "$model" good.csv --fix-upper-rail-floor 0 --json out.json
+expect 2 "--fix-upper-rail-floor needs a null (not --reference none)" "$model" good.csv --reference none --fix \
+  --fix-upper-rail-floor 0 --json out.json
+expect 2 "--fix-upper-rail-floor: expected a number in 0..1e+06, got '-1'" "$model" good.csv --fix \
+  --fix-upper-rail-floor -1 --json out.json
+expect 2 "--fix-upper-rail-floor 1.5 is above the candidates' floor 1" "$model" good.csv --fix \
+  --fix-upper-rail-floor 1.5 --json out.json
+expect 2 "--fix-upper-rail-floor 0.6 is above the candidates' floor 0.5" "$model" good.csv --fix \
+  --fix-min-excess-null 0.5 --fix-upper-rail-floor 0.6 --json out.json
 expect 1 "--reference good.csv is also a log under test" "$model" good.csv --reference good.csv --json out.json
 expect 1 "no_fc8.csv: no column 'fc8'" "$model" good.csv --reference no_fc8.csv --json out.json
 expect 1 "malformed.csv:15:12: column 'f2'" "$model" good.csv --reference malformed.csv --json out.json

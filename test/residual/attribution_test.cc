@@ -9,10 +9,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <random>
 #include <set>
 #include <stdexcept>
+#include <string>
 #include <variant>
+#include <vector>
 
 #include "trainer/residual/augment.h"
 
@@ -494,6 +497,63 @@ TEST(CalibratedNull, AnotherFloorRanksAsAttributeAtThatFloor) {
   }
   const Attribution absolute = run(test);
   EXPECT_EQ(significant(with_null_floor(absolute, 0.0)), significant(absolute));
+}
+
+// with_upper_rail_floor (--fix's candidates, FixOptions::upper_rail_floor):
+// an upper rail below the floor of excess_share passes at the rail's own
+// floor when every other test of the screen passes; a lower rail, another
+// effect, a rail below the share of the residual variance (min_explained),
+// above Holm's level or with an implausible gain, and a rail below its own
+// floor do not. Hand-made results (the floors' arithmetic alone), ranked
+// significant first. Without a null, nothing changes.
+TEST(CalibratedNull, AnUpperRailBelowTheFloorPassesAtItsOwnFloor) {
+  const auto result = [](const std::string& label, EffectKind kind, int side, double excess_share) {
+    HypothesisResult r;
+    r.label = label;
+    r.hypothesis.kind = kind;
+    r.hypothesis.side = side;
+    r.testable = true;
+    r.p_value = 1e-12;
+    r.p_adjusted = 1e-10;
+    r.explained = 0.5;
+    r.excess_share = excess_share;
+    return r;
+  };
+  Attribution screen;
+  screen.null = NullCalibration{};
+  screen.tested = 8;
+  screen.ranked.push_back(result("upper rail", EffectKind::kSaturation, +1, 0.3));
+  screen.ranked.push_back(result("lower rail", EffectKind::kSaturation, -1, 0.3));
+  screen.ranked.push_back(result("delay", EffectKind::kSensorDelay, 0, 0.3));
+  screen.ranked.push_back(result("upper rail, little variance", EffectKind::kSaturation, +1, 0.3));
+  screen.ranked.back().explained = 0.05;  // below min_explained (0.1)
+  screen.ranked.push_back(result("upper rail, above Holm's level", EffectKind::kSaturation, +1, 0.3));
+  screen.ranked.back().p_adjusted = 0.02;
+  screen.ranked.push_back(result("upper rail, implausible", EffectKind::kSaturation, +1, 0.3));
+  screen.ranked.back().plausible = false;
+  screen.ranked.push_back(result("upper rail, below the null", EffectKind::kSaturation, +1, -0.1));
+  screen.ranked.push_back(result("upper rail, above the floor", EffectKind::kSaturation, +1, 4.0));
+  const auto significant = [](const Attribution& a) {
+    std::vector<std::string> labels;
+    for (const auto& r : a.ranked)
+      if (r.significant) labels.push_back(r.label);
+    return labels;
+  };
+  const Attribution at_floor = with_null_floor(screen, kDefaultMinExcessNull);
+  EXPECT_EQ(significant(at_floor), std::vector<std::string>{"upper rail, above the floor"});
+  const Attribution rails = with_upper_rail_floor(at_floor, 0.0);
+  EXPECT_EQ(significant(rails), (std::vector<std::string>{"upper rail, above the floor", "upper rail"}));
+  EXPECT_EQ(rails.options.upper_rail_floor, std::optional<double>(0.0));
+  EXPECT_EQ(rails.options.min_excess_null, kDefaultMinExcessNull);
+  EXPECT_TRUE(rails.ranked[1].significant);   // the significant first, by excess share
+  EXPECT_FALSE(rails.ranked[2].significant);
+  EXPECT_EQ(significant(with_upper_rail_floor(at_floor, 0.5)), significant(at_floor));  // 0.3 < 0.5
+  // A rail's floor above the others' changes nothing (it is never higher).
+  EXPECT_EQ(significant(with_upper_rail_floor(with_null_floor(screen, 0.2), 1.0)),
+            significant(with_null_floor(screen, 0.2)));
+  Attribution absolute = screen;
+  absolute.null.reset();
+  EXPECT_EQ(significant(with_upper_rail_floor(absolute, 0.0)), significant(absolute));
 }
 
 TEST(CalibratedNull, AReferenceWithOtherChannelsIsRefused) {

@@ -336,8 +336,13 @@ namespace {
 void mark_and_rank(Attribution& att) {
   const AttributionOptions& options = att.options;
   for (auto& r : att.ranked) {
-    r.significant = r.testable && r.p_adjusted < options.alpha && r.explained >= options.min_explained &&
-                    floor_statistic(att, r) >= floor_of(options, att.null.has_value()) && r.plausible;
+    const bool upper_rail = r.hypothesis.kind == EffectKind::kSaturation && r.hypothesis.side > 0;
+    const bool rail_floor = att.null && upper_rail && options.upper_rail_floor &&
+                            *options.upper_rail_floor < options.min_excess_null;
+    const bool above_floor = rail_floor ? r.excess_share >= *options.upper_rail_floor
+                                        : floor_statistic(att, r) >= floor_of(options, att.null.has_value());
+    r.significant =
+        r.testable && r.p_adjusted < options.alpha && r.explained >= options.min_explained && above_floor && r.plausible;
   }
   std::stable_sort(att.ranked.begin(), att.ranked.end(), [&att](const HypothesisResult& a, const HypothesisResult& b) {
     if (a.significant != b.significant) return a.significant;
@@ -385,12 +390,27 @@ Attribution attribute(const ResidualData& data, const std::vector<Hypothesis>& h
   return att;
 }
 
-Attribution with_null_floor(const Attribution& attribution, double min_excess_null) {
+namespace {
+
+// `attribution` with its options changed by `change(options)`, significance
+// and ranking recomputed; without a null, `attribution` unchanged.
+template <class Change>
+Attribution refloored(const Attribution& attribution, Change change) {
   if (!attribution.null) return attribution;
   Attribution att = attribution;
-  att.options.min_excess_null = min_excess_null;
+  change(att.options);
   mark_and_rank(att);
   return att;
+}
+
+}  // namespace
+
+Attribution with_null_floor(const Attribution& attribution, double min_excess_null) {
+  return refloored(attribution, [&](AttributionOptions& o) { o.min_excess_null = min_excess_null; });
+}
+
+Attribution with_upper_rail_floor(const Attribution& attribution, double floor) {
+  return refloored(attribution, [&](AttributionOptions& o) { o.upper_rail_floor = floor; });
 }
 
 }  // namespace hadynet::trainer::residual

@@ -65,6 +65,11 @@ struct AttributionOptions {
   // hypothesis on clean development logs (1.76; docs/residual.md, "A
   // calibrated null"), as min_explained_std was for the absolute floor.
   double min_excess_null = kDefaultMinExcessNull;
+  // With a calibrated null: the floor of excess_share of an upper rail (a
+  // saturation at the top of a channel's readings) instead of
+  // min_excess_null when lower (unset: min_excess_null); every other
+  // condition stays. Set by with_upper_rail_floor() for fix()'s candidates.
+  std::optional<double> upper_rail_floor;
 };
 
 struct HypothesisResult {
@@ -157,5 +162,10 @@ Attribution attribute(const ResidualData& data, const std::vector<Hypothesis>& h
 // than the screen's verdict (FixOptions::min_excess_null). Without a
 // null, `attribution` unchanged (the absolute floors stay).
 Attribution with_null_floor(const Attribution& attribution, double min_excess_null);
+
+// `attribution` with AttributionOptions::upper_rail_floor at `floor`:
+// significance and ranking recomputed as with_null_floor() does. Without a
+// null, `attribution` unchanged.
+Attribution with_upper_rail_floor(const Attribution& attribution, double floor);
 
 }  // namespace hadynet::trainer::residual

@@ -661,8 +661,11 @@ HadynetModel augmented_model(const HadynetModel& model, const Augmentation& a,
 }
 
 Attribution candidates_view(const Attribution& attribution, const FixOptions& options) {
-  if (!options.min_excess_null || *options.min_excess_null >= attribution.options.min_excess_null) return attribution;
-  return with_null_floor(attribution, *options.min_excess_null);
+  const Attribution view =
+      !options.min_excess_null || *options.min_excess_null >= attribution.options.min_excess_null
+          ? attribution
+          : with_null_floor(attribution, *options.min_excess_null);
+  return options.upper_rail_floor ? with_upper_rail_floor(view, *options.upper_rail_floor) : view;
 }
 
 FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, const ResidualData& data,
@@ -683,6 +686,8 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   const ResidualLevels* levels = result.scale == DecisionScale::kResidual ? &null_levels : nullptr;
   const Attribution view = candidates_view(attribution, options);
   if (view.null) result.candidates_floor = view.options.min_excess_null;
+  if (view.null && view.options.upper_rail_floor && *view.options.upper_rail_floor < view.options.min_excess_null)
+    result.upper_rail_floor = view.options.upper_rail_floor;
   std::vector<Augmentation> planned = plan_candidates(data, view, options.candidates);
   // An earlier round's plans (FixOptions::earlier_candidates), tried after
   // this round's: none this round's screen plans too (kind and channels).

@@ -41,6 +41,10 @@ namespace hadynet::trainer::residual {
 
 // FixOptions::min_excess_null's default (units of a channel's clean residual level).
 inline constexpr double kDefaultFixMinExcessNull = 1.0;
+// FixOptions::upper_rail_floor's default: an upper rail needs no excess over
+// the null's but none below it (docs/residual.md, "An upper rail below the
+// candidates' floor (stop 90)").
+inline constexpr double kDefaultFixUpperRailFloor = 0.0;
 // FixOptions::drift_probe_alpha's default. The probe only proposes: the
 // selection and the decision on held-out rows against fine-tuning alone
 // judge its candidate (as FixOptions::min_excess_null lets the screen's
@@ -191,6 +195,16 @@ struct FixOptions {
   // default"): on fresh logs more effects named, no clean set confirmed;
   // with one fold (stop 45) it made more wrong fixes and was not the default.
   std::optional<double> min_excess_null = kDefaultFixMinExcessNull;
+  // With a calibrated null: the floor of excess_share of an upper rail among
+  // the candidates (AttributionOptions::upper_rail_floor), when below the
+  // candidates' floor; every other condition of the screen stays (Holm's
+  // level, the share of the held-out residual variance, a plausible gain).
+  // A rail's 1-step residual is small where the network carries the clipped
+  // reading over from its input, yet it follows the prediction's excess
+  // over the rail one for one: on development sets every rail set held such
+  // a rail, mostly below the candidates' floor, and 1 of 385 others (no
+  // clean set) did. --fix-upper-rail-floor; unset: the candidates' floor.
+  std::optional<double> upper_rail_floor = kDefaultFixUpperRailFloor;
   // The calibrated null's logs of the analysis (analyse()'s reference), for
   // the augmented model's verdict; nullptr or empty: absolute floors.
   const std::vector<LogInput>* reference = nullptr;
@@ -622,7 +636,9 @@ std::vector<Augmentation> richer_plans(const ResidualData& data, const Attributi
 // The ranking fix() plans its candidates from: `attribution` re-floored at
 // options.min_excess_null (with_null_floor) when that is below the screen's
 // floor, else `attribution` itself (never above the screen's floor; unset:
-// the screen's; without a null the absolute floors stay).
+// the screen's; without a null the absolute floors stay), and an upper
+// rail's floor at options.upper_rail_floor (with_upper_rail_floor) when
+// that is below the former.
 Attribution candidates_view(const Attribution& attribution, const FixOptions& options);
 
 // The sensor model after adding the augmentation's part (add_to_sensor:
@@ -796,6 +812,9 @@ struct FixResult {
   // FixOptions::min_excess_null, at most the screen's floor); none without a
   // null (the screen's absolute floors).
   std::optional<double> candidates_floor;
+  // The floor of an upper rail's excess_share among the candidates
+  // (FixOptions::upper_rail_floor), when below candidates_floor; else none.
+  std::optional<double> upper_rail_floor;
   std::vector<CandidateTrial> candidates;          // the screen's candidates, in its order (then the probe's, then an earlier round's, then the chosen curve's rail)
   std::vector<Augmentation> candidate_plans;       // candidates[k]'s plan, before any re-estimation
   // The drift probes (drift_probe.h), run when the logs are long enough for
