@@ -444,7 +444,15 @@
 # 4730-4749 clean sets (stop 88's code); 4750-4759 saturation=2 and
 # 4760-4769 sensor-curve=0.7 measured with the final code and stop 88's on
 # the same logs. bench/residual_pass_rates.py pools blocks of one code.
-# Next unused: 4790 on.
+# Stop 90 (an upper rail is a candidate below the candidates' floor,
+# --fix-upper-rail-floor): 4790-4799 every effect at its larger strength
+# measured with stop 89's code, then development of the rule (its rail
+# sets, with those of 4600-4609, 4645-4654, 4710-4729 and 4750-4759 and
+# cross-talk 4647, re-run with the rule); 4800-4809 every effect measured
+# with the final code (its rail sets and the curve's 4802 with stop 89's
+# code too); 4810-4829 clean sets, 4830-4839 the gain wobble, 4840-4849
+# saturation=2 with both codes, 4850-4854 two effects.
+# Next unused: 4855 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -152,8 +152,10 @@
 # Stop 88: 4655-4674 with its final code (every choice's rivals also the
 # plans of the groups it does not hold that gained more; 0 of 20).
 # Stop 89: 4730-4749 with stop 88's code (0 of 20); 4770-4789 with its
-# final code (a chosen curve's rail among its rivals; 0 of 20).
-# Next unused seed: 4790
+# final code (a chosen curve's rail among its rivals; 0 of 20). Stop 90:
+# 4810-4829 with its final code (an upper rail a candidate below the
+# candidates' floor; 0 of 20).
+# Next unused seed: 4855
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

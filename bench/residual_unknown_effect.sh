@@ -64,7 +64,9 @@
 # final code, a curve at its group's summed excess share, once per group:
 # 0 of 10 confirmed, 5 unexplained); 4680-4689 (stop 88's final code,
 # every choice's rivals also the plans of the groups it does not hold that
-# gained more: 0 of 10 confirmed, 5 unexplained).
+# gained more: 0 of 10 confirmed, 5 unexplained); 4830-4839 (stop 90's
+# final code, an upper rail a candidate below the candidates' floor: 0 of
+# 10 confirmed, 3 unexplained).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R]
