@@ -455,12 +455,14 @@
 # Next unused: 4855 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
-#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...
+#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--fix-upper-rail-floor S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...
 #   defaults: models/hand.safetensors, build/residual-detection, 10, 231, the tool's --candidates (5), every case
 #   (--case: only those; repeatable), the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
 #   --fix-min-excess-null S: passed to `hadynet residual --fix` (candidates below the screen's floor;
 #   the tool's default 1 since stop 48, the screen's floor 3 before)
+#   --fix-upper-rail-floor S: passed to `hadynet residual --fix` (an upper rail's floor among the
+#   candidates; the tool's default 0 since stop 90; 1, the candidates' floor: stop 89's candidates)
 #   --rezeroed-first-init I: the k-th seed's sets are recorded under the zeroing I + k, one the model
 #   never saw, and keep the trained state names (a re-zeroed hand; bench/residual_grasps.sh)
 #   --decision-loss L: passed to `hadynet residual --fix` (squared, its default, or absolute: its default in stop 59)
@@ -489,6 +491,7 @@ while (($#)); do
     --first-seed) first_seed=$2; shift 2 ;;
     --candidates) candidates=(--candidates "$2"); shift 2 ;;
     --fix-min-excess-null) candidates+=(--fix-min-excess-null "$2"); shift 2 ;;
+    --fix-upper-rail-floor) candidates+=(--fix-upper-rail-floor "$2"); shift 2 ;;
     --decision-loss) candidates+=(--decision-loss "$2"); shift 2 ;;
     --decision-scale) candidates+=(--decision-scale "$2"); shift 2 ;;
     --decision-pooling) candidates+=(--decision-pooling "$2"); shift 2 ;;
