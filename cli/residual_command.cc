@@ -308,8 +308,8 @@ int run_residual(int argc, char** argv) {
             "with --fix and a null: an upper rail (the readings of a channel clipped at their top) is a\n"
             "candidate down to S times its channel's clean residual level beyond the null, below the\n"
             "candidates' floor (--fix-min-excess-null), when the screen finds it at Holm's level with its\n"
-            "share of the held-out residual variance (docs/residual.md, \"An upper rail below the\n"
-            "candidates' floor\"); never above the candidates' floor",
+            "share of the held-out residual variance and a plausible gain (docs/residual.md, \"An upper\n"
+            "rail below the candidates' floor\"); never above the candidates' floor",
             num("%g", rs::kDefaultFixUpperRailFloor));
   opt.value("drift-probe-alpha", "A",
             "with --fix: the drift probe's family-wise level (Holm over the channel groups whose fitted rate\n"
@@ -412,20 +412,6 @@ int run_residual(int argc, char** argv) {
     if (!fix_upper_rail_floor) return 2;
   }
   if (!fix_epochs || !fix_lr || !fix_seed || !rounds || !candidates || !folds || !drift_probe_alpha) return 2;
-  if (opt.has("fix-upper-rail-floor") && !opt.has("fix")) {
-    std::fprintf(stderr, "hadynet residual: --fix-upper-rail-floor needs --fix\n");
-    return 2;
-  }
-  if (opt.has("fix-upper-rail-floor") && no_reference) {
-    std::fprintf(stderr, "hadynet residual: --fix-upper-rail-floor needs a null (not --reference none)\n");
-    return 2;
-  }
-  if (const double candidates_floor = fix_min_excess ? *fix_min_excess : std::min(rs::kDefaultFixMinExcessNull, *min_excess);
-      fix_upper_rail_floor && *fix_upper_rail_floor > candidates_floor) {
-    std::fprintf(stderr, "hadynet residual: --fix-upper-rail-floor %g is above the candidates' floor %g\n"
-                 "(--fix-min-excess-null): an upper rail's floor can only be lower\n", *fix_upper_rail_floor, candidates_floor);
-    return 2;
-  }
   if (opt.has("fix-min-excess-null") && !opt.has("fix")) {
     std::fprintf(stderr, "hadynet residual: --fix-min-excess-null needs --fix\n");
     return 2;
@@ -437,6 +423,21 @@ int run_residual(int argc, char** argv) {
   }
   if (opt.has("fix-min-excess-null") && no_reference) {
     std::fprintf(stderr, "hadynet residual: --fix-min-excess-null needs a null (not --reference none)\n");
+    return 2;
+  }
+  if (opt.has("fix-upper-rail-floor") && !opt.has("fix")) {
+    std::fprintf(stderr, "hadynet residual: --fix-upper-rail-floor needs --fix\n");
+    return 2;
+  }
+  if (opt.has("fix-upper-rail-floor") && no_reference) {
+    std::fprintf(stderr, "hadynet residual: --fix-upper-rail-floor needs a null (not --reference none)\n");
+    return 2;
+  }
+  if (const double candidates_floor = fix_min_excess ? *fix_min_excess : std::min(rs::kDefaultFixMinExcessNull, *min_excess);
+      fix_upper_rail_floor && *fix_upper_rail_floor > candidates_floor) {
+    std::fprintf(stderr, "hadynet residual: --fix-upper-rail-floor %g is above the candidates' floor %g\n"
+                 "(--fix-min-excess-null, at most --min-excess-null): an upper rail's floor can only be lower\n",
+                 *fix_upper_rail_floor, candidates_floor);
     return 2;
   }
   if (opt.has("drift-probe-alpha") && !opt.has("fix")) {

@@ -105,6 +105,8 @@ expect 2 "--fix-upper-rail-floor 1.5 is above the candidates' floor 1" "$model" 
   --fix-upper-rail-floor 1.5 --json out.json
 expect 2 "--fix-upper-rail-floor 0.6 is above the candidates' floor 0.5" "$model" good.csv --fix \
   --fix-min-excess-null 0.5 --fix-upper-rail-floor 0.6 --json out.json
+expect 2 "--fix-upper-rail-floor 0.6 is above the candidates' floor 0.5" "$model" good.csv --fix \
+  --min-excess-null 0.5 --fix-upper-rail-floor 0.6 --json out.json
 expect 1 "--reference good.csv is also a log under test" "$model" good.csv --reference good.csv --json out.json
 expect 1 "no_fc8.csv: no column 'fc8'" "$model" good.csv --reference no_fc8.csv --json out.json
 expect 1 "malformed.csv:15:12: column 'f2'" "$model" good.csv --reference malformed.csv --json out.json

@@ -28,9 +28,9 @@ hadynet=$1 model=$2 work=$3
 here=$(cd "$(dirname "$0")/../.." && pwd)
 source "$here/test/cli/plant_fix_run.sh"
 # --fix-upper-rail-floor 1 (the candidates' floor): since stop 90 the
-# screen's upper rail of fc7 (0.23 times its clean level beyond the null)
-# is a candidate itself by default and the rail is applied without the
-# rule tested here.
+# screen's upper rails of the loadcells (fc4's, the plan's lead, 0.57 times
+# its clean level beyond the null; fc7's 0.23) are candidates themselves by
+# default, and the rail is applied without the rule tested here.
 plant_fix_run "$hadynet" "$model" "$work" 4713 --fix-upper-rail-floor 1 -- --effect saturation=2 || exit 1
 grep -E "^(fix|decision|Rivals)" "$work/out.txt" | cut -c1-400
 python3 - "$work/residual.json" "$here/bench" "$here/test/cli" <<'PY'

@@ -504,7 +504,7 @@ TEST(CalibratedNull, AnotherFloorRanksAsAttributeAtThatFloor) {
 // floor when every other test of the screen passes; a lower rail, another
 // effect, a rail below the share of the residual variance (min_explained),
 // above Holm's level or with an implausible gain, and a rail below its own
-// floor do not. Hand-made results (the floors' arithmetic alone), ranked
+// floor do not; one at its own floor does. Hand-made results (the floors' arithmetic alone), ranked
 // significant first. Without a null, nothing changes.
 TEST(CalibratedNull, AnUpperRailBelowTheFloorPassesAtItsOwnFloor) {
   const auto result = [](const std::string& label, EffectKind kind, int side, double excess_share) {
@@ -548,6 +548,11 @@ TEST(CalibratedNull, AnUpperRailBelowTheFloorPassesAtItsOwnFloor) {
   EXPECT_TRUE(rails.ranked[1].significant);   // the significant first, by excess share
   EXPECT_FALSE(rails.ranked[2].significant);
   EXPECT_EQ(significant(with_upper_rail_floor(at_floor, 0.5)), significant(at_floor));  // 0.3 < 0.5
+  // At the rail's floor itself a rail passes (>=, as every floor of excess share).
+  EXPECT_EQ(significant(with_upper_rail_floor(at_floor, 0.3)), significant(rails));
+  // A rail's floor equal to the others' is no other floor: the excess of 0.3 stays below 1.
+  EXPECT_EQ(significant(with_upper_rail_floor(with_null_floor(screen, 1.0), 1.0)),
+            std::vector<std::string>{"upper rail, above the floor"});
   // A rail's floor above the others' changes nothing (it is never higher).
   EXPECT_EQ(significant(with_upper_rail_floor(with_null_floor(screen, 0.2), 1.0)),
             significant(with_null_floor(screen, 0.2)));

@@ -69,6 +69,9 @@ struct AttributionOptions {
   // saturation at the top of a channel's readings) instead of
   // min_excess_null when lower (unset: min_excess_null); every other
   // condition stays. Set by with_upper_rail_floor() for fix()'s candidates.
+  // A rail's family (Attribution::family_of: one effect, any side) then
+  // holds the upper rails this floor lets in too, also under a lower rail's
+  // lead above the floor.
   std::optional<double> upper_rail_floor;
 };
 

@@ -202,8 +202,10 @@ struct FixOptions {
   // A rail's 1-step residual is small where the network carries the clipped
   // reading over from its input, yet it follows the prediction's excess
   // over the rail one for one: on development blocks every rail set held
-  // such a rail (60 of 60), mostly below the candidates' floor, 1 of 280
-  // sets of the other effects did and none of 60 clean sets.
+  // such a rail (60 of 60), 10 of them none at the candidates' floor; 1 of
+  // 350 sets of the other effects did and none of 60 clean sets. The
+  // rail's family and extension read this floor too, so a rail above the
+  // candidates' floor can be planned on more channels.
   // --fix-upper-rail-floor; unset: the candidates' floor.
   std::optional<double> upper_rail_floor = kDefaultFixUpperRailFloor;
   // The calibrated null's logs of the analysis (analyse()'s reference), for
