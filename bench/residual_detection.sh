@@ -451,8 +451,9 @@
 # cross-talk 4647, re-run with the rule); 4800-4809 every effect measured
 # with the final code (its rail sets and the curve's 4802 with stop 89's
 # code too); 4810-4829 clean sets, 4830-4839 the gain wobble, 4840-4849
-# saturation=2 with both codes, 4850-4854 two effects.
-# Next unused: 4855 on.
+# saturation=2 with both codes, 4850-4854 two effects, 4855-4864 every
+# effect at its larger strength measured with the final code.
+# Next unused: 4865 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--fix-upper-rail-floor S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...

@@ -155,7 +155,7 @@
 # final code (a chosen curve's rail among its rivals; 0 of 20). Stop 90:
 # 4810-4829 with its final code (an upper rail a candidate below the
 # candidates' floor; 0 of 20).
-# Next unused seed: 4855
+# Next unused seed: 4865
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
