@@ -41,8 +41,9 @@ namespace hadynet::trainer::residual {
 
 // FixOptions::min_excess_null's default (units of a channel's clean residual level).
 inline constexpr double kDefaultFixMinExcessNull = 1.0;
-// FixOptions::upper_rail_floor's default: an upper rail needs no excess over
-// the null's but none below it (docs/residual.md, "An upper rail below the
+// FixOptions::upper_rail_floor's default: an upper rail needs an excess
+// share of at least 0 (it explains at least what it does on the null), not
+// the candidates' floor (docs/residual.md, "An upper rail below the
 // candidates' floor (stop 90)").
 inline constexpr double kDefaultFixUpperRailFloor = 0.0;
 // FixOptions::drift_probe_alpha's default. The probe only proposes: the
