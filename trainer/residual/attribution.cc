@@ -337,8 +337,7 @@ void mark_and_rank(Attribution& att) {
   const AttributionOptions& options = att.options;
   for (auto& r : att.ranked) {
     const bool upper_rail = r.hypothesis.kind == EffectKind::kSaturation && r.hypothesis.side > 0;
-    const bool uses_rail_floor = att.null && upper_rail && options.upper_rail_floor &&
-                                 *options.upper_rail_floor < options.min_excess_null;
+    const bool uses_rail_floor = att.null && upper_rail && options.upper_rail_floor_applies();
     const bool above_floor = uses_rail_floor ? r.excess_share >= *options.upper_rail_floor
                                         : floor_statistic(att, r) >= floor_of(options, att.null.has_value());
     r.significant =

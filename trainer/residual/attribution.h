@@ -73,6 +73,8 @@ struct AttributionOptions {
   // holds the upper rails this floor lets in too, also under a lower rail's
   // lead above the floor.
   std::optional<double> upper_rail_floor;
+  // upper_rail_floor is set and below min_excess_null (it then applies).
+  bool upper_rail_floor_applies() const { return upper_rail_floor && *upper_rail_floor < min_excess_null; }
 };
 
 struct HypothesisResult {

@@ -686,8 +686,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   const ResidualLevels* levels = result.scale == DecisionScale::kResidual ? &null_levels : nullptr;
   const Attribution view = candidates_view(attribution, options);
   if (view.null) result.candidates_floor = view.options.min_excess_null;
-  if (view.null && view.options.upper_rail_floor && *view.options.upper_rail_floor < view.options.min_excess_null)
-    result.upper_rail_floor = view.options.upper_rail_floor;
+  if (view.null && view.options.upper_rail_floor_applies()) result.upper_rail_floor = view.options.upper_rail_floor;
   std::vector<Augmentation> planned = plan_candidates(data, view, options.candidates);
   // An earlier round's plans (FixOptions::earlier_candidates), tried after
   // this round's: none this round's screen plans too (kind and channels).
