@@ -456,7 +456,7 @@
 # Next unused: 4865 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
-#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--fix-upper-rail-floor S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--case EFFECT=STRENGTH]...
+#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--fix-upper-rail-floor S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--fix-tie-break T] [--case EFFECT=STRENGTH]...
 #   defaults: models/hand.safetensors, build/residual-detection, 10, 231, the tool's --candidates (5), every case
 #   (--case: only those; repeatable), the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
@@ -470,6 +470,7 @@
 #   --decision-scale S: passed to `hadynet residual --fix` (std or residual: each channel's error in its clean residual level)
 #   --decision-pooling P: passed to `hadynet residual --fix` (rows, its default, or logs: each log in its own level)
 #   --fix-selection R: passed to `hadynet residual --fix` (screen-order or every-channel)
+#   --fix-tie-break T: passed to `hadynet residual --fix` (largest-gain or fewest-channels)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
 set -euo pipefail
@@ -497,6 +498,7 @@ while (($#)); do
     --decision-scale) candidates+=(--decision-scale "$2"); shift 2 ;;
     --decision-pooling) candidates+=(--decision-pooling "$2"); shift 2 ;;
     --fix-selection) candidates+=(--fix-selection "$2"); shift 2 ;;
+    --fix-tie-break) candidates+=(--fix-tie-break "$2"); shift 2 ;;
     --case) only_cases+=("$2"); shift 2 ;;
     --rezeroed-first-init) rezeroed_first_init=$2; shift 2 ;;
     *) echo "residual_detection: unknown argument $1" >&2; exit 2 ;;

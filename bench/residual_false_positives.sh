@@ -160,7 +160,7 @@
 # Give others as arguments.
 #
 # Usage: bench/residual_false_positives.sh [--model M] [--out DIR] [--rated-range R]... [--candidates K]
-#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [SEED...]
+#          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--fix-tie-break T] [SEED...]
 #   defaults: models/hand.safetensors, build/residual-false-positives, 161..180,
 #   no rated range (the plant's datasheet: --rated-range fc=0..50 --rated-range f=0..200),
 #   the null of `hadynet residual`'s default: the held-out logs stored in the model
@@ -172,6 +172,7 @@
 #   --decision-scale S: passed to `hadynet residual --fix` (std or residual: each channel's error in its clean residual level)
 #   --decision-pooling P: passed to `hadynet residual --fix` (rows, its default, or logs: each log in its own level)
 #   --fix-selection R: passed to `hadynet residual --fix` (screen-order or every-channel)
+#   --fix-tie-break T: passed to `hadynet residual --fix` (largest-gain or fewest-channels)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per seed with an ETA, then the counts; OUT/summary.txt.
 set -euo pipefail
@@ -195,6 +196,7 @@ while (($#)); do
     --decision-scale) ranges+=(--decision-scale "$2"); shift 2 ;;
     --decision-pooling) ranges+=(--decision-pooling "$2"); shift 2 ;;
     --fix-selection) ranges+=(--fix-selection "$2"); shift 2 ;;
+    --fix-tie-break) ranges+=(--fix-tie-break "$2"); shift 2 ;;
     --rezeroed-first-init) rezeroed_first_init=$2; shift 2 ;;
     -*) echo "residual_false_positives: unknown option $1" >&2; exit 2 ;;
     *) seeds+=("$1"); shift ;;

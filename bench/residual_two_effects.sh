@@ -75,7 +75,7 @@
 # --candidates 5).
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
-#          [--pair A=X+B=Y]... [--decision-loss L] [--decision-scale S] [--fix-selection R]
+#          [--pair A=X+B=Y]... [--decision-loss L] [--decision-scale S] [--fix-selection R] [--fix-tie-break T]
 #   defaults: models/hand.safetensors, build/residual-two-effects, 5, 641, --candidates 3 (the earlier
 #   runs' setting, for comparison; the tool's default is 5), the pairs
 #   sensor-delay=2+crosstalk=0.35, sensor-delay=2+friction=4, input-delay=2+crosstalk=0.35,
@@ -83,6 +83,7 @@
 #   --decision-loss L: passed to `hadynet residual --fix` (squared, its default, or absolute: its default in stop 59)
 #   --decision-scale S: passed to `hadynet residual --fix` (std or residual: each channel's error in its clean residual level)
 #   --fix-selection R: passed to `hadynet residual --fix` (screen-order or every-channel)
+#   --fix-tie-break T: passed to `hadynet residual --fix` (largest-gain or fewest-channels)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per run with an ETA, then the table (OUT/summary.txt).
 set -euo pipefail
@@ -106,6 +107,7 @@ while (($#)); do
     --decision-loss) fix_args+=(--decision-loss "$2"); shift 2 ;;
     --decision-scale) fix_args+=(--decision-scale "$2"); shift 2 ;;
     --fix-selection) fix_args+=(--fix-selection "$2"); shift 2 ;;
+    --fix-tie-break) fix_args+=(--fix-tie-break "$2"); shift 2 ;;
     *) echo "residual_two_effects: unknown argument $1" >&2; exit 2 ;;
   esac
 done

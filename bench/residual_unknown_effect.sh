@@ -69,13 +69,14 @@
 # 10 confirmed, 3 unexplained).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
-#          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R]
+#          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--fix-tie-break T]
 #   defaults: models/hand.safetensors, build/residual-unknown-effect, 10, 221, the null of
 #   `hadynet residual`'s default (the held-out logs stored in the model; --reference-seed none: no null)
 #   --decision-loss L: passed to `hadynet residual --fix` (squared, its default, or absolute: its default in stop 59)
 #   --decision-scale S: passed to `hadynet residual --fix` (std or residual: each channel's error in its clean residual level)
 #   --decision-pooling P: passed to `hadynet residual --fix` (rows, its default, or logs: each log in its own level)
 #   --fix-selection R: passed to `hadynet residual --fix` (screen-order or every-channel)
+#   --fix-tie-break T: passed to `hadynet residual --fix` (largest-gain or fewest-channels)
 # Environment: HADYNET (default build/release/cli/hadynet).
 # Prints one line per log set with an ETA, then the counts (OUT/summary.txt).
 set -euo pipefail
@@ -100,6 +101,7 @@ while (($#)); do
     --decision-scale) fix_args+=(--decision-scale "$2"); shift 2 ;;
     --decision-pooling) fix_args+=(--decision-pooling "$2"); shift 2 ;;
     --fix-selection) fix_args+=(--fix-selection "$2"); shift 2 ;;
+    --fix-tie-break) fix_args+=(--fix-tie-break "$2"); shift 2 ;;
     *) echo "residual_unknown_effect: unknown argument $1" >&2; exit 2 ;;
   esac
 done

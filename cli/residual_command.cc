@@ -297,7 +297,9 @@ int run_residual(int argc, char** argv) {
                               "drifts of its group) or friction (the curves of its groups), and of any choice every\n"
                               "plan of the groups it does not hold that gained more than it, that gained on those rows\n"
                               "too are tested beside it on the held-out rows, all at Holm's levels, and of those\n"
-                              "confirmed the one that predicts the channels any of them changes best is applied", "5");
+                              "confirmed, the best predictor of the channels any of them changes and the plans it does\n"
+                              "not beat significantly there tie, and the one of them changing the fewest channels is\n"
+                              "applied (--fix-tie-break)", "5");
   opt.value("fix-min-excess-null", "S",
             "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"
             "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"
@@ -331,6 +333,12 @@ int run_residual(int argc, char** argv) {
             "channels, the first in the screen's order that gains significantly) or every-channel (each on\n"
             "every channel, the largest statistic among those that gain significantly)",
             rs::selection_rule_name(rs::FixOptions{}.selection));
+  opt.value("fix-tie-break", "largest-gain|fewest-channels",
+            "with --fix: which confirmed plan is applied when the choice and its rivals are confirmed:\n"
+            "largest-gain (the largest mean gain on the channels any of them changes) or fewest-channels\n"
+            "(of that plan and the plans it does not beat significantly there, the one changing the\n"
+            "fewest channels)",
+            rs::tie_break_name(rs::FixOptions{}.tie_break));
   opt.value("decision-scale", "std|residual",
             "with --fix: the unit of each channel's error in the held-out tests' loss (the decision and\n"
             "the tests after it; the selection and the drift probe keep std) before the mean over the judged\n"
@@ -401,6 +409,8 @@ int run_residual(int argc, char** argv) {
   if (!decision_pooling) return 2;
   const auto selection = named_value(opt, "fix-selection", rs::selection_rule_named, "screen-order or every-channel");
   if (!selection) return 2;
+  const auto tie_break = named_value(opt, "fix-tie-break", rs::tie_break_named, "largest-gain or fewest-channels");
+  if (!tie_break) return 2;
   std::optional<double> fix_min_excess;  // given; else FixOptions' default (fix() keeps it at most the screen's)
   if (opt.has("fix-min-excess-null")) {
     fix_min_excess = opt.get_double("fix-min-excess-null", 0.0, 1e6);
@@ -518,6 +528,7 @@ int run_residual(int argc, char** argv) {
     fo.decision_scale = *decision_scale;
     fo.decision_pooling = *decision_pooling;
     fo.selection = *selection;
+    fo.tie_break = *tie_break;
     if (fix_min_excess) fo.min_excess_null = fix_min_excess;
     if (fix_upper_rail_floor) fo.upper_rail_floor = fix_upper_rail_floor;
     fo.reference = &reference;

@@ -27,6 +27,11 @@ json held_out_json(const rs::HeldOutError& e) {
   return {{"samples", e.samples}, {"verdict", e.verdict}, {"channels", ch}};
 }
 
+// A Diebold-Mariano test's fields.
+json dm_json(const rs::DieboldMariano& t) {
+  return {{"mean_loss_difference", t.mean}, {"statistic", t.stat}, {"rows", t.samples}, {"p_value", t.p_value}};
+}
+
 // "a, b, c".
 std::string comma_separated(const std::vector<std::string>& names) {
   std::string out;
@@ -173,6 +178,9 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
           plan["gain_over_chosen"] = {{"mean_loss_difference", rv.gain->mean},
                                       {"statistic", rv.gain->stat},
                                       {"p_value", rv.gain->p_value}};
+        plan["changes"] = rv.changes;
+        if (rv.behind_largest) plan["behind_largest_gain"] = dm_json(*rv.behind_largest);
+        plan["ties"] = rv.ties;
         plans.push_back(plan);
       }
       j["rivals"] = {{"against", f.reference},
@@ -180,7 +188,14 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                      {"chosen_effect", r.chosen_effect},
                      {"chosen_p_value", r.chosen_confirmation.p_value},
                      {"chosen_confirmed", r.chosen_confirmed},
+                     {"chosen_changes", r.chosen_changes},
+                     {"chosen_behind_largest_gain",
+                      r.chosen_behind_largest ? dm_json(*r.chosen_behind_largest) : json()},
+                     {"chosen_ties", r.chosen_ties},
                      {"gain_channels", r.gain_channels},
+                     {"tie_break", rs::tie_break_name(r.tie_break)},
+                     {"largest_gain_effect", r.largest_gain_effect},
+                     {"tie_broken", r.tie_broken},
                      {"plans", plans}};
     }
     json candidates = json::array();
@@ -311,6 +326,10 @@ std::string rivals_sentence(const rs::FixResult::Rivals& r, const std::string& r
     text += rv.confirmed ? ", confirmed" : ", not confirmed";
     if (rv.gain) text += ", its gain over " + r.chosen_effect + " on the channels any confirmed one changes " +
                          num("%.3g", rv.gain->mean);
+    if (rv.behind_largest)
+      text += ", behind " + r.largest_gain_effect + "'s there by " + num("%.3g", rv.behind_largest->mean) + " (p " +
+              num("%.2g", rv.behind_largest->p_value) + (rv.ties ? ", a tie" : "") + ")";
+    text += ", changing " + std::to_string(rv.changes) + " channel" + (rv.changes == 1 ? "" : "s");
     if (rv.applied) {
       text += ", applied in its place";
       applied = true;
@@ -318,6 +337,13 @@ std::string rivals_sentence(const rs::FixResult::Rivals& r, const std::string& r
     text += ";";
   }
   text.pop_back();
+  if (r.chosen_behind_largest)
+    text += "; " + r.chosen_effect + " (changing " + std::to_string(r.chosen_changes) + " channel" +
+            (r.chosen_changes == 1 ? "" : "s") + ") behind " + r.largest_gain_effect + "'s by " +
+            num("%.3g", r.chosen_behind_largest->mean) + " (p " + num("%.2g", r.chosen_behind_largest->p_value) +
+            (r.chosen_ties ? ", a tie" : "") + ")";
+  if (r.tie_broken)
+    text += "; of the plans tied with " + r.largest_gain_effect + ", the one changing the fewest channels is applied";
   if (!applied && r.chosen_confirmed) text += "; " + r.chosen_effect + " kept";
   return text;
 }

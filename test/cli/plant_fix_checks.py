@@ -4,7 +4,7 @@ residual_leak_between_groups_test.sh, residual_drift_rival_test.sh,
 residual_drift_group_rival_test.sh, residual_crosstalk_source_test.sh,
 residual_drift_full_screen_test.sh, residual_curve_as_rival_test.sh,
 residual_other_group_rival_test.sh, residual_curve_rail_test.sh,
-residual_upper_rail_test.sh).
+residual_upper_rail_test.sh, residual_rival_tie_test.sh).
 
 named_with_cut(case, seed, json_path, check): the detection bench's rule
 on one run (named with its parameter, cut by 30 %, below fine-tuning

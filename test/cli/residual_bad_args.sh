@@ -94,6 +94,8 @@ expect 2 "--decision-pooling is rows or logs, not 'folds'" "$model" good.csv --f
   --json out.json
 expect 2 "--fix-selection is screen-order or every-channel, not 'best'" "$model" good.csv --fix --fix-selection best \
   --json out.json
+expect 2 "--fix-tie-break is largest-gain or fewest-channels, not 'simplest'" "$model" good.csv --fix \
+  --fix-tie-break simplest --json out.json
 expect 2 "--fix-min-excess-null 4 is above the screen's --min-excess-null 3" "$model" good.csv --fix \
   --fix-min-excess-null 4 --json out.json
 expect 2 "--fix-upper-rail-floor needs --fix" "$model" good.csv --fix-upper-rail-floor 0 --json out.json

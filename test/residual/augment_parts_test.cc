@@ -1610,6 +1610,35 @@ TEST(DecisionRivals, ARailHasThePlansOfOtherGroupsAsRivalsThatGainedMoreThanIt) 
   EXPECT_DOUBLE_EQ(residual::rival_gain_floor(planned[1], planned[0], 0.12, true), 0.12);
 }
 
+// --fix-tie-break fewest-channels (fewest_channels_among_ties): of the
+// plan with the largest gain and the confirmed plans that tie with it, the
+// one changing the fewest channels; the larger gain among equally few; a
+// plan that does not tie is never taken, however few its channels. Exact:
+// indices.
+TEST(DecisionRivals, OfTiedPlansTheOneChangingTheFewestChannelsIsApplied) {
+  using residual::ConfirmedPlan;
+  using residual::fewest_channels_among_ties;
+  // [0] the choice (1 channel, gain 0), [1] a curve of nine channels with
+  // the largest gain: the choice ties with it and is applied.
+  EXPECT_EQ(fewest_channels_among_ties({{1, 0.0, true}, {9, 0.003, false}}, 1), 0u);
+  // The choice does not tie (the largest gain beats it significantly): kept.
+  EXPECT_EQ(fewest_channels_among_ties({{1, 0.0, false}, {9, 0.14, false}}, 1), 1u);
+  // The largest gain's plan changes the fewest itself: kept.
+  EXPECT_EQ(fewest_channels_among_ties({{8, 0.0, true}, {4, 0.02, false}}, 1), 1u);
+  // The choice has the largest gain; a rival of 4 channels ties: applied.
+  EXPECT_EQ(fewest_channels_among_ties({{8, 0.0, false}, {4, -0.026, true}}, 0), 1u);
+  // Two tied rivals of 4 channels each: the larger gain; a tied plan of
+  // 6 and an untied plan of 2 are not taken.
+  EXPECT_EQ(fewest_channels_among_ties({{9, 0.0, true}, {4, 0.01, true}, {4, 0.05, true}, {6, 0.2, false},
+                                        {2, 0.0, false}, {6, 0.1, true}},
+                                       3),
+            2u);
+  // A tie of channels and gain with the largest's plan: that plan.
+  EXPECT_EQ(fewest_channels_among_ties({{3, 0.0, true}, {3, 0.0, false}}, 1), 1u);
+  // One plan alone.
+  EXPECT_EQ(fewest_channels_among_ties({{5, 0.0, false}}, 0), 0u);
+}
+
 // A model of two y channels, a and b, of standard deviations 2 and 4.
 HadynetModel loss_model() {
   HadynetModel m;

@@ -118,6 +118,14 @@ std::optional<SelectionRule> selection_rule_named(const std::string& name) {
   return value_named(name, {SelectionRule::kScreenOrder, SelectionRule::kEveryChannel}, selection_rule_name);
 }
 
+const char* tie_break_name(TieBreak rule) {
+  return rule == TieBreak::kLargestGain ? "largest-gain" : "fewest-channels";
+}
+
+std::optional<TieBreak> tie_break_named(const std::string& name) {
+  return value_named(name, {TieBreak::kLargestGain, TieBreak::kFewestChannels}, tie_break_name);
+}
+
 const char* decision_scale_name(DecisionScale scale) {
   return scale == DecisionScale::kStd ? "std" : "residual";
 }
@@ -132,6 +140,17 @@ const char* decision_pooling_name(DecisionPooling pooling) {
 
 std::optional<DecisionPooling> decision_pooling_named(const std::string& name) {
   return value_named(name, {DecisionPooling::kRows, DecisionPooling::kLogs}, decision_pooling_name);
+}
+
+std::size_t fewest_channels_among_ties(const std::vector<ConfirmedPlan>& plans, std::size_t largest) {
+  std::size_t pick = largest;
+  for (std::size_t i = 0; i < plans.size(); ++i) {
+    const ConfirmedPlan& p = plans[i];
+    if (i == largest || !p.ties) continue;
+    const ConfirmedPlan& q = plans[pick];
+    if (p.changes < q.changes || (p.changes == q.changes && p.gain > q.gain)) pick = i;
+  }
+  return pick;
 }
 
 DecisionRows decision_rows(int T, int split, int d) {
@@ -1225,6 +1244,35 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       r.plans.push_back(std::move(rv));
     }
     confirmed = any;
+    r.tie_break = options.tie_break;
+    r.chosen_changes = decided.trial.tested.channels.size();
+    for (std::size_t i = 0; i < others.size(); ++i) r.plans[i].changes = others[i].trial.tested.channels.size();
+    r.largest_gain_effect = best ? r.plans[*best].effect : r.chosen_effect;
+    if (any && options.tie_break == TieBreak::kFewestChannels) {
+      // The confirmed plans the largest gain's does not beat significantly
+      // tie with it; of those, the one changing the fewest channels, the
+      // larger gain among equally few (the choice's gain is 0).
+      const FoldTrial& largest = best ? others[*best].trial : decided.trial;
+      const auto ties = [&](const FoldTrial& t, std::optional<DieboldMariano>& behind) {
+        behind = compare(t.rows, t.mirrored, largest.rows, largest.mirrored, r.gain_channels);
+        return !significant(*behind);
+      };
+      // plans[0]: the choice; plans[i + 1]: others[i] (a plan not
+      // confirmed never ties).
+      std::vector<ConfirmedPlan> plans(others.size() + 1);
+      plans[0].changes = r.chosen_changes;
+      if (best && r.chosen_confirmed) plans[0].ties = r.chosen_ties = ties(decided.trial, r.chosen_behind_largest);
+      for (std::size_t i = 0; i < others.size(); ++i) {
+        FixResult::Rivals::Rival& rv = r.plans[i];
+        plans[i + 1].changes = rv.changes;
+        plans[i + 1].gain = rv.gain ? rv.gain->mean : 0.0;
+        if (rv.confirmed && !(best && i == *best)) plans[i + 1].ties = rv.ties = ties(others[i].trial, rv.behind_largest);
+      }
+      const std::size_t largest_plan = best ? *best + 1 : 0;
+      const std::size_t applied_plan = fewest_channels_among_ties(plans, largest_plan);
+      r.tie_broken = applied_plan != largest_plan;
+      best = applied_plan == 0 ? std::nullopt : std::optional<std::size_t>(applied_plan - 1);
+    }
     if (best) {
       r.plans[*best].applied = true;
       decided = std::move(others[*best]);

@@ -67,6 +67,14 @@ enum class SelectionRule { kScreenOrder, kEveryChannel };
 const char* selection_rule_name(SelectionRule rule);  // "screen-order" or "every-channel"
 std::optional<SelectionRule> selection_rule_named(const std::string& name);
 
+// --fix-tie-break (FixOptions::tie_break): which of the confirmed plans
+// (the selection's choice and its rivals, FixResult::Rivals) is applied
+// when the one with the largest mean gain does not beat another
+// significantly on the channels any of them changes.
+enum class TieBreak { kLargestGain, kFewestChannels };
+const char* tie_break_name(TieBreak rule);  // "largest-gain" or "fewest-channels"
+std::optional<TieBreak> tie_break_named(const std::string& name);
+
 // The per-row loss of every Diebold-Mariano test of --fix (the selection,
 // the decision, the tests after a confirmation and the drift probe): the
 // mean over the judged channels of each channel's 1-step error in the
@@ -166,6 +174,20 @@ struct FixOptions {
   // injected tension leak and loadcell delay (docs/residual.md, "Every
   // channel in its own residual's unit (stop 61)").
   SelectionRule selection = SelectionRule::kScreenOrder;
+  // Of the confirmed plans (the choice and its rivals), which is applied.
+  // kLargestGain: the one with the largest mean gain over the choice on the
+  // channels any of them changes (no test). kFewestChannels: of the plans
+  // that one does not beat significantly there (one-sided Diebold-Mariano
+  // at alpha, every fold judged: they tie with it), the one that changes
+  // the fewest channels (Augmentation::channels), the larger mean gain
+  // among equally few: where the held-out rows cannot tell two confirmed
+  // accounts apart, the one that changes less of the model. The default
+  // since stop 91: on the 57 development sets where two plans or more were
+  // confirmed it broke a tie on 8; a cross-talk then beat a curve of its
+  // group twice (sets 4861, 4863, now passed) and a rail a curve or a
+  // wider rail six times (passed with either rule; docs/residual.md,
+  // "Ties among confirmed plans (stop 91)"). --fix-tie-break.
+  TieBreak tie_break = TieBreak::kFewestChannels;
   // How many of the screen's candidates may be tried (plan_candidates: the
   // best of each class (an effect; a cross-talk within or between groups, a
   // curve per group), and a plan extended to its group also on its
@@ -767,6 +789,20 @@ std::optional<std::size_t> best_candidate(const std::vector<CandidateTrial>& can
 // `alpha` (chosen_candidate's first rule; fix() judges no further candidate).
 bool gains_significantly(const CandidateTrial& c, double alpha);
 
+// One confirmed plan of the decision (the choice or a rival) for
+// fewest_channels_among_ties: how many channels it changes, its mean gain
+// over the choice (the choice's: 0), and whether it ties with the plan of
+// the largest gain (that plan's gain over it is not significant).
+struct ConfirmedPlan {
+  std::size_t changes = 0;
+  double gain = 0;
+  bool ties = false;
+};
+// TieBreak::kFewestChannels: of plans[largest] and the plans that tie with
+// it, the index of the one changing the fewest channels; the larger gain
+// among equally few (plans[largest] on a full tie). `largest` < plans.size().
+std::size_t fewest_channels_among_ties(const std::vector<ConfirmedPlan>& plans, std::size_t largest);
+
 // The decision (issue 12, "decide by what the fix does"): the screen only
 // proposes. Of its first FixOptions::candidates candidates, one is chosen
 // on the training rows alone (chosen_candidate; selection: CandidateTrial). The chosen augmented, fine-tuned model is kept only when
@@ -940,12 +976,27 @@ struct FixResult {
       std::optional<DieboldMariano> own_channels;  // a curve: the same on its own channels
       bool confirmed = false;                      // at Holm's level
       std::optional<DieboldMariano> gain;          // confirmed: the choice's loss minus its on gain_channels
-      bool applied = false;                        // the decision's plan is this rival
+      std::size_t changes = 0;                     // how many channels it changes (Augmentation::channels)
+      // Confirmed and not the plan of the largest gain, with
+      // TieBreak::kFewestChannels: its loss minus that plan's on
+      // gain_channels, every fold; ties: not significant there.
+      std::optional<DieboldMariano> behind_largest;
+      bool ties = false;
+      bool applied = false;  // the decision's plan is this rival
     };
     std::string chosen_effect;           // the selection's choice ...
     DieboldMariano chosen_confirmation;  // ... its test (reference's loss minus its)
     bool chosen_confirmed = false;       // ... at Holm's level
+    std::size_t chosen_changes = 0;      // ... how many channels it changes
+    std::optional<DieboldMariano> chosen_behind_largest;  // ... as Rival::behind_largest
+    bool chosen_ties = false;
     double alpha = 0;                    // the decision's level
+    TieBreak tie_break = TieBreak::kLargestGain;
+    // The plan of the largest gain: its effect (the choice's when none beats
+    // it); tie_broken: a plan with fewer channels that ties with it was
+    // applied instead (TieBreak::kFewestChannels).
+    std::string largest_gain_effect;
+    bool tie_broken = false;
     std::vector<std::string> gain_channels;
     std::vector<Rival> plans;
   };
