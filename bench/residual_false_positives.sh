@@ -154,8 +154,9 @@
 # Stop 89: 4730-4749 with stop 88's code (0 of 20); 4770-4789 with its
 # final code (a chosen curve's rail among its rivals; 0 of 20). Stop 90:
 # 4810-4829 with its final code (an upper rail a candidate below the
-# candidates' floor; 0 of 20).
-# Next unused seed: 4865
+# candidates' floor; 0 of 20). Stop 91: 4930-4949 with its final code (of
+# tied confirmed plans the one changing the fewest channels; 0 of 20).
+# Next unused seed: 4960
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

@@ -72,7 +72,11 @@
 # (a curve at its group's summed excess share, once per group;
 # --candidates 5). Stop 88: 4675-4679 with its final code (every choice's
 # rivals also the plans of the groups it does not hold that gained more;
-# --candidates 5).
+# --candidates 5). Stop 90: 4850-4854 with its final code (an upper rail a
+# candidate below the candidates' floor; --candidates 5). Stop 91:
+# 4885-4889 with its final code (of tied confirmed plans the one changing
+# the fewest channels; --candidates 5), the sensor delay and friction with
+# stop 90's code too.
 #
 # Usage: bench/residual_two_effects.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--pair A=X+B=Y]... [--decision-loss L] [--decision-scale S] [--fix-selection R] [--fix-tie-break T]

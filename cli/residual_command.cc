@@ -297,9 +297,9 @@ int run_residual(int argc, char** argv) {
                               "drifts of its group) or friction (the curves of its groups), and of any choice every\n"
                               "plan of the groups it does not hold that gained more than it, that gained on those rows\n"
                               "too are tested beside it on the held-out rows, all at Holm's levels, and of those\n"
-                              "confirmed, the best predictor of the channels any of them changes and the plans it does\n"
-                              "not beat significantly there tie, and the one of them changing the fewest channels is\n"
-                              "applied (--fix-tie-break)", "5");
+                              "confirmed the one --fix-tie-break picks is applied (by default, of the best predictor\n"
+                              "of the channels any of them changes and the plans it does not beat significantly there,\n"
+                              "the one changing the fewest channels)", "5");
   opt.value("fix-min-excess-null", "S",
             "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"
             "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"
@@ -334,7 +334,7 @@ int run_residual(int argc, char** argv) {
             "every channel, the largest statistic among those that gain significantly)",
             rs::selection_rule_name(rs::FixOptions{}.selection));
   opt.value("fix-tie-break", "largest-gain|fewest-channels",
-            "with --fix: which confirmed plan is applied when the choice and its rivals are confirmed:\n"
+            "with --fix: which plan is applied when two or more of the choice and its rivals are confirmed:\n"
             "largest-gain (the largest mean gain on the channels any of them changes) or fewest-channels\n"
             "(of that plan and the plans it does not beat significantly there, the one changing the\n"
             "fewest channels)",

@@ -178,8 +178,8 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
           plan["gain_over_chosen"] = {{"mean_loss_difference", rv.gain->mean},
                                       {"statistic", rv.gain->stat},
                                       {"p_value", rv.gain->p_value}};
-        plan["changes"] = rv.changes;
-        if (rv.behind_largest) plan["behind_largest_gain"] = dm_json(*rv.behind_largest);
+        plan["changed_channels"] = rv.changed_channels;
+        plan["behind_largest_gain"] = rv.behind_largest ? dm_json(*rv.behind_largest) : json();
         plan["ties"] = rv.ties;
         plans.push_back(plan);
       }
@@ -188,13 +188,15 @@ nlohmann::json fix_json(const rs::FixResult& f, const rs::FixOptions& o) {
                      {"chosen_effect", r.chosen_effect},
                      {"chosen_p_value", r.chosen_confirmation.p_value},
                      {"chosen_confirmed", r.chosen_confirmed},
-                     {"chosen_changes", r.chosen_changes},
+                     {"chosen_changed_channels", r.chosen_changed_channels},
                      {"chosen_behind_largest_gain",
                       r.chosen_behind_largest ? dm_json(*r.chosen_behind_largest) : json()},
                      {"chosen_ties", r.chosen_ties},
                      {"gain_channels", r.gain_channels},
                      {"tie_break", rs::tie_break_name(r.tie_break)},
-                     {"largest_gain_effect", r.largest_gain_effect},
+                     {"largest_gain_candidate",
+                      r.largest_gain_candidate ? json(*r.largest_gain_candidate) : json()},
+                     {"largest_gain_effect", r.largest_gain_candidate ? json(r.largest_gain_effect) : json()},
                      {"tie_broken", r.tie_broken},
                      {"plans", plans}};
     }
@@ -312,6 +314,16 @@ std::string richer_sentence(const rs::FixResult::RicherAccount& r, const std::st
                         : "no significant gain, " + r.replaces + " kept");
 }
 
+// "3 channels", "1 channel".
+std::string channel_count(std::size_t n) { return std::to_string(n) + (n == 1 ? " channel" : " channels"); }
+
+// A plan's loss minus that of the plan of the largest gain (Rival::behind_largest).
+std::string behind_largest(const rs::FixResult::Rivals& r, const rs::DieboldMariano& t, bool ties) {
+  return "its loss minus that of the largest gain's plan (" + r.largest_gain_effect + ", no. " +
+         std::to_string(r.largest_gain_candidate.value_or(0) + 1) + " of the candidates listed) " +
+         num("%.3g", t.mean) + ", p " + num("%.2g", t.p_value) + (ties ? ": a tie" : ": not a tie");
+}
+
 std::string rivals_sentence(const rs::FixResult::Rivals& r, const std::string& reference) {
   const std::size_t m = r.plans.size() + 1;
   std::string text = "Rivals of " + r.chosen_effect + " (p " + num("%.2g", r.chosen_confirmation.p_value) +
@@ -326,10 +338,8 @@ std::string rivals_sentence(const rs::FixResult::Rivals& r, const std::string& r
     text += rv.confirmed ? ", confirmed" : ", not confirmed";
     if (rv.gain) text += ", its gain over " + r.chosen_effect + " on the channels any confirmed one changes " +
                          num("%.3g", rv.gain->mean);
-    if (rv.behind_largest)
-      text += ", behind " + r.largest_gain_effect + "'s there by " + num("%.3g", rv.behind_largest->mean) + " (p " +
-              num("%.2g", rv.behind_largest->p_value) + (rv.ties ? ", a tie" : "") + ")";
-    text += ", changing " + std::to_string(rv.changes) + " channel" + (rv.changes == 1 ? "" : "s");
+    if (rv.behind_largest) text += ", " + behind_largest(r, *rv.behind_largest, rv.ties);
+    text += ", changing " + channel_count(rv.changed_channels.size());
     if (rv.applied) {
       text += ", applied in its place";
       applied = true;
@@ -338,12 +348,11 @@ std::string rivals_sentence(const rs::FixResult::Rivals& r, const std::string& r
   }
   text.pop_back();
   if (r.chosen_behind_largest)
-    text += "; " + r.chosen_effect + " (changing " + std::to_string(r.chosen_changes) + " channel" +
-            (r.chosen_changes == 1 ? "" : "s") + ") behind " + r.largest_gain_effect + "'s by " +
-            num("%.3g", r.chosen_behind_largest->mean) + " (p " + num("%.2g", r.chosen_behind_largest->p_value) +
-            (r.chosen_ties ? ", a tie" : "") + ")";
+    text += "; " + r.chosen_effect + " (changing " + channel_count(r.chosen_changed_channels.size()) + "): " +
+            behind_largest(r, *r.chosen_behind_largest, r.chosen_ties);
   if (r.tie_broken)
-    text += "; of the plans tied with " + r.largest_gain_effect + ", the one changing the fewest channels is applied";
+    text += "; of the plan of the largest gain and those tied with it, the one changing the fewest channels is "
+            "applied";
   if (!applied && r.chosen_confirmed) text += "; " + r.chosen_effect + " kept";
   return text;
 }

@@ -41,8 +41,10 @@ check(r.get("chosen_ties") is True, "the cross-talk does not tie with the larges
 gains = [p for p in r.get("plans", []) if p["confirmed"] and "gain_over_chosen" in p]
 largest = max(gains, key=lambda p: p["gain_over_chosen"]["mean_loss_difference"], default=None)
 check(largest is not None and largest["gain_over_chosen"]["mean_loss_difference"] > 0
-      and r.get("chosen_changes", 99) < largest.get("changes", 0),
+      and len(r.get("chosen_changed_channels") or range(99)) < len(largest.get("changed_channels") or []),
       "the largest gain's plan does not gain over the cross-talk, or changes no more channels")
+check(largest is not None and r.get("largest_gain_candidate") == largest["candidate"],
+      "largest_gain_candidate is not the plan of the largest gain")
 check(r.get("tie_broken") is True and not any(p["applied"] for p in r.get("plans", [])),
       "the tie not broken: a rival applied in the cross-talk's place")
 check(aug.get("effect") == "crosstalk", "the cross-talk is not the change applied")

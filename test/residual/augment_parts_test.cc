@@ -1616,14 +1616,15 @@ TEST(DecisionRivals, ARailHasThePlansOfOtherGroupsAsRivalsThatGainedMoreThanIt) 
 // plan that does not tie is never taken, however few its channels. Exact:
 // indices.
 TEST(DecisionRivals, OfTiedPlansTheOneChangingTheFewestChannelsIsApplied) {
-  using residual::ConfirmedPlan;
+  using residual::TestedPlan;
   using residual::fewest_channels_among_ties;
   // [0] the choice (1 channel, gain 0), [1] a curve of nine channels with
   // the largest gain: the choice ties with it and is applied.
   EXPECT_EQ(fewest_channels_among_ties({{1, 0.0, true}, {9, 0.003, false}}, 1), 0u);
-  // The choice does not tie (the largest gain beats it significantly): kept.
+  // The choice does not tie (the largest gain beats it significantly): the
+  // largest gain's plan is applied.
   EXPECT_EQ(fewest_channels_among_ties({{1, 0.0, false}, {9, 0.14, false}}, 1), 1u);
-  // The largest gain's plan changes the fewest itself: kept.
+  // The largest gain's plan changes the fewest itself: it is applied.
   EXPECT_EQ(fewest_channels_among_ties({{8, 0.0, true}, {4, 0.02, false}}, 1), 1u);
   // The choice has the largest gain; a rival of 4 channels ties: applied.
   EXPECT_EQ(fewest_channels_among_ties({{8, 0.0, false}, {4, -0.026, true}}, 0), 1u);

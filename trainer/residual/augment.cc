@@ -142,13 +142,14 @@ std::optional<DecisionPooling> decision_pooling_named(const std::string& name) {
   return value_named(name, {DecisionPooling::kRows, DecisionPooling::kLogs}, decision_pooling_name);
 }
 
-std::size_t fewest_channels_among_ties(const std::vector<ConfirmedPlan>& plans, std::size_t largest) {
+std::size_t fewest_channels_among_ties(const std::vector<TestedPlan>& plans, std::size_t largest) {
   std::size_t pick = largest;
   for (std::size_t i = 0; i < plans.size(); ++i) {
-    const ConfirmedPlan& p = plans[i];
+    const TestedPlan& p = plans[i];
     if (i == largest || !p.ties) continue;
-    const ConfirmedPlan& q = plans[pick];
-    if (p.changes < q.changes || (p.changes == q.changes && p.gain > q.gain)) pick = i;
+    const TestedPlan& q = plans[pick];
+    if (p.changed_channels < q.changed_channels || (p.changed_channels == q.changed_channels && p.gain > q.gain))
+      pick = i;
   }
   return pick;
 }
@@ -1245,9 +1246,12 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
     }
     confirmed = any;
     r.tie_break = options.tie_break;
-    r.chosen_changes = decided.trial.tested.channels.size();
-    for (std::size_t i = 0; i < others.size(); ++i) r.plans[i].changes = others[i].trial.tested.channels.size();
-    r.largest_gain_effect = best ? r.plans[*best].effect : r.chosen_effect;
+    r.chosen_changed_channels = decided.trial.tested.channels;
+    for (std::size_t i = 0; i < others.size(); ++i) r.plans[i].changed_channels = others[i].trial.tested.channels;
+    if (any) {
+      r.largest_gain_candidate = best ? rivals[*best] : chosen;
+      r.largest_gain_effect = best ? r.plans[*best].effect : r.chosen_effect;
+    }
     if (any && options.tie_break == TieBreak::kFewestChannels) {
       // The confirmed plans the largest gain's does not beat significantly
       // tie with it; of those, the one changing the fewest channels, the
@@ -1259,12 +1263,12 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
       };
       // plans[0]: the choice; plans[i + 1]: others[i] (a plan not
       // confirmed never ties).
-      std::vector<ConfirmedPlan> plans(others.size() + 1);
-      plans[0].changes = r.chosen_changes;
+      std::vector<TestedPlan> plans(others.size() + 1);
+      plans[0].changed_channels = r.chosen_changed_channels.size();
       if (best && r.chosen_confirmed) plans[0].ties = r.chosen_ties = ties(decided.trial, r.chosen_behind_largest);
       for (std::size_t i = 0; i < others.size(); ++i) {
         FixResult::Rivals::Rival& rv = r.plans[i];
-        plans[i + 1].changes = rv.changes;
+        plans[i + 1].changed_channels = rv.changed_channels.size();
         plans[i + 1].gain = rv.gain ? rv.gain->mean : 0.0;
         if (rv.confirmed && !(best && i == *best)) plans[i + 1].ties = rv.ties = ties(others[i].trial, rv.behind_largest);
       }

@@ -176,17 +176,14 @@ struct FixOptions {
   SelectionRule selection = SelectionRule::kScreenOrder;
   // Of the confirmed plans (the choice and its rivals), which is applied.
   // kLargestGain: the one with the largest mean gain over the choice on the
-  // channels any of them changes (no test). kFewestChannels: of the plans
-  // that one does not beat significantly there (one-sided Diebold-Mariano
-  // at alpha, every fold judged: they tie with it), the one that changes
-  // the fewest channels (Augmentation::channels), the larger mean gain
-  // among equally few: where the held-out rows cannot tell two confirmed
-  // accounts apart, the one that changes less of the model. The default
-  // since stop 91: on the 57 development sets where two plans or more were
-  // confirmed it broke a tie on 8; a cross-talk then beat a curve of its
-  // group twice (sets 4861, 4863, now passed) and a rail a curve or a
-  // wider rail six times (passed with either rule; docs/residual.md,
-  // "Ties among confirmed plans (stop 91)"). --fix-tie-break.
+  // channels any of them changes (no test). kFewestChannels: of that plan
+  // and the confirmed plans it does not beat significantly there (one-sided
+  // Diebold-Mariano at alpha, every fold judged: they tie with it), the one
+  // that changes the fewest channels (Augmentation::channels), the larger
+  // mean gain among equally few: where the held-out rows cannot tell two
+  // confirmed accounts apart, the one that changes less of the model. The
+  // default since stop 91 (docs/residual.md, "Ties among confirmed plans
+  // (stop 91)"). --fix-tie-break.
   TieBreak tie_break = TieBreak::kFewestChannels;
   // How many of the screen's candidates may be tried (plan_candidates: the
   // best of each class (an effect; a cross-talk within or between groups, a
@@ -789,19 +786,21 @@ std::optional<std::size_t> best_candidate(const std::vector<CandidateTrial>& can
 // `alpha` (chosen_candidate's first rule; fix() judges no further candidate).
 bool gains_significantly(const CandidateTrial& c, double alpha);
 
-// One confirmed plan of the decision (the choice or a rival) for
-// fewest_channels_among_ties: how many channels it changes, its mean gain
-// over the choice (the choice's: 0), and whether it ties with the plan of
-// the largest gain (that plan's gain over it is not significant).
-struct ConfirmedPlan {
-  std::size_t changes = 0;
+// One plan the decision tested (the choice or a rival), for
+// fewest_channels_among_ties: how many channels it changes
+// (Augmentation::channels), its mean gain over the choice (the choice's:
+// 0), and whether it ties with the plan of the largest gain: confirmed, and
+// that plan's gain over it not significant (false for a plan not
+// confirmed, and for the largest gain's plan itself).
+struct TestedPlan {
+  std::size_t changed_channels = 0;
   double gain = 0;
   bool ties = false;
 };
 // TieBreak::kFewestChannels: of plans[largest] and the plans that tie with
 // it, the index of the one changing the fewest channels; the larger gain
 // among equally few (plans[largest] on a full tie). `largest` < plans.size().
-std::size_t fewest_channels_among_ties(const std::vector<ConfirmedPlan>& plans, std::size_t largest);
+std::size_t fewest_channels_among_ties(const std::vector<TestedPlan>& plans, std::size_t largest);
 
 // The decision (issue 12, "decide by what the fix does"): the screen only
 // proposes. Of its first FixOptions::candidates candidates, one is chosen
@@ -976,25 +975,30 @@ struct FixResult {
       std::optional<DieboldMariano> own_channels;  // a curve: the same on its own channels
       bool confirmed = false;                      // at Holm's level
       std::optional<DieboldMariano> gain;          // confirmed: the choice's loss minus its on gain_channels
-      std::size_t changes = 0;                     // how many channels it changes (Augmentation::channels)
+      std::vector<std::string> changed_channels;   // the channels it changes (Augmentation::channels)
       // Confirmed and not the plan of the largest gain, with
       // TieBreak::kFewestChannels: its loss minus that plan's on
-      // gain_channels, every fold; ties: not significant there.
+      // gain_channels, every fold (with DecisionPooling::kLogs each log in
+      // its own level, so not simply the difference of the two gains).
       std::optional<DieboldMariano> behind_largest;
+      // That loss difference not significant: it ties with the plan of the
+      // largest gain (false for that plan itself and for a plan not tested).
       bool ties = false;
       bool applied = false;  // the decision's plan is this rival
     };
     std::string chosen_effect;           // the selection's choice ...
     DieboldMariano chosen_confirmation;  // ... its test (reference's loss minus its)
     bool chosen_confirmed = false;       // ... at Holm's level
-    std::size_t chosen_changes = 0;      // ... how many channels it changes
+    std::vector<std::string> chosen_changed_channels;     // ... the channels it changes
     std::optional<DieboldMariano> chosen_behind_largest;  // ... as Rival::behind_largest
-    bool chosen_ties = false;
+    bool chosen_ties = false;                             // ... as Rival::ties
     double alpha = 0;                    // the decision's level
     TieBreak tie_break = TieBreak::kLargestGain;
-    // The plan of the largest gain: its effect (the choice's when none beats
-    // it); tie_broken: a plan with fewer channels that ties with it was
-    // applied instead (TieBreak::kFewestChannels).
+    // When any is confirmed, the confirmed plan of the largest gain: its
+    // candidate (an index into `candidates`) and effect (the choice's when
+    // no rival beats it); tie_broken: a plan with fewer channels that ties
+    // with it was applied instead (TieBreak::kFewestChannels).
+    std::optional<std::size_t> largest_gain_candidate;
     std::string largest_gain_effect;
     bool tie_broken = false;
     std::vector<std::string> gain_channels;
