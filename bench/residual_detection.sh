@@ -453,7 +453,15 @@
 # code too); 4810-4829 clean sets, 4830-4839 the gain wobble, 4840-4849
 # saturation=2 with both codes, 4850-4854 two effects, 4855-4864 every
 # effect at its larger strength measured with the final code.
-# Next unused: 4865 on.
+# Stop 91 (of tied confirmed plans the one changing the fewest channels,
+# --fix-tie-break): development: the 57 sets of stops 87-90's runs where
+# two plans or more were confirmed (docs/residual.md, "Ties among
+# confirmed plans (stop 91)"), among them 4800-4809's and 4855-4864's;
+# measured with the final code: 4865-4874, 4875-4884 and 4950-4959 every
+# effect at its larger strength, 4890-4909 crosstalk=0.35, 4910-4919
+# sensor-curve=0.7 and saturation=2 (the sets where the rule broke a tie
+# with stop 90's code too). 4920-4929 unused.
+# Next unused: 4960 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--fix-upper-rail-floor S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--fix-tie-break T] [--case EFFECT=STRENGTH]...
