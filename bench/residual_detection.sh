@@ -460,8 +460,13 @@
 # measured with the final code: 4865-4874, 4875-4884 and 4950-4959 every
 # effect at its larger strength, 4890-4909 crosstalk=0.35, 4910-4919
 # sensor-curve=0.7 and saturation=2 (the sets where the rule broke a tie
-# with stop 90's code too). 4920-4929 unused.
-# Next unused: 4960 on.
+# with stop 90's code too). 4920-4929 unused until stop 92.
+# Stop 92 (no change to the loop): 4960-4969 every effect at its larger
+# strength measured with stop 91's code; development of nothing. Drift
+# 4864, 4867, 4950, 4952, 4953 and 4957 re-run with the plant's rate
+# forced (a throw-away build; docs/residual.md, "What the cut leaves of
+# the bar (stop 92)"). 4920-4929 and 4970-4979 went to clean sets.
+# Next unused: 4980 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--fix-upper-rail-floor S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--fix-tie-break T] [--case EFFECT=STRENGTH]...

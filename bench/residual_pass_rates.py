@@ -21,14 +21,26 @@ Prints a table, cases in name order: passed / runs; the Wilson score
 interval at 95 % (binomial, runs taken as independent); and P(>= 9 of 10),
 the chance that a block of 10 fresh sets meets the bar at the observed rate
 (on the last row, that every case meets it in one block: the product,
-cases taken as independent). Exit status 2 for bad arguments or files, or
-when the files hold no run of the cases asked for.
+cases taken as independent). Then the misses by cause:
+  named, short    the right effect with the right parameter was applied,
+                  and its cut (30 %) or the control missed;
+  not confirmed   nothing was applied (the line's effect is the tested
+                  choice's, or "-" when none was tested);
+  wrong fix       a change was confirmed and applied that the bench's rule
+                  does not name (another effect or parameter);
+  failed          `hadynet residual` failed;
+and passed / named with P(>= 9 of 10) at that rate: the bar's chance if
+every run named its effect and the cut missed as often as on the named
+runs (what the cut and the control alone leave of the bar: no choice or
+decision can pass a set they miss with the effect named). Exit status 2
+for bad arguments or files, or when the files hold no run of the cases
+asked for.
 """
 import math
 import re
 import sys
 
-LINE = re.compile(r"(\S+) seed (\d+): named (yes|no) +cut (yes|no) .*<control (yes|no)")
+LINE = re.compile(r"(\S+) seed (\d+): named (yes|no) +cut (yes|no) .*<control (yes|no) +\| (confirmed|not confirmed):")
 FAILED = re.compile(r"(\S+) seed (\d+): residual failed")  # residual_detection.sh's line for a failed run
 Z95 = 1.959964  # two-sided 95 % normal quantile
 
@@ -48,8 +60,21 @@ def at_least(k, n, p):
     return sum(math.comb(n, i) * p**i * (1 - p) ** (n - i) for i in range(k, n + 1))
 
 
+CAUSES = ("named, short", "not confirmed", "wrong fix", "failed")
+
+
+def outcome(m):
+    """A run line's outcome: "passed" or its miss's cause (CAUSES); m: LINE's match, None for a failed run."""
+    if m is None:
+        return "failed"
+    named, cut, control, confirmed = m.group(3) == "yes", m.group(4) == "yes", m.group(5) == "yes", m.group(6)
+    if named:
+        return "passed" if cut and control else "named, short"
+    return "not confirmed" if confirmed == "not confirmed" else "wrong fix"
+
+
 def count(paths, cases=None):
-    """{case: [runs, passes]} over the files; ValueError for a set seen twice."""
+    """{case: {"runs": n, "passed": n, cause: n...}} over the files; ValueError for a set seen twice."""
     counts = {}
     where = {}  # (case, seed) -> the file it was first seen in
     for path in paths:
@@ -65,9 +90,9 @@ def count(paths, cases=None):
                 if key in where:
                     raise ValueError(f"{key[0]} seed {key[1]} is counted twice: in {where[key]} and in {path}")
                 where[key] = path
-                c = counts.setdefault(key[0], [0, 0])
-                c[0] += 1
-                c[1] += bool(m) and m.group(3) == "yes" and m.group(4) == "yes" and m.group(5) == "yes"
+                c = counts.setdefault(key[0], dict.fromkeys(("runs", "passed") + CAUSES, 0))
+                c["runs"] += 1
+                c[outcome(m)] += 1
     return counts
 
 
@@ -76,7 +101,8 @@ def rates(counts):
            "|---|---|---|---|"]
     total = [0, 0]
     every = 1.0  # P(every case >= 9 of 10 in one block), the cases independent
-    for case, (runs, passes) in sorted(counts.items()):
+    for case, c in sorted(counts.items()):
+        runs, passes = c["runs"], c["passed"]
         low, high = wilson(passes, runs)
         out.append(f"| {case} | {passes} / {runs} | {low:.2f}-{high:.2f} | {at_least(9, 10, passes / runs):.2f} |")
         total[0] += runs
@@ -84,6 +110,26 @@ def rates(counts):
         every *= at_least(9, 10, passes / runs)
     low, high = wilson(total[1], total[0])
     out.append(f"| every effect | {total[1]} / {total[0]} | {low:.2f}-{high:.2f} | {every:.2f} (all at once) |")
+    return "\n".join(out)
+
+
+def causes(counts):
+    """The misses by cause, and the bar's chance with every run named (passed / named)."""
+    out = ["| effect=strength | " + " | ".join(CAUSES) + " | passed / named | P(>= 9 of 10) at that rate |",
+           "|---|" + "---|" * (len(CAUSES) + 2)]
+    total = dict.fromkeys(("passed",) + CAUSES, 0)
+    every = 1.0
+    for case, c in sorted(counts.items()):
+        named = c["passed"] + c["named, short"]
+        rate = c["passed"] / named if named else 0.0
+        every *= at_least(9, 10, rate)
+        for k in total:
+            total[k] += c[k]
+        out.append(f"| {case} | " + " | ".join(str(c[k]) for k in CAUSES) +
+                   f" | {c['passed']} / {named} | {at_least(9, 10, rate):.2f} |")
+    named = total["passed"] + total["named, short"]
+    out.append("| every effect | " + " | ".join(str(total[k]) for k in CAUSES) +
+               f" | {total['passed']} / {named} | {every:.2f} (all at once) |")
     return "\n".join(out)
 
 
@@ -116,6 +162,8 @@ def main(argv):
               file=sys.stderr)
         return 2
     print(rates(counts))
+    print()
+    print(causes(counts))
     return 0
 
 

@@ -5,8 +5,8 @@
 # (stop 91)"). Fresh plant logs (the four grasps of docs/residual.md, 300
 # rows, recorded with SEED and the plant effect CASE), through
 # `hadynet residual MODEL LOGS --fix` with the plant's rated ranges and
-# every other setting a default. Two development sets of the rule, one per
-# path through fix():
+# every other setting a default. Three development sets of the rule, one
+# per path through fix():
 #   4861, crosstalk=0.35: the selection chooses the plant's cross-talk
 #     fc1 -> fc0 (one channel changed), confirmed against fine-tuning alone
 #     (p 4e-5); its rival, a curve of the loadcells applied to the whole
@@ -16,13 +16,18 @@
 #   4849, saturation=2: the selection's curve is not confirmed; two rails
 #     are (five and four channels), the wider with the larger gain; they
 #     tie, and the narrower rival is applied in the other rival's place.
+#   4859, saturation=2: the selection's curve of the loadcells (nine
+#     channels) is confirmed and has the largest gain; a rail of six
+#     loadcells is confirmed beside it and ties with it, and the rail is
+#     applied in the choice's place.
 # Checked: a tie is broken; the plan of the largest gain is the confirmed
 # plan with the largest gain over the choice; the plan applied ties with
 # it, changes fewer channels and the fewest of the tied; it is of EFFECT,
 # named (the bench's rule, bench/residual_named.py) and its held-out RMSE
 # on the channels it changes is cut by 30 % and below fine-tuning alone
 # (the bench's rule, bench/residual_run_line.py). About 20 s each on the
-# development VM. With stop 90's binary 4861 fails (the curve applied).
+# development VM. With stop 90's binary 4861 and 4859 fail (the curve
+# applied).
 #   residual_rival_tie_test.sh HADYNET MODEL WORKDIR SEED CASE EFFECT
 set -uo pipefail
 hadynet=$1 model=$2 work=$3 seed=$4 case=$5 effect=$6
