@@ -462,10 +462,11 @@
 # sensor-curve=0.7 and saturation=2 (the sets where the rule broke a tie
 # with stop 90's code too). 4920-4929 unused until stop 92.
 # Stop 92 (no change to the loop): 4960-4969 every effect at its larger
-# strength measured with stop 91's code; development of nothing. Drift
-# 4864, 4867, 4950, 4952, 4953 and 4957 re-run with the plant's rate
-# forced (a throw-away build; docs/residual.md, "What the cut leaves of
-# the bar (stop 92)"). 4920-4929 and 4970-4979 went to clean sets.
+# strength measured with stop 91's code (then, with every stored run, the
+# development data of a weighted Holm that was not built). Drift 4864,
+# 4867, 4950, 4952, 4953 and 4957 re-run with the plant's rate forced (a
+# throw-away build; docs/residual.md, "What the cut leaves of the bar
+# (stop 92)"). 4920-4929 and 4970-4979 went to clean sets.
 # Next unused: 4980 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]

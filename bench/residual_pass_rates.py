@@ -27,14 +27,18 @@ cases taken as independent). Then the misses by cause:
   not confirmed   nothing was applied (the line's effect is the tested
                   choice's, or "-" when none was tested);
   wrong fix       a change was confirmed and applied that the bench's rule
-                  does not name (another effect or parameter);
+                  does not name (another effect, parameter or channels the
+                  rule does not accept);
   failed          `hadynet residual` failed;
-and passed / named with P(>= 9 of 10) at that rate: the bar's chance if
-every run named its effect and the cut missed as often as on the named
-runs (what the cut and the control alone leave of the bar: no choice or
-decision can pass a set they miss with the effect named). Exit status 2
-for bad arguments or files, or when the files hold no run of the cases
-asked for.
+and passed / named with P(>= 9 of 10) at that rate: an estimate of the
+bar's chance if every run named its effect and the cut and the control
+missed as often as on the named runs (n/a where no run was named). It is
+an estimate, not a bound: a plan other than the one applied may cut more,
+and sets that were not named may cut better or worse than named ones.
+A line that names a set ("CASE seed S:") but is neither a run's line nor
+a failed run's is reported on stderr and not counted. Exit status 2 for
+bad arguments or files, or when the files hold no run of the cases asked
+for.
 """
 import math
 import re
@@ -42,6 +46,7 @@ import sys
 
 LINE = re.compile(r"(\S+) seed (\d+): named (yes|no) +cut (yes|no) .*<control (yes|no) +\| (confirmed|not confirmed):")
 FAILED = re.compile(r"(\S+) seed (\d+): residual failed")  # residual_detection.sh's line for a failed run
+SET = re.compile(r"(\S+) seed (\d+):")  # any line that names a set
 Z95 = 1.959964  # two-sided 95 % normal quantile
 
 
@@ -83,6 +88,9 @@ def count(paths, cases=None):
                 m = LINE.match(line)
                 failed = None if m else FAILED.match(line)
                 if not m and not failed:
+                    if SET.match(line):
+                        print(f"residual_pass_rates: {path}: not a run's line, not counted: {line.strip()[:120]}",
+                              file=sys.stderr)
                     continue
                 key = ((m or failed).group(1), (m or failed).group(2))
                 if cases and key[0] not in cases:
@@ -118,18 +126,18 @@ def causes(counts):
     out = ["| effect=strength | " + " | ".join(CAUSES) + " | passed / named | P(>= 9 of 10) at that rate |",
            "|---|" + "---|" * (len(CAUSES) + 2)]
     total = dict.fromkeys(("passed",) + CAUSES, 0)
-    every = 1.0
+    every = 1.0  # None once a case has no named run: the product is undefined
     for case, c in sorted(counts.items()):
         named = c["passed"] + c["named, short"]
-        rate = c["passed"] / named if named else 0.0
-        every *= at_least(9, 10, rate)
+        chance = at_least(9, 10, c["passed"] / named) if named else None
+        every = every * chance if every is not None and chance is not None else None
         for k in total:
             total[k] += c[k]
         out.append(f"| {case} | " + " | ".join(str(c[k]) for k in CAUSES) +
-                   f" | {c['passed']} / {named} | {at_least(9, 10, rate):.2f} |")
+                   f" | {c['passed']} / {named} | {'n/a' if chance is None else f'{chance:.2f}'} |")
     named = total["passed"] + total["named, short"]
     out.append("| every effect | " + " | ".join(str(total[k]) for k in CAUSES) +
-               f" | {total['passed']} / {named} | {every:.2f} (all at once) |")
+               f" | {total['passed']} / {named} | {'n/a' if every is None else f'{every:.2f}'} (all at once) |")
     return "\n".join(out)
 
 
