@@ -467,9 +467,10 @@
 # 4867, 4950, 4952, 4953 and 4957 re-run with the plant's rate forced (a
 # throw-away build; docs/residual.md, "What the cut leaves of the bar
 # (stop 92)"), and the cross-talk misses of 4791-4969 with 4961-4965 with
-# the cross-talk judged on every channel (another, not kept). 4920-4929
-# and 4970-4979 went to clean sets.
-# Next unused: 4980 on.
+# the cross-talk judged on every channel (another, not kept); 4980-4989
+# every effect at its larger strength measured with stop 91's code, run
+# last. 4920-4929 and 4970-4979 went to clean sets.
+# Next unused: 4990 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--fix-upper-rail-floor S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--fix-tie-break T] [--case EFFECT=STRENGTH]...

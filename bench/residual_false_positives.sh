@@ -158,7 +158,7 @@
 # tied confirmed plans the one changing the fewest channels; 0 of 20).
 # Stop 92: 4920-4929 and 4970-4979 with stop 91's code (no change to the
 # loop; 0 of 20).
-# Next unused seed: 4980
+# Next unused seed: 4990
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #
