@@ -470,7 +470,15 @@
 # the cross-talk judged on every channel (another, not kept); 4980-4989
 # every effect at its larger strength measured with stop 91's code, run
 # last. 4920-4929 and 4970-4979 went to clean sets.
-# Next unused: 4990 on.
+# Stop 93 (no change to the loop): 4990-4999 every effect at its larger
+# strength measured with stop 91's code; its sets and the five blocks
+# above read on the channels the plant's effect moved
+# (bench/residual_footprint.sh, whose clean twins reuse their seeds); the
+# six sets of those blocks whose decision p lay between 0.01 and 0.05
+# re-run with a decision at 0.05 (a throw-away build, not kept;
+# docs/residual.md, "The cut on the channels the effect moved (stop 93)").
+# 5000-5019 went to clean sets.
+# Next unused: 5020 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--fix-upper-rail-floor S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--fix-tie-break T] [--case EFFECT=STRENGTH]...

@@ -18,7 +18,8 @@ every channel; its line says so and the table leaves it out. A channel is
 **moved** when the
 RMS of that difference over the held-out rows (each log's last
 1 - train_fraction, the rows residual.json's before/after are measured on)
-is at least X (--share, 0.5, fixed before any set was read) of the
+is at least X (--share, 0.5: fixed after one development set, the rail
+4951, and before any other set was read) of the
 channel's held-out 1-step RMSE before the fix. Prints one line:
 
   CASE seed SEED: bar yes|no moved yes|no named yes|no (moved CH ...;
@@ -84,8 +85,10 @@ def footprint(set_logs, clean_logs, train_fraction):
 def line(case, seed, set_dir, clean_dir, share):
     bar_line = run_line(case, seed, os.path.join(set_dir, "residual.json"), "")
     m = re.match(r"\S+ seed \d+: named (yes|no) +cut (yes|no) +\(after/before (\S+)\) <control (yes|no)", bar_line)
-    named, bar = m.group(1) == "yes", m.groups()[1::2] == ("yes", "yes")
-    bar = named and bar
+    if not m:
+        sys.exit(f"residual_footprint: residual_run_line.py's line is not in the form read here: {bar_line}")
+    named = m.group(1) == "yes"
+    bar = named and m.group(2) == "yes" and m.group(4) == "yes"
     fix = json.load(open(os.path.join(set_dir, "residual.json")))["fix"]
     out = f"{case} seed {seed}: "
     if case.startswith("drift="):
@@ -142,7 +145,13 @@ if __name__ == "__main__":
     share = 0.5
     if "--share" in args:
         k = args.index("--share")
-        share = float(args[k + 1])
+        try:
+            share = float(args[k + 1])
+        except (IndexError, ValueError):
+            share = -1.0
+        if not share > 0:
+            print("residual_footprint: --share needs a number above 0", file=sys.stderr)
+            sys.exit(2)
         del args[k:k + 2]
     if len(args) == 5 and args[0] == "line":
         print(line(args[1], int(args[2]), args[3], args[4], share))

@@ -34,7 +34,7 @@ hadynet="${HADYNET:-build/release/cli/hadynet}"
 mkdir -p "$out/clean"
 lines="$out/lines.txt"
 : >"$lines"
-mapfile -t sets < <(find "${trees[@]}" -path '*/seed*/residual.json' -printf '%h\n' | sort -t/ -k1)
+mapfile -t sets < <(find "${trees[@]}" -path '*/seed*/residual.json' -printf '%h\n' | sort)
 ((${#sets[@]})) || { echo "residual_footprint: no set under ${trees[*]}" >&2; exit 2; }
 start=$(date +%s) k=0
 for d in "${sets[@]}"; do
