@@ -15,20 +15,21 @@ effect leaves alone differs by exactly 0). Not for drift: the plant's
 drift includes a random walk drawn from the sensor noise's generator
 (host-sim/plant/sensor_simulation.cc), so the twins' noise differs on
 every channel; its line says so and the table leaves it out. A channel is
-**moved** when the
-RMS of that difference over the held-out rows (each log's last
-1 - train_fraction, the rows residual.json's before/after are measured on)
-is at least X (--share, 0.5: fixed after one development set, the rail
-4951, and before any other set was read) of the
-channel's held-out 1-step RMSE before the fix. Prints one line:
+**moved** when the RMS of that difference over the held-out rows (each
+log's last 1 - train_fraction, the rows residual.json's before/after are
+measured on) is at least X of the channel's held-out 1-step RMSE before
+the fix (--share X, 0.5: fixed after one development set, the rail 4951,
+and before any other set was read). Prints one line:
 
-  CASE seed SEED: bar yes|no moved yes|no named yes|no (moved CH ...;
-  cut there R, below the control there yes|no; the bar's cut R0 on CH ...)
+  CASE seed SEED: bar yes|no moved yes|no named yes|no (moved CH(SHARE)
+  ...; cut there R, below the control there yes|no; the bar's cut R0)
 
   bar    the bar's rule as residual_run_line.py reads it (named, the mean
          after/before on the changed channels <= 0.7, below the control);
   moved  the same, with the cut and the control read on the moved channels
-         (every moved channel, whether or not the plan changed it).
+         (every moved channel, whether or not the plan changed it);
+  SHARE  the channel's footprint over its error before.
+A set with nothing applied says so and passes neither.
 
 table: per case, sets, passed by the bar, passed on the moved channels, and
 the sets that pass one reading and not the other.
