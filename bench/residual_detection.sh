@@ -474,8 +474,9 @@
 # strength measured with stop 91's code; its sets and the five blocks
 # above read on the channels the plant's effect moved
 # (bench/residual_footprint.sh, whose clean twins reuse their seeds); the
-# six sets of those blocks whose decision p lay between 0.01 and 0.05
-# re-run with a decision at 0.05 (a throw-away build, not kept;
+# 18 sets of those blocks with a Holm-adjusted decision p (the choice's or
+# a rival's) between 0.01 and 0.05 re-run with a decision at 0.05 (a
+# throw-away build, not kept;
 # docs/residual.md, "The cut on the channels the effect moved (stop 93)").
 # 5000-5019 went to clean sets.
 # Next unused: 5020 on.
