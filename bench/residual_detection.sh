@@ -478,8 +478,9 @@
 # a rival's) between 0.01 and 0.05 re-run with a decision at 0.05 (a
 # throw-away build, not kept;
 # docs/residual.md, "The cut on the channels the effect moved (stop 93)").
-# 5000-5019 went to clean sets.
-# Next unused: 5020 on.
+# 5000-5019 went to clean sets, 5020-5029 to the effect outside the
+# library.
+# Next unused: 5030 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--fix-upper-rail-floor S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--fix-tie-break T] [--case EFFECT=STRENGTH]...

@@ -66,7 +66,8 @@
 # every choice's rivals also the plans of the groups it does not hold that
 # gained more: 0 of 10 confirmed, 5 unexplained); 4830-4839 (stop 90's
 # final code, an upper rail a candidate below the candidates' floor: 0 of
-# 10 confirmed, 3 unexplained).
+# 10 confirmed, 3 unexplained); 5020-5029 (stop 93, stop 91's code: 0 of
+# 10 confirmed, 0 unexplained).
 #
 # Usage: bench/residual_unknown_effect.sh [--model M] [--out DIR] [--seeds N] [--first-seed S]
 #          [--reference-seed S] [--effect-kind gain-wobble|curve] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--fix-tie-break T]
