@@ -40,10 +40,7 @@ start=$(date +%s) k=0
 for d in "${sets[@]}"; do
   seed=${d##*/seed} case=$(basename "$(dirname "$d")")
   clean="$out/clean/seed$seed"
-  if [[ ! -d "$clean" ]]; then
-    collect_residual_grasps "$hadynet" "$clean.part" "$seed" || { echo "residual_footprint: collect seed $seed failed" >&2; exit 1; }
-    mv "$clean.part" "$clean"
-  fi
+  record_clean_twin "$hadynet" "$clean" "$seed" || { echo "residual_footprint: collect seed $seed failed" >&2; exit 1; }
   python3 bench/residual_footprint.py line "$case" "$seed" "$d" "$clean" --share "$share" | tee -a "$lines"
   k=$((k + 1))
   echo "[$k/${#sets[@]}, ETA $(( ($(date +%s) - start) * (${#sets[@]} - k) / k ))s]" >&2

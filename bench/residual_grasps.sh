@@ -55,3 +55,14 @@ record_reference() {
   collect_residual_grasps "$1" "$2/reference" "$3"
   reference_args=(--reference "$2/reference")
 }
+
+# record_clean_twin HADYNET DIR SEED: the four grasps with SEED and no
+# effect in DIR, once (kept when DIR exists; recorded into DIR.part and
+# moved, so an interrupted run leaves no half twin): the clean twin of a
+# set recorded with the same seed and an effect (RESIDUAL_ROWS as the set).
+record_clean_twin() {
+  [[ -d "$2" ]] && return 0
+  rm -rf "$2.part"
+  collect_residual_grasps "$1" "$2.part" "$3" || return 1
+  mv "$2.part" "$2"
+}

@@ -28,6 +28,35 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from residual_named import names  # noqa: E402
 
 
+def rmse_of(fix, part):
+    """{channel: held-out 1-step RMSE} of fix[part] (before, after, control)."""
+    return {c["channel"]: c["rmse"] for c in fix[part]["channels"]}
+
+
+def cut_channels(fix):
+    """The channels the bar's cut is read on (the module's doc, "cut"); []
+    when nothing was applied."""
+    channels = (fix.get("augmentation") or {}).get("channels", [])
+    if not (fix.get("after") and fix.get("before") and channels):
+        return []
+    before, after = rmse_of(fix, "before"), rmse_of(fix, "after")
+    # The decision's channels; a simpler account applied in the confirmed
+    # change's place (fix.simpler) was confirmed on its own channels.
+    simpler = fix.get("simpler") or {}
+    judged = simpler["channels"] if simpler.get("applied") else fix.get("confirmation", {}).get("channels")
+    # A wider plan applied after the confirmation (fix.extensions) changes
+    # the channels its own test judged too.
+    for wider in fix.get("extensions") or []:
+        if wider.get("applied"):
+            judged = list(judged or []) + [c for c in wider.get("channels", []) if c not in (judged or [])]
+    # The changed channels among them: a calibration curve is judged on
+    # every channel (Augmentation::judged_on_every_channel) and cut on
+    # its curved ones; an aux channel's decision is on the targets it
+    # explains, none of which is the aux channel itself.
+    changed = [c for c in (judged or []) if c in channels]
+    return [c for c in (changed or judged or channels) if c in before and c in after]
+
+
 def run_line(case, seed, path, progress):
     effect, strength = case.split("=")
     strength = float(strength)
@@ -35,34 +64,16 @@ def run_line(case, seed, path, progress):
     aug = fix.get("augmentation") or {}
     named_effect = aug.get("effect", "-")
     confirmed = bool(fix.get("changed"))
-    channels = aug.get("channels", [])
     named = confirmed and names(effect, strength, fix)
     cut = below_control = False
     ratio = float("nan")
-    if fix.get("after") and fix.get("before") and channels:
-        def rmse(part):
-            return {c["channel"]: c["rmse"] for c in fix[part]["channels"]}
-        before, after = rmse("before"), rmse("after")
-        control = rmse("control") if fix.get("control") else {}
-        # The decision's channels; a simpler account applied in the confirmed
-        # change's place (fix.simpler) was confirmed on its own channels.
-        simpler = fix.get("simpler") or {}
-        judged = simpler["channels"] if simpler.get("applied") else fix.get("confirmation", {}).get("channels")
-        # A wider plan applied after the confirmation (fix.extensions) changes
-        # the channels its own test judged too.
-        for wider in fix.get("extensions") or []:
-            if wider.get("applied"):
-                judged = list(judged or []) + [c for c in wider.get("channels", []) if c not in (judged or [])]
-        # The changed channels among them: a calibration curve is judged on
-        # every channel (Augmentation::judged_on_every_channel) and cut on
-        # its curved ones; an aux channel's decision is on the targets it
-        # explains, none of which is the aux channel itself.
-        changed = [c for c in (judged or []) if c in channels]
-        tested = [c for c in (changed or judged or channels) if c in before and c in after]
-        if tested:
-            ratio = sum(after[c] / before[c] for c in tested) / len(tested)
-            cut = ratio <= 0.7
-            below_control = bool(control) and sum(after[c] for c in tested) < sum(control[c] for c in tested)
+    tested = cut_channels(fix)
+    if tested:
+        before, after = rmse_of(fix, "before"), rmse_of(fix, "after")
+        control = rmse_of(fix, "control") if fix.get("control") else {}
+        ratio = sum(after[c] / before[c] for c in tested) / len(tested)
+        cut = ratio <= 0.7
+        below_control = bool(control) and sum(after[c] for c in tested) < sum(control[c] for c in tested)
     label = (aug.get("description", fix.get("status", "-")))[:60]
     return (f"{case} seed {seed}: named {'yes' if named else 'no '} cut {'yes' if cut else 'no '} "
             f"(after/before {ratio:.2f}) <control {'yes' if below_control else 'no '} | "
