@@ -19,11 +19,11 @@ gives no reading.
 
 The plant draws the same noise with and without an effect, so a perfect
 account of a sensor delay, a cross-talk or a tension leak hands
-fine-tuning the twin's data: its after is the twin's control up to
-fine-tuning's own spread (a second draw). The **twin's cut** is the mean
-over the bar's channels (residual_run_line.cut_channels) of the twin's
-control / the set's before: the cut such an account reaches, within that
-spread. The held-out rows end where the run's largest sensor delay
+fine-tuning nearly the twin's data, so its after is about the twin's
+control. The **twin's cut** is the mean over the bar's channels
+(residual_run_line.cut_channels) of the twin's control / the set's
+before: about the cut such an account reaches (not a floor: fine-tuning
+is deterministic, but a delay costs rows at each log's ends). The held-out rows end where the run's largest sensor delay
 allows (d rows short of each log's end), so a set whose fix plans a delay
 is read on a few rows fewer than its twin: the line prints both counts
 when they differ. Also printed: the same mean of the twin's before (the
@@ -92,9 +92,10 @@ def line(case, seed, set_dir, twin_json):
     twin_cut = sum(twin_control[c] / before[c] for c in channels) / len(channels)
     unchanged = sum(twin_before[c] / before[c] for c in channels) / len(channels)
     rows = (fix["before"].get("samples"), twin["before"].get("samples"))
+    differ = None not in rows and rows[0] != rows[1]
     return (out + f"cut {'yes' if m.group(2) == 'yes' else 'no '} {cut:.3f} twin {twin_cut:.3f} "
             f"(unchanged model {unchanged:.3f}) within {'yes' if twin_cut <= BAR_CUT else 'no '} "
-            f"(on {len(channels)} channels" + (f"; held-out samples {rows[0]}, twin {rows[1]}" if rows[0] != rows[1] else "")
+            f"(on {len(channels)} channels" + (f"; held-out samples {rows[0]}, twin {rows[1]}" if differ else "")
             + ")")
 
 

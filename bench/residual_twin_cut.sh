@@ -10,18 +10,20 @@
 # MODEL: the model the sets were run with. Records each seed's four grasps
 # without an effect once (DIR/clean/seedS, bench/residual_grasps.sh,
 # RESIDUAL_ROWS as the sets were recorded: 300 unless set; a directory
-# bench/residual_footprint.sh recorded serves as it is), runs `hadynet
+# bench/residual_footprint.sh recorded with the same rows serves as it
+# is), runs `hadynet
 # residual MODEL TWIN --rated-range fc=0..50 --rated-range f=0..200 --fix
 # --fix-min-excess-null 0` on it once (DIR/twin/seedS.json: its fix.control
 # is fine-tuning alone on the twin; the rated ranges are the detection
-# bench's; DIR/twin/model.txt holds the model's SHA-256, and another model's twins
-# are refused), writes a line per set to DIR/lines.txt and the table per
+# bench's; DIR/twin/model.txt holds the model's SHA-256 and the rows, and
+# other twins are refused), writes a line per set to DIR/lines.txt and the table per
 # case to DIR/summary.txt. Sets recorded under a re-zeroing
 # (--rezeroed-first-init) are not supported: their twin would need the
 # same zeroing.
-# Environment: HADYNET (default build/release/cli/hadynet).
+# Environment: HADYNET (default build/release/cli/hadynet; a relative path is
+# the repository's), RESIDUAL_ROWS.
 set -euo pipefail
-usage() { sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; }
 # value OPTION ARG...: the option's value, or usage and exit 2 when it has none.
 value() { [[ $# -ge 2 && -n "$2" ]] || { echo "residual_twin_cut: $1 needs a value" >&2; usage >&2; exit 2; }; }
 out="" model="" trees=()
@@ -44,12 +46,17 @@ source bench/residual_grasps.sh
 hadynet="${HADYNET:-build/release/cli/hadynet}"
 [[ -x "$hadynet" ]] || { echo "residual_twin_cut: $hadynet not found" >&2; exit 2; }
 mkdir -p "$out/clean" "$out/twin"
-# The twins' JSONs hold one model's fine-tuning: another model's are refused.
+# The twins hold one model's fine-tuning on logs of one length: another's
+# are refused, and so are twins of unknown origin (no model.txt).
+key="$(sha256sum <"$model" | cut -d' ' -f1) rows=${RESIDUAL_ROWS:-300}"
 if [[ -f "$out/twin/model.txt" ]]; then
-  [[ "$(cat "$out/twin/model.txt")" == "$(sha256sum <"$model")" ]] ||
-    { echo "residual_twin_cut: $out/twin holds another model's twins (model.txt)" >&2; exit 2; }
+  [[ "$(cat "$out/twin/model.txt")" == "$key" ]] ||
+    { echo "residual_twin_cut: $out/twin holds another model's or row count's twins (model.txt)" >&2; exit 2; }
+elif compgen -G "$out/twin/seed*.json" >/dev/null; then
+  echo "residual_twin_cut: $out/twin holds twins without model.txt (of which model and rows?): use another --out" >&2
+  exit 2
 else
-  sha256sum <"$model" >"$out/twin/model.txt"
+  echo "$key" >"$out/twin/model.txt"
 fi
 lines="$out/lines.txt"
 : >"$lines"

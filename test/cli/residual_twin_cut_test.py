@@ -107,13 +107,13 @@ def main():
               "(unchanged model 0.350) within no  (on 1 channels)", f"beyond 0.7: {r.stdout!r}")
         lines.append(r.stdout)
 
-        # Not named (a cross-talk of another source).
+        # Not named (a cross-talk of another source), the twin at 0.36 / 0.4 = 0.900.
         fix = copy.deepcopy(LEAK)
         fix["augmentation"]["source"] = "f4"
         fix["augmentation"]["description"] = "remove the crosstalk f4 -> fc6"
-        r = line_of(tmp, "unnamed", fix, TWIN, seed="11")
-        check(r.stdout.startswith("tension-leak=0.2 seed 11: bar no  named no  cut yes 0.300 twin 0.250"),
-              f"not named: {r.stdout!r}")
+        r = line_of(tmp, "unnamed", fix, with_twin_fc6(0.36), seed="11")
+        check(r.stdout.startswith("tension-leak=0.2 seed 11: bar no  named no  cut yes 0.300 twin 0.900")
+              and "within no " in r.stdout, f"not named: {r.stdout!r}")
         lines.append(r.stdout)
 
         # The bar's cut just above 0.7 (0.2803 / 0.4 = 0.70075) is short: the
@@ -132,11 +132,12 @@ def main():
               and "within no " in r.stdout, f"passed, twin beyond: {r.stdout!r}")
         lines.append(r.stdout)
 
-        # Named and cut, but fine-tuning alone does better on fc6 (0.1): the bar fails.
+        # Named and cut, but fine-tuning alone does better on fc6 (0.1): the
+        # bar fails. The twin at 0.14 / 0.4 = 0.350.
         fix = copy.deepcopy(LEAK)
         fix["control"] = rmse({"fc0": 0.4, "fc5": 0.5, "fc6": 0.1})
-        r = line_of(tmp, "control", fix, TWIN, seed="18")
-        check(r.stdout.startswith("tension-leak=0.2 seed 18: bar no  named yes cut yes 0.300"),
+        r = line_of(tmp, "control", fix, with_twin_fc6(0.14), seed="18")
+        check(r.stdout.startswith("tension-leak=0.2 seed 18: bar no  named yes cut yes 0.300 twin 0.350"),
               f"above the control: {r.stdout!r}")
         lines.append(r.stdout)
 
@@ -166,11 +167,19 @@ def main():
                   and "twin" not in r.stdout.split("not measured")[0], f"{case} not measured: {r.stdout!r}")
             lines.append(r.stdout)
 
-        # A twin without fine-tuning alone (no control): not measured.
-        twin = {k: v for k, v in TWIN.items() if k != "control"}
-        r = line_of(tmp, "no_control", LEAK, twin, seed="13")
-        check(r.returncode == 0 and "not measured (the twin's --fix reached no held-out test" in r.stdout,
-              f"twin without control: {r.stdout!r}")
+        # A twin without fine-tuning alone (no control), or without its
+        # before: not measured.
+        for part in ("control", "before"):
+            twin = {k: v for k, v in TWIN.items() if k != part}
+            r = line_of(tmp, "no_" + part, LEAK, twin, seed="13")
+            check(r.returncode == 0 and "not measured (the twin's --fix reached no held-out test" in r.stdout,
+                  f"twin without {part}: {r.stdout!r} {r.stderr!r}")
+
+        # Only one side with a sample count: nothing printed about samples.
+        twin = copy.deepcopy(TWIN)
+        del twin["before"]["samples"]
+        r = line_of(tmp, "one_count", LEAK, twin, seed="21")
+        check(r.stdout.strip().endswith("(on 1 channels)"), f"one sample count: {r.stdout!r}")
 
         # Nothing applied: a line that says so.
         fix = {k: v for k, v in LEAK.items() if k not in ("after", "control", "confirmation")}
@@ -184,24 +193,27 @@ def main():
         check(r.returncode != 0 and "has no channel fc6" in r.stderr, f"twin missing fc6: {r.stdout!r} {r.stderr!r}")
 
         # The table over seeds 7 (passed, 0.25), 9 (short, 0.80), 11 (not
-        # named, 0.25), 16 (short, 0.25), 17 (passed, 0.75) and 18 (the
-        # control, 0.25): 6 read, 2 passed, 2 short (9 beyond 0.7), 2 beyond
-        # 0.7 (9, 17), median 0.25 (over the passed alone it would be 0.5).
-        # Named: cut - twin's 0.05, -0.05, 0.451, -0.45, 0.05: mean 0.0102;
-        # deviations 0.0398, -0.0602, 0.4408, -0.4602, 0.0398, squares summing
-        # to 0.41288, sd sqrt(0.41288 / 4) = 0.3213.
+        # named, 0.90), 16 (short, 0.25), 17 (passed, 0.75) and 18 (the
+        # control, 0.35): 6 read, 2 passed, 2 short (9 beyond 0.7), 3 beyond
+        # 0.7 (9, 11, 17; named alone it would be 2), median (0.35 + 0.75) /
+        # 2 = 0.550 (over the passed alone 0.5, the named alone 0.35).
+        # Named: cut - twin's 0.05, -0.05, 0.451, -0.45, -0.05: mean
+        # -0.0098; deviations 0.0598, -0.0402, 0.4608, -0.4402, -0.0402,
+        # squares summing to 0.41292, sd sqrt(0.41292 / 4) = 0.3213.
         path = os.path.join(tmp, "lines.txt")
         with open(path, "w") as f:
             f.write("".join(lines))
         r = run("table", path)
-        check(r.returncode == 0 and "| tension-leak=0.2 | 6 | 2 | 2 | 1 (9) | 2 | 0.250 | +0.010 (0.321) |"
+        check(r.returncode == 0 and "| tension-leak=0.2 | 6 | 2 | 2 | 1 (9) | 3 | 0.550 | -0.010 (0.321) |"
               in r.stdout and "saturation" not in r.stdout and "sensor-curve" not in r.stdout,
               f"table: {r.stdout!r}")
 
         r = run("--help")
         check(r.returncode == 0 and "twin's cut" in r.stdout, "--help")
         r = run("line", "x")
-        check(r.returncode == 2, "bad arguments exit 2")
+        check(r.returncode == 2, "too few arguments exit 2")
+        r = run("line", "a=1", "1", tmp, path, "extra")
+        check(r.returncode == 2, "too many arguments exit 2")
     if failures:
         print(f"{len(failures)} check(s) failed")
         sys.exit(1)
