@@ -480,7 +480,11 @@
 # docs/residual.md, "The cut on the channels the effect moved (stop 93)").
 # 5000-5019 went to clean sets, 5020-5029 to the effect outside the
 # library.
-# Next unused: 5030 on.
+# Stop 94 (no change to the loop): 5030-5039 every effect at its larger
+# strength measured with stop 91's code; its sets and the six blocks above
+# read against their clean twins (bench/residual_twin_cut.sh, whose twins
+# reuse their seeds; docs/residual.md, "The cut on the clean twin (stop 94)").
+# Next unused: 5040 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--fix-upper-rail-floor S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--fix-tie-break T] [--case EFFECT=STRENGTH]...
