@@ -19,19 +19,20 @@ gives no reading.
 
 The plant draws the same noise with and without an effect, so a perfect
 account of a sensor delay, a cross-talk or a tension leak hands
-fine-tuning nearly the twin's data, so its after is about the twin's
+fine-tuning nearly the twin's data, and its after is about the twin's
 control. The **twin's cut** is the mean over the bar's channels
 (residual_run_line.cut_channels) of the twin's control / the set's
-before: about the cut such an account reaches (not a floor: fine-tuning
-is deterministic, but a delay costs rows at each log's ends). The held-out rows end where the run's largest sensor delay
-allows (d rows short of each log's end), so a set whose fix plans a delay
-is read on a few rows fewer than its twin: the line prints both counts
-when they differ. Also printed: the same mean of the twin's before (the
-unchanged model, no fine-tuning). Drift, friction and the dead time have
-twins in distribution only: drift's walk draws from the sensor noise's
-generator, and friction and the dead time change the motion itself (the
-twin is the same commands without them, so its error need not be within
-any account's reach). Not measured: a rail and a calibration curve, which
+before: about the cut such an account reaches. It is not a floor:
+fine-tuning is deterministic, but the held-out rows end where the run's
+largest sensor delay allows (d rows short of each log's end), so a set
+whose fix plans a delay is fine-tuned and read on a few rows fewer than
+its twin (the line prints both held-out counts when they differ). Also
+printed: the same mean of the twin's before (the unchanged model, no
+fine-tuning). Drift, friction and the dead time have twins in
+distribution only: drift's walk draws from the sensor noise's generator,
+and friction and the dead time change the motion itself (the twin is the
+same commands without them, so its error need not be within any
+account's reach). Not measured: a rail and a calibration curve, which
 change the readings' scale (a rail holds a clipped loadcell at one level,
 easier to predict than the force it hides: on the rail 4865 the fix read
 0.65 of before and the twin's control 0.90); their lines say so and the
