@@ -42,7 +42,7 @@ import re
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from residual_run_line import run_line  # noqa: E402
+from residual_run_line import rmse_of, run_line  # noqa: E402
 
 
 def read_log(path):
@@ -97,10 +97,8 @@ def line(case, seed, set_dir, clean_dir, share):
     if not (fix.get("before") and fix.get("after")):
         return out + f"bar no  moved no  named {'yes' if named else 'no '} (nothing applied)"
 
-    def rmse(part):
-        return {c["channel"]: c["rmse"] for c in fix[part]["channels"]}
-    before, after = rmse("before"), rmse("after")
-    control = rmse("control") if fix.get("control") else {}
+    before, after = rmse_of(fix, "before"), rmse_of(fix, "after")
+    control = rmse_of(fix, "control") if fix.get("control") else {}
     moved_by = footprint(os.path.join(set_dir, "logs"), clean_dir, fix["train_fraction"])
     moved = [c for c in before if moved_by.get(c, 0.0) >= share * before[c]]
     ratio = sum(after[c] / before[c] for c in moved) / len(moved) if moved else float("nan")
