@@ -1,0 +1,154 @@
+#!/usr/bin/env python3
+"""bench/residual_friction_twin.py on friction sets and twins written here.
+
+Muscle 0's friction is d0(t) = 3 sign(u0(t-1)) exactly (the command changes
+sign every 3 rows and is 0, so its sign too, every 7th row): the command's
+sign one row earlier explains its level and its steps in full (r^2 1
+within 1e-6, the ridge's size), and so does every richer feature set (it
+holds the sign). Row t's own sign (rows <= t, not t - 1) would not.
+Muscle 1's friction alternates +-0.05 N: sd 0.05 <= --min-sd 0.1, not
+read, so the pairs are the two logs' muscle 0; --min-sd 0.045 reads it.
+Muscle 2's difference is 2 sign(u2(t-1)) plus 1.5 times a sign that
+alternates every row: its "sign" fit (one feature and an intercept) must
+equal the squared correlation, computed here independently, of the level
+and of the steps (printed to 3 decimals, so within 0.0006).
+Also: --muscles, every muscle by default, a set without a twin listed and
+skipped, a twin with another row count refused, bad arguments refused.
+The 8 mutants of the script tried (the features' row, the sd floor and
+its option, r^2, the step's differences, the skipped list, sign(0), the
+lag) are all killed."""
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "bench", "residual_friction_twin.py")
+failures = []
+
+
+def check(ok, what):
+    if not ok:
+        failures.append(what)
+        print("FAIL:", what)
+
+
+def sign(v):
+    return 1.0 if v > 0 else (-1.0 if v < 0 else 0.0)
+
+
+def write_log(path, rows):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as f:
+        f.write("# format: hadynet-log\n# dt_s: 0.2\n")
+        f.write("t,f0,f1,f2,u0,u1,u2\n")
+        for r in rows:
+            f.write(",".join(repr(v) for v in r) + "\n")
+
+
+def write_pair(root, twins, seed, name, n, phase, twin_rows_less=0):
+    u0 = [0.0 if t % 7 == 6 else (1.0 if ((t + phase) // 3) % 2 == 0 else -1.0) * (0.5 + 0.1 * (t % 4)) for t in range(n)]
+    u1 = [0.3 * math.sin(0.7 * t) for t in range(n)]
+    u2 = [1.0 if (t % 5) < 2 else -1.0 for t in range(n)]
+    clean = [[0.2 * t, 10 + math.sin(0.3 * t), 5 + math.cos(0.2 * t), 7 + 0.01 * t, u0[t], u1[t], u2[t]]
+             for t in range(n)]
+    fric = []
+    for t, r in enumerate(clean):
+        d0 = 3 * sign(u0[t - 1]) if t else 0.0
+        d2 = (2 * sign(u2[t - 1]) if t else 0.0) + 1.5 * (1.0 if t % 2 else -1.0)
+        fric.append([r[0], r[1] + d0, r[2] + (0.05 if t % 2 else -0.05), r[3] + d2] + r[4:])
+    write_log(os.path.join(root, "friction=4", "seed%d" % seed, "logs", "train", name), fric)
+    if twins is not None:
+        write_log(os.path.join(twins, "clean", "seed%d" % seed, "train", name), clean[: n - twin_rows_less])
+
+
+def read(path):
+    with open(path) as f:
+        lines = [line.strip() for line in f if not line.startswith("#")]
+    cols = lines[0].split(",")
+    return cols, [[float(v) for v in line.split(",")] for line in lines[1:]]
+
+
+def muscle2(set_log, twin_log):
+    """Muscle 2's difference d2 and its sign feature sign(u2(t-1)) (0 at t = 0)."""
+    cols, rows = read(set_log)
+    _, trows = read(twin_log)
+    i, k = cols.index("f2"), cols.index("u2")
+    d = [a[i] - b[i] for a, b in zip(rows, trows)]
+    z = [0.0] + [sign(r[k]) for r in rows[:-1]]
+    return d, z
+
+
+def diff(x):
+    return [x[t] - x[t - 1] for t in range(1, len(x))]
+
+
+def corr2(x, y):
+    mx, my = sum(x) / len(x), sum(y) / len(y)
+    sxy = sum((a - mx) * (b - my) for a, b in zip(x, y))
+    sxx = sum((a - mx) ** 2 for a in x)
+    syy = sum((b - my) ** 2 for b in y)
+    return sxy * sxy / (sxx * syy)
+
+
+def run(*args):
+    p = subprocess.run([sys.executable, SCRIPT, *args], capture_output=True, text=True)
+    return p.returncode, p.stdout, p.stderr
+
+
+def row(out, name):
+    for line in out.splitlines():
+        if line.startswith("| " + name + " |"):
+            cells = [c.strip() for c in line.strip("|").split("|")]
+            return float(cells[1]), float(cells[2])
+    return None
+
+
+with tempfile.TemporaryDirectory() as tmp:
+    runs, twins = os.path.join(tmp, "runs"), os.path.join(tmp, "twins")
+    write_pair(runs, twins, 7001, "a.csv", 60, 0)
+    write_pair(runs, twins, 7001, "b.csv", 60, 1)
+    write_pair(os.path.join(runs, "B"), None, 7002, "a.csv", 60, 0)  # a half without a twin
+
+    code, out, err = run("--runs", runs, "--twins", twins, "--muscles", "0,1")
+    check(code == 0, f"exit 0 ({err})")
+    check("friction sets read: 7001; no twin: 7002" in out, "the set without a twin is listed and skipped")
+    check("(log, muscle) pairs: 2" in out, "muscle 1's constant difference is not read: 2 pairs")
+    for name in ("sign", "sign, 1 earlier", "sign, 3 earlier; command, 2 earlier", "sign and command, 5 earlier each"):
+        r = row(out, name)
+        check(r is not None and abs(r[0] - 1) < 1e-6 and abs(r[1] - 1) < 1e-6,
+              f"{name}: d0 = 3 sign(u0(t-1)) explained in full, level and step ({r})")
+
+    code, out, err = run("--runs", runs, "--twins", twins, "--muscles", "0,1", "--min-sd", "0.045")
+    check(code == 0 and "(log, muscle) pairs: 4" in out, f"--min-sd 0.045 reads muscle 1 (sd 0.05) too ({out})")
+
+    level, step = [], []
+    for name in ("a.csv", "b.csv"):
+        d, z = muscle2(os.path.join(runs, "friction=4", "seed7001", "logs", "train", name),
+                       os.path.join(twins, "clean", "seed7001", "train", name))
+        level.append(corr2(z, d))
+        step.append(corr2(diff(z), diff(d)))
+    want = (sum(level) / 2, sum(step) / 2)
+    code, out, err = run("--runs", runs, "--twins", twins, "--muscles", "2")
+    r = row(out, "sign")
+    check(code == 0 and r is not None and abs(r[0] - want[0]) < 0.0006 and abs(r[1] - want[1]) < 0.0006
+          and abs(want[0] - want[1]) > 0.01,
+          f"muscle 2: the sign's r^2 is the squared correlation, level and step ({r} against {want})")
+
+    code, out, err = run("--runs", runs, "--twins", twins)
+    check(code == 0 and "(log, muscle) pairs: 4" in out, f"every muscle by default: muscles 0 and 2 read ({out})")
+
+    bad = os.path.join(tmp, "bad")
+    write_pair(os.path.join(bad, "runs"), os.path.join(bad, "twins"), 7003, "a.csv", 40, 0, twin_rows_less=1)
+    code, out, err = run("--runs", os.path.join(bad, "runs"), "--twins", os.path.join(bad, "twins"))
+    check(code != 0 and "40 rows, its twin" in err, f"a twin with another row count is refused ({err})")
+
+    code, out, err = run("--runs", runs)
+    check(code != 0 and "--twins DIR are required" in err, "--twins missing is refused")
+    code, out, err = run("--twins", twins, "--bogus", "1")
+    check(code != 0 and "unknown argument" in err, "an unknown argument is refused")
+    code, out, err = run("--help")
+    check(code == 0 and "Usage: residual_friction_twin.py" in out, "--help")
+
+print("FAILED: %d check(s)" % len(failures) if failures else "ok")
+sys.exit(1 if failures else 0)
