@@ -6,8 +6,9 @@ three tries, none kept (stop 95)"; not a test).
 A friction set of bench/residual_detection.sh (--case friction=N) and its
 clean twin of bench/residual_twin_cut.sh hold the same grasps, commands and
 noise draws; they differ by the plant's tendon friction alone. So, row by
-row, d_m = f_m(set) - f_m(twin) is what the friction adds to tendon m's
-tension (N). For every log and muscle m (a tension column f<m> and a command
+row, d_m = f_m(set) - f_m(twin) is what the friction changes in tendon m's
+tension (N): its force on the tendon, and the tension of the motion it
+changed (the hand moves otherwise under the same commands). For every log and muscle m (a tension column f<m> and a command
 column u<m>, the plant's naming) whose d_m varies by more than --min-sd, a
 least-squares fit with an intercept explains d_m by features of the command
 as the fix's derived inputs see them: row t uses rows <= t - 1 (the command
@@ -41,8 +42,9 @@ FEATURE_SETS = [
 
 
 def lag(x, k):
-    """x delayed by k rows, 0 before the log's first row."""
-    return [0.0] * k + list(x[: len(x) - k]) if k else list(x)
+    """x delayed by k rows, 0 before the log's first row (as long as x)."""
+    k = min(k, len(x))
+    return [0.0] * k + list(x[: len(x) - k])
 
 
 def sign(v):
@@ -92,7 +94,7 @@ def solve(a, b):
 
 def r_squared(features, y):
     """1 - var(residual) / var(y) of the least-squares fit of y on the
-    features and an intercept."""
+    features and an intercept; None when y does not vary."""
     x = [[1.0] + [f[t] for f in features] for t in range(len(y))]
     n = len(x[0])
     a = [[sum(row[i] * row[j] for row in x) for j in range(n)] for i in range(n)]
@@ -101,6 +103,8 @@ def r_squared(features, y):
     resid = [yt - sum(c * v for c, v in zip(coef, row)) for row, yt in zip(x, y)]
     mean_y = sum(y) / len(y)
     var_y = sum((v - mean_y) ** 2 for v in y) / len(y)
+    if var_y == 0:
+        return None
     mean_r = sum(resid) / len(resid)
     var_r = sum((v - mean_r) ** 2 for v in resid) / len(resid)
     return 1 - var_r / var_y
@@ -128,7 +132,7 @@ def fits(set_log, twin_log, muscles, min_sd):
         if "f" + m not in cols or "u" + m not in cols or "f" + m not in tcols:
             sys.exit(f"{set_log}: no columns f{m} and u{m} (and f{m} in its twin)")
         d = [a - b for a, b in zip(column(cols, rows, "f" + m), column(tcols, trows, "f" + m))]
-        if sd(d) <= min_sd:
+        if sd(d) <= min_sd or sd(diff(d)) == 0:
             continue
         u = column(cols, rows, "u" + m)
         s = [sign(v) for v in u]
@@ -140,15 +144,21 @@ def fits(set_log, twin_log, muscles, min_sd):
 
 
 def friction_sets(run_dirs):
-    """(seed, train dir) of every friction set under the run directories."""
-    found = []
+    """(case, seed, train dir) of every friction set under the run
+    directories, each once (directories given twice or nested are read once)."""
+    found, seen = [], set()
     for run in run_dirs:
         pattern = [os.path.join(run, "friction=*", "seed*", "logs", "train"),
                    os.path.join(run, "*", "friction=*", "seed*", "logs", "train")]
         for p in pattern:
             for train in sorted(glob.glob(p)):
-                seed = os.path.basename(os.path.dirname(os.path.dirname(train)))[len("seed"):]
-                found.append((seed, train))
+                real = os.path.realpath(train)
+                if real in seen:
+                    continue
+                seen.add(real)
+                seed_dir = os.path.dirname(os.path.dirname(train))
+                case = os.path.basename(os.path.dirname(seed_dir))
+                found.append((case, os.path.basename(seed_dir)[len("seed"):], train))
     return found
 
 
@@ -173,20 +183,25 @@ def main(argv):
             twins = v
         elif a == "--muscles":
             muscles = [m.strip() for m in v.split(",") if m.strip()]
+            if not muscles or not all(m.isdigit() for m in muscles):
+                sys.exit(f"residual_friction_twin: --muscles '{v}' is not a list of muscle numbers (--help)")
         else:
-            min_sd = float(v)
+            try:
+                min_sd = float(v)
+            except ValueError:
+                sys.exit(f"residual_friction_twin: --min-sd '{v}' is not a number (--help)")
         i += 2
     if not runs or twins is None:
         sys.exit("residual_friction_twin: --runs DIR... and --twins DIR are required (--help)")
     level = {name: [] for name, _ in FEATURE_SETS}
     step = {name: [] for name, _ in FEATURE_SETS}
     read, skipped = [], []
-    for seed, train in friction_sets(runs):
+    for case, seed, train in friction_sets(runs):
         twin = os.path.join(twins, "clean", "seed" + seed, "train")
         if not os.path.isdir(twin):
-            skipped.append(seed)
+            skipped.append(f"{case}/{seed}")
             continue
-        read.append(seed)
+        read.append(f"{case}/{seed}")
         for log in sorted(glob.glob(os.path.join(train, "*.csv"))):
             other = os.path.join(twin, os.path.basename(log))
             if not os.path.isfile(other):

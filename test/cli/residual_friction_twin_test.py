@@ -1,22 +1,27 @@
 #!/usr/bin/env python3
 """bench/residual_friction_twin.py on friction sets and twins written here.
 
-Muscle 0's friction is d0(t) = 3 sign(u0(t-1)) exactly (the command changes
-sign every 3 rows and is 0, so its sign too, every 7th row): the command's
-sign one row earlier explains its level and its steps in full (r^2 1
-within 1e-6, the ridge's size), and so does every richer feature set (it
-holds the sign). Row t's own sign (rows <= t, not t - 1) would not.
-Muscle 1's friction alternates +-0.05 N: sd 0.05 <= --min-sd 0.1, not
-read, so the pairs are the two logs' muscle 0; --min-sd 0.045 reads it.
-Muscle 2's difference is 2 sign(u2(t-1)) plus 1.5 times a sign that
-alternates every row: its "sign" fit (one feature and an intercept) must
-equal the squared correlation, computed here independently, of the level
-and of the steps (printed to 3 decimals, so within 0.0006).
+Each muscle's difference (set less twin) is built from its command u_m and
+s_m = sign(u_m), 0 before the log's first row:
+  0: 3 s0(t-1) exactly (u0 changes sign every 3 rows and is 0, so its sign
+     too, every 7th row): every feature set explains its level and steps
+     in full (r^2 1 within 1e-6, the ridge's size); row t's own sign (rows
+     <= t, not t - 1) would not.
+  1: +-0.05 alternating: sd 0.05 <= --min-sd 0.1, not read; 0.045 reads it.
+  2: 2 s2(t-1) + 1.5 times a sign alternating every row: the "sign" row
+     (one feature and an intercept) is the squared correlation, computed
+     here independently, of level and steps, averaged over the two logs,
+     which differ (printed to 3 decimals, so within 0.0006).
+  3: 2 s3(t-1) - 1.5 s3(t-2) + 0.7: "sign, 1 earlier" explains it in full
+     (with the intercept), "sign" not (level r^2 below 0.99);
+  4: s4(t-4) + 0.5 u4(t-3): the last two rows in full, the first two not;
+  5: u5(t-6): the last row in full, the others not.
 Also: --muscles, every muscle by default, a set without a twin listed and
 skipped, a twin with another row count refused, bad arguments refused.
-The 8 mutants of the script tried (the features' row, the sd floor and
-its option, r^2, the step's differences, the skipped list, sign(0), the
-lag) are all killed."""
+The 13 mutants of the script tried (the features' row, the sd floor and
+its option, r^2 and its intercept, the step's differences, the skipped
+list, sign(0), the lag, each richer row's features, the mean over pairs)
+are all killed."""
 import math
 import os
 import subprocess
@@ -37,26 +42,54 @@ def sign(v):
     return 1.0 if v > 0 else (-1.0 if v < 0 else 0.0)
 
 
+MUSCLES = 6
+
+
 def write_log(path, rows):
     os.makedirs(os.path.dirname(path), exist_ok=True)
     with open(path, "w") as f:
         f.write("# format: hadynet-log\n# dt_s: 0.2\n")
-        f.write("t,f0,f1,f2,u0,u1,u2\n")
+        f.write(",".join(["t"] + ["f%d" % m for m in range(MUSCLES)] + ["u%d" % m for m in range(MUSCLES)]) + "\n")
         for r in rows:
             f.write(",".join(repr(v) for v in r) + "\n")
 
 
+def noise(seed, n):
+    """A deterministic sequence in [-1, 1], never 0, with sign changes."""
+    x, out = seed, []
+    for _ in range(n):
+        x = (1103515245 * x + 12345) % 2**31
+        v = x / 2**30 - 1
+        out.append(v if abs(v) > 0.05 else 0.3)
+    return out
+
+
+def at(x, t):
+    return x[t] if t >= 0 else 0.0
+
+
 def write_pair(root, twins, seed, name, n, phase, twin_rows_less=0):
-    u0 = [0.0 if t % 7 == 6 else (1.0 if ((t + phase) // 3) % 2 == 0 else -1.0) * (0.5 + 0.1 * (t % 4)) for t in range(n)]
-    u1 = [0.3 * math.sin(0.7 * t) for t in range(n)]
-    u2 = [1.0 if (t % 5) < 2 else -1.0 for t in range(n)]
-    clean = [[0.2 * t, 10 + math.sin(0.3 * t), 5 + math.cos(0.2 * t), 7 + 0.01 * t, u0[t], u1[t], u2[t]]
+    u = [
+        [0.0 if t % 7 == 6 else (1.0 if ((t + phase) // 3) % 2 == 0 else -1.0) * (0.5 + 0.1 * (t % 4)) for t in range(n)],
+        [0.3 * math.sin(0.7 * t) for t in range(n)],
+        [1.0 if ((t + phase) % 5) < 2 else -1.0 for t in range(n)],
+        noise(11 + phase, n),
+        noise(23 + phase, n),
+        noise(37 + phase, n),
+    ]
+    s = [[sign(v) for v in um] for um in u]
+    alt = [1.0 if t % 2 else -1.0 for t in range(n)]
+    d = [
+        [3 * at(s[0], t - 1) for t in range(n)],
+        [0.05 * alt[t] for t in range(n)],
+        [2 * at(s[2], t - 1) + 1.5 * alt[t] for t in range(n)],
+        [2 * at(s[3], t - 1) - 1.5 * at(s[3], t - 2) + 0.7 for t in range(n)],
+        [at(s[4], t - 4) + 0.5 * at(u[4], t - 3) for t in range(n)],
+        [at(u[5], t - 6) for t in range(n)],
+    ]
+    clean = [[0.2 * t] + [10 + m + math.sin(0.3 * t + m) for m in range(MUSCLES)] + [um[t] for um in u]
              for t in range(n)]
-    fric = []
-    for t, r in enumerate(clean):
-        d0 = 3 * sign(u0[t - 1]) if t else 0.0
-        d2 = (2 * sign(u2[t - 1]) if t else 0.0) + 1.5 * (1.0 if t % 2 else -1.0)
-        fric.append([r[0], r[1] + d0, r[2] + (0.05 if t % 2 else -0.05), r[3] + d2] + r[4:])
+    fric = [[r[0]] + [r[1 + m] + d[m][t] for m in range(MUSCLES)] + r[1 + MUSCLES:] for t, r in enumerate(clean)]
     write_log(os.path.join(root, "friction=4", "seed%d" % seed, "logs", "train", name), fric)
     if twins is not None:
         write_log(os.path.join(twins, "clean", "seed%d" % seed, "train", name), clean[: n - twin_rows_less])
@@ -112,7 +145,7 @@ with tempfile.TemporaryDirectory() as tmp:
 
     code, out, err = run("--runs", runs, "--twins", twins, "--muscles", "0,1")
     check(code == 0, f"exit 0 ({err})")
-    check("friction sets read: 7001; no twin: 7002" in out, "the set without a twin is listed and skipped")
+    check("friction sets read: friction=4/7001; no twin: friction=4/7002" in out, "the set without a twin is listed and skipped")
     check("(log, muscle) pairs: 2" in out, "muscle 1's constant difference is not read: 2 pairs")
     for name in ("sign", "sign, 1 earlier", "sign, 3 earlier; command, 2 earlier", "sign and command, 5 earlier each"):
         r = row(out, name)
@@ -135,8 +168,26 @@ with tempfile.TemporaryDirectory() as tmp:
           and abs(want[0] - want[1]) > 0.01,
           f"muscle 2: the sign's r^2 is the squared correlation, level and step ({r} against {want})")
 
+    check(abs(level[0] - level[1]) > 0.002, f"muscle 2's two logs differ ({level}): the mean is read, not one")
+
+    # Each feature set explains in full the muscle whose difference it holds
+    # and no smaller set does (level r^2 below 0.99): muscle 3 needs the sign
+    # one step earlier (and the intercept: +0.7), muscle 4 the sign 4 rows
+    # back and the command 3 rows back, muscle 5 the command 6 rows back.
+    names = ["sign", "sign, 1 earlier", "sign, 3 earlier; command, 2 earlier", "sign and command, 5 earlier each"]
+    for m, first_full in ((3, 1), (4, 2), (5, 3)):
+        code, out, err = run("--runs", runs, "--twins", twins, "--muscles", str(m))
+        for i, name in enumerate(names):
+            r = row(out, name)
+            if i >= first_full:
+                check(r is not None and abs(r[0] - 1) < 1e-6 and abs(r[1] - 1) < 1e-6,
+                      f"muscle {m}: '{name}' explains it in full ({r})")
+            else:
+                check(r is not None and r[0] < 0.99, f"muscle {m}: '{name}' does not explain it in full ({r})")
+
     code, out, err = run("--runs", runs, "--twins", twins)
-    check(code == 0 and "(log, muscle) pairs: 4" in out, f"every muscle by default: muscles 0 and 2 read ({out})")
+    check(code == 0 and "(log, muscle) pairs: 10" in out,
+          f"every muscle by default: all but muscle 1 read on both logs ({out})")
 
     bad = os.path.join(tmp, "bad")
     write_pair(os.path.join(bad, "runs"), os.path.join(bad, "twins"), 7003, "a.csv", 40, 0, twin_rows_less=1)
