@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""What the plant's friction adds to a tendon's tension, read against the
+"""What the plant's friction changes in a tendon's tension, read against the
 clean twin (docs/residual.md, "Friction's account against its clean twin:
 three tries, none kept (stop 95)"; not a test).
 
@@ -8,9 +8,9 @@ clean twin of bench/residual_twin_cut.sh hold the same grasps, commands and
 noise draws; they differ by the plant's tendon friction alone. So, row by
 row, d_m = f_m(set) - f_m(twin) is what the friction changes in tendon m's
 tension (N): its force on the tendon, and the tension of the motion it
-changed (the hand moves otherwise under the same commands). For every log and muscle m (a tension column f<m> and a command
-column u<m>, the plant's naming) whose d_m varies by more than --min-sd, a
-least-squares fit with an intercept explains d_m by features of the command
+changed (the hand moves otherwise under the same commands). For every log
+and muscle m (a tension column f<m> and a command column u<m>, the
+plant's naming) whose d_m varies by more than --min-sd, a least-squares fit with an intercept explains d_m by features of the command
 as the fix's derived inputs see them: row t uses rows <= t - 1 (the command
 u(t-1) moves the hand from row t-1 to row t). For each feature set it prints
 the mean r^2 over the (log, muscle) pairs of
@@ -54,14 +54,19 @@ def sign(v):
 def read_log(path):
     """(column names, rows of floats) of a HADYNET log; '#' lines are metadata."""
     with open(path) as f:
-        lines = [line.strip() for line in f if line.strip() and not line.startswith("#")]
-    cols = lines[0].split(",")
+        lines = [(n, line.strip()) for n, line in enumerate(f, start=1) if line.strip() and not line.startswith("#")]
+    if not lines:
+        sys.exit(f"{path}: no header line")
+    cols = lines[0][1].split(",")
     rows = []
-    for n, line in enumerate(lines[1:], start=2):
+    for n, line in lines[1:]:
         values = line.split(",")
         if len(values) != len(cols):
-            sys.exit(f"{path}: data line {n} has {len(values)} fields, the header {len(cols)}")
-        rows.append([float(v) for v in values])
+            sys.exit(f"{path}: line {n} has {len(values)} fields, the header {len(cols)}")
+        try:
+            rows.append([float(v) for v in values])
+        except ValueError:
+            sys.exit(f"{path}: line {n}: a field is not a number")
     return cols, rows
 
 

@@ -17,7 +17,8 @@ s_m = sign(u_m), 0 before the log's first row:
   4: s4(t-4) + 0.5 u4(t-3): the last two rows in full, the first two not;
   5: u5(t-6): the last row in full, the others not.
 Also: --muscles, every muscle by default, a set without a twin listed and
-skipped, a twin with another row count refused, bad arguments refused.
+skipped, a twin with another row count refused, a malformed line named by
+file and line, bad arguments refused.
 The 13 mutants of the script tried (the features' row, the sd floor and
 its option, r^2 and its intercept, the step's differences, the skipped
 list, sign(0), the lag, each richer row's features, the mean over pairs)
@@ -193,6 +194,15 @@ with tempfile.TemporaryDirectory() as tmp:
     write_pair(os.path.join(bad, "runs"), os.path.join(bad, "twins"), 7003, "a.csv", 40, 0, twin_rows_less=1)
     code, out, err = run("--runs", os.path.join(bad, "runs"), "--twins", os.path.join(bad, "twins"))
     check(code != 0 and "40 rows, its twin" in err, f"a twin with another row count is refused ({err})")
+
+    broken = os.path.join(tmp, "broken")
+    write_pair(os.path.join(broken, "runs"), os.path.join(broken, "twins"), 7004, "a.csv", 20, 0)
+    path = os.path.join(broken, "runs", "friction=4", "seed7004", "logs", "train", "a.csv")
+    with open(path, "a") as f:
+        f.write("9.9,1\n")  # file line 2 + 1 + 20 + 1 = 24: two metadata lines, the header, 20 rows
+    code, out, err = run("--runs", os.path.join(broken, "runs"), "--twins", os.path.join(broken, "twins"))
+    check(code != 0 and path + ": line 24 has 2 fields, the header 13" in err,
+          f"a malformed line is named by file and line ({err})")
 
     code, out, err = run("--runs", runs)
     check(code != 0 and "--twins DIR are required" in err, "--twins missing is refused")
