@@ -488,10 +488,10 @@
 # and their clean twins for friction's account (bench/residual_friction_twin.py
 # and trial builds, not kept), and every set re-run with a model trained on
 # twelve recordings (1, 2001-2003 and 9001-9008 of the paper preset; not
-# kept); 5040-5049 and 5070-5079 every effect at its larger strength
-# measured with stop 91's code (docs/residual.md, "An eighth and a ninth
-# fresh block (stop 95)"). 5050-5069 went to clean sets.
-# Next unused: 5080 on.
+# kept); 5040-5049, 5070-5079 and 5080-5089 every effect at its larger
+# strength measured with stop 91's code (docs/residual.md, "An eighth, a
+# ninth and a tenth fresh block (stop 95)"). 5050-5069 went to clean sets.
+# Next unused: 5090 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--fix-upper-rail-floor S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--fix-tie-break T] [--case EFFECT=STRENGTH]...
