@@ -28,6 +28,12 @@ Usage: residual_friction_twin.py --runs DIR... --twins DIR [--muscles LIST] [--m
   --muscles LIST  comma-separated muscle numbers (default: every m with f<m> and u<m>)
   --min-sd N      the smallest standard deviation of d_m read (N; default 0.1)
 Sets without a twin are listed and skipped. Pure Python (no numpy).
+
+Data roles (stop 95): read on the friction sets 5030-5039 and their clean
+twins (stop 94's block, development for stop 95's tries at friction's
+account; nothing in this script was chosen on them). The model it is read
+beside is trained on seeds 1 and 2001-2003; --min-sd only drops pairs whose
+difference hardly varies and decides nothing about the loop.
 """
 import glob
 import os
