@@ -24,6 +24,7 @@
 #include "trainer/residual/analysis.h"
 #include "trainer/residual/augment.h"
 #include "trainer/residual/rated_ranges.h"
+#include "trainer/work_pool.h"
 
 namespace hadynet::cli {
 
@@ -354,12 +355,18 @@ int run_residual(int argc, char** argv) {
             rs::decision_pooling_name(rs::FixOptions{}.decision_pooling));
   opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
                         "unchanged model, a weaker guard)");
+  opt.value("threads", "N", "threads of the network's forward and backward passes (0: every core); results do not\n"
+                          "depend on it",
+            "1");
   if (!opt.parse(argc, argv)) return 2;
   if (opt.help_requested()) return 0;
   if (opt.positional().size() < 2) {
     std::fprintf(stderr, "hadynet residual: give MODEL and logs (see --help)\n");
     return 2;
   }
+  const auto threads = opt.get_int("threads", 0, 1024);
+  if (!threads) return 2;
+  trainer::set_training_threads(static_cast<int>(*threads));
   const auto max_lag = opt.get_int("max-lag", 1, 1000);
   const auto max_delay = opt.get_int("max-delay", 1, 100);
   const auto fraction = opt.get_double("train-fraction", 0.1, 0.9);
