@@ -491,7 +491,10 @@
 # kept); 5040-5049, 5070-5079 and 5080-5089 every effect at its larger
 # strength measured with stop 91's code (docs/residual.md, "An eighth, a
 # ninth and a tenth fresh block (stop 95)"). 5050-5069 went to clean sets.
-# Next unused: 5090 on.
+# Stop 96 (no change to the loop; `hadynet residual --threads` added, one
+# thread by default): 5090-5099 every effect at its larger strength measured
+# with stop 91's code (docs/residual.md, "An eleventh fresh block (stop 96)").
+# Next unused: 5100 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]
 #          [--reference-seed S] [--rezeroed-first-init I] [--fix-min-excess-null S] [--fix-upper-rail-floor S] [--decision-loss L] [--decision-scale S] [--decision-pooling P] [--fix-selection R] [--fix-tie-break T] [--case EFFECT=STRENGTH]...

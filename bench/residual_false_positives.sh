@@ -161,7 +161,8 @@
 # the loop; 0 of 20; --fix tested one candidate, on 5000, p 0.96). Stop
 # 95: 5050-5069 with stop 91's code (no change to the loop; 0 of 20;
 # --fix tested a candidate on 5061, p 0.96, and 5066, p 0.9).
-# Next unused seed: 5090
+# Stop 96 ran no clean block (5090-5099 went to every effect). Next unused
+# seed: 5100
 # (bench/residual_detection.sh lists the other seeds).
 # Give others as arguments.
 #

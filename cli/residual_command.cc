@@ -367,6 +367,8 @@ int run_residual(int argc, char** argv) {
   const auto threads = opt.get_int("threads", 0, 1024);
   if (!threads) return 2;
   trainer::set_training_threads(static_cast<int>(*threads));
+  if (trainer::training_pool().threads() > 1)  // one thread, the default, says nothing
+    std::fprintf(stderr, "hadynet residual: the network's passes on %d threads\n", trainer::training_pool().threads());
   const auto max_lag = opt.get_int("max-lag", 1, 1000);
   const auto max_delay = opt.get_int("max-delay", 1, 100);
   const auto fraction = opt.get_double("train-fraction", 0.1, 0.9);
