@@ -455,7 +455,7 @@
 # effect at its larger strength measured with the final code.
 # Stop 91 (of tied confirmed plans the one changing the fewest channels,
 # --fix-tie-break): development: the 57 sets of stops 87-90's runs where
-# two plans or more were confirmed (docs/residual.md, "Ties among
+# two plans or more were confirmed (docs/residual-experiments.md, "Ties among
 # confirmed plans (stop 91)"), among them 4800-4809's and 4855-4864's;
 # measured with the final code: 4865-4874, 4875-4884 and 4950-4959 every
 # effect at its larger strength, 4890-4909 crosstalk=0.35, 4910-4919
@@ -465,7 +465,7 @@
 # strength measured with stop 91's code (then, with every stored run, the
 # development data of a weighted Holm that was not built). Drift 4864,
 # 4867, 4950, 4952, 4953 and 4957 re-run with the plant's rate forced (a
-# throw-away build; docs/residual.md, "What the cut leaves of the bar
+# throw-away build; docs/residual-experiments.md, "What the cut leaves of the bar
 # (stop 92)"), and the cross-talk misses of 4791-4969 with 4961-4965 with
 # the cross-talk judged on every channel (another, not kept); 4980-4989
 # every effect at its larger strength measured with stop 91's code, run
@@ -477,23 +477,23 @@
 # 18 sets of those blocks with a Holm-adjusted decision p (the choice's or
 # a rival's) between 0.01 and 0.05 re-run with a decision at 0.05 (a
 # throw-away build, not kept;
-# docs/residual.md, "The cut on the channels the effect moved (stop 93)").
+# docs/residual-experiments.md, "The cut on the channels the effect moved (stop 93)").
 # 5000-5019 went to clean sets, 5020-5029 to the effect outside the
 # library.
 # Stop 94 (no change to the loop): 5030-5039 every effect at its larger
 # strength measured with stop 91's code; its sets and the six blocks above
 # read against their clean twins (bench/residual_twin_cut.sh, whose twins
-# reuse their seeds; docs/residual.md, "The cut on the clean twin (stop 94)").
+# reuse their seeds; docs/residual-experiments.md, "The cut on the clean twin (stop 94)").
 # Stop 95 (no change to the loop): 5030-5039 development: its friction sets
 # and their clean twins for friction's account (bench/residual_friction_twin.py
 # and trial builds, not kept), and every set re-run with a model trained on
 # twelve recordings (1, 2001-2003 and 9001-9008 of the paper preset; not
 # kept); 5040-5049, 5070-5079 and 5080-5089 every effect at its larger
-# strength measured with stop 91's code (docs/residual.md, "An eighth, a
+# strength measured with stop 91's code (docs/residual-experiments.md, "An eighth, a
 # ninth and a tenth fresh block (stop 95)"). 5050-5069 went to clean sets.
 # Stop 96 (no change to the loop; `hadynet residual --threads` added, one
 # thread by default): 5090-5099 every effect at its larger strength measured
-# with stop 91's code (docs/residual.md, "An eleventh fresh block (stop 96)").
+# with stop 91's code (docs/residual-experiments.md, "An eleventh fresh block (stop 96)").
 # Next unused: 5100 on.
 #
 # Usage: bench/residual_detection.sh [--model M] [--out DIR] [--seeds N] [--first-seed S] [--candidates K]

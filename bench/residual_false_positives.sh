@@ -27,7 +27,7 @@
 # inputs starting as the pure dead time: 491-510, with and without
 # --candidates 3. Seeds 461 and 471-480 belong to bench/dead_time_control.sh,
 # 481-490 to bench/residual_detection.sh (input dead time), 511-515 to the
-# two-effect runs with an input dead time (docs/residual.md, "--rounds").
+# two-effect runs with an input dead time (docs/residual.md, "Rounds: several effects at once").
 # With the static calibration curve in the library (sensor-curve): 541-560
 # development (run before the plan took the winner's group only), 601-620
 # measured, with and without --candidates 3 (seeds 521-522, 531-540 and

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """What the plant's friction changes in a tendon's tension, read against the
-clean twin (docs/residual.md, "Friction's account against its clean twin:
+clean twin (docs/residual-experiments.md, "Friction's account against its clean twin:
 three tries, none kept (stop 95)"; not a test).
 
 A friction set of bench/residual_detection.sh (--case friction=N) and its

@@ -27,7 +27,7 @@
 # the blocks 4865-4884, 4950-4969, 4980-4999 and 5030-5039 of
 # bench/residual_detection.sh, their twins on the same seeds; the model was
 # trained on seeds 1 and 2001-2003 and its null's floor chosen on 11, 13-16
-# and 181-184 (docs/residual.md, "The cut on the clean twin (stop 94)").
+# and 181-184 (docs/residual-experiments.md, "The cut on the clean twin (stop 94)").
 set -euo pipefail
 usage() { sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; }
 # value OPTION ARG...: the option's value, or usage and exit 2 when it has none.

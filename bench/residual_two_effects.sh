@@ -43,7 +43,7 @@
 # on the logged commands only) again, with 1987-1991's. Stop 59:
 # 2085-2089 with --decision-loss absolute (both named in 12 of 20),
 # then development: the squared loss and a decision-only variant re-run
-# on the same logs (docs/residual.md, "The decision's loss"). Stop 60:
+# on the same logs (docs/residual-experiments.md, "The decision's loss"). Stop 60:
 # 2175-2179 (the cross-talk group's pairs, --decision-loss squared: both
 # named in 15 of 20). Stop 61: 2280-2284 (the residual's unit in the
 # held-out tests). Stop 62 (an earlier round's candidates, a cross-talk

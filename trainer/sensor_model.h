@@ -56,7 +56,7 @@ struct SensorCrosstalk {
 //     grows with the true load (creep) is driven by the level, not by the
 //     reading: a driver of the reading (before stop 54) counts the bias
 //     itself and, at 0.02 per N s, read the plant's bias 1.4-1.7 times too
-//     high by the end of a 60 s log (docs/residual.md, "The plant's own
+//     high by the end of a 60 s log (docs/residual-experiments.md, "The plant's own
 //     effect as the fix"). Its rate is >= 0 (check()): with a negative
 //     rate 1 / (1 + rate dt) > 1 and D grows exponentially;
 //   time: D_r = r dt.

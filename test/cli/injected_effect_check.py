@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Whether `hadynet residual --fix` answered an effect added after recording
 (test/cli/inject_effect.py) as it must: residual_injected_effects.sh's rules,
-shared with the measurement on fresh seeds (docs/residual.md, "Effects added
+shared with the measurement on fresh seeds (docs/residual-experiments.md, "Effects added
 after recording").
 
 usage: injected_effect_check.py CASE RESIDUAL_JSON [MODEL_OUT]

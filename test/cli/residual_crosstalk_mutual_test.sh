@@ -14,7 +14,7 @@
 # its measured source is biased (the source holds the target), fc4's and
 # fc3's held-out errors rose above fine-tuning alone's, and the decision
 # did not confirm (p 0.2; "unexplained structure"). Since stop 63 the
-# extension leaves mutual pairs out (crosstalk::plan; docs/residual.md,
+# extension leaves mutual pairs out (crosstalk::plan; docs/residual-experiments.md,
 # "A mutual pair is not extended"): confirmed at p 5.4e-08 on the
 # development VM. Seed 2327 was a development seed of this step (the miss
 # it mends). About 60 s on the development VM.

@@ -10,7 +10,7 @@
 # sources along the finger chain, fc4 explained a hair more beyond the
 # null (12.13 against the plant's fc3's 12.00). Since stop 71 a further
 # target takes the source of its clearest held-out t (fc3: t 25.9 against
-# 25.7; docs/residual.md, "Every group the probe finds, its plans as a
+# 25.7; docs/residual-experiments.md, "Every group the probe finds, its plans as a
 # drift's rivals, and a cross-talk's source by its t"). Seed 3050 was a
 # development seed of that step (a miss it mends). About 40 s on the
 # development VM.

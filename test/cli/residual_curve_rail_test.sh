@@ -11,7 +11,7 @@
 # was asked for only after a curve was confirmed, and the run ended with
 # "unexplained structure". Since stop 89 a chosen curve whose group tops out
 # together has that rail among its rivals (fix(), CandidateTrial::
-# rail_of_chosen_curve; docs/residual.md, "A chosen curve's rail (stop
+# rail_of_chosen_curve; docs/residual-experiments.md, "A chosen curve's rail (stop
 # 89)"): the rail is tested beside the curve, confirmed (p 1.3e-7 against
 # Holm's level 0.005) and applied.
 # Checked: the selection's choice is a loadcell curve, not confirmed; the

@@ -11,7 +11,7 @@
 # decision confirmed it (p 3.9e-07) and it was applied: neighbouring
 # fingertips load together, so fc2's level explains fc1's compression.
 # Since stop 64 a confirmed cross-talk within a group is followed by the
-# richer account (docs/residual.md, "A curve in place of a cross-talk"):
+# richer account (docs/residual-experiments.md, "A curve in place of a cross-talk"):
 # the curve of its target's group, confirmed against fine-tuning alone on
 # every channel and its own, replaces it when it predicts the channels
 # either claims significantly better (p 2.8e-07 on the development VM).

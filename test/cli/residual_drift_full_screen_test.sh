@@ -11,7 +11,7 @@
 # clearest gain, p 0.092 on the selection's rows) and the decision
 # confirmed it (p 0.0021): a wrong fix. Since stop 72 the probe runs there
 # too and its plan comes last, beyond --candidates (drift_probe_place();
-# docs/residual.md, "The drift probe behind a full screen"). Seed 3161 was
+# docs/residual-experiments.md, "The drift probe behind a full screen"). Seed 3161 was
 # a development seed of that step. About 40 s on the development VM.
 #   residual_drift_full_screen_test.sh HADYNET MODEL WORKDIR
 set -uo pipefail

@@ -10,8 +10,8 @@
 # plan of the nine loadcells: gives_way_to_group_drift kept it), and the
 # decision did not confirm it on the held-out rows (p 0.013 > 0.01):
 # "unexplained structure". Since stop 71 a chosen load drift has the drift
-# probe's plans as rivals (decision_rivals(); docs/residual.md, "The probe's
-# plans as a load drift's rivals"): the group's plan is tested beside the
+# probe's plans as rivals (decision_rivals(); docs/residual-experiments.md,
+# "Every group the probe finds, its plans as a drift's rivals"): the group's plan is tested beside the
 # family at Holm's levels and confirmed there (p 1.1e-06 on the development
 # VM). On another CPU the selection may choose the group's plan at once;
 # either path passes, but a family of the loadcells chosen there must have

@@ -9,7 +9,7 @@
 # the selection chose a curve of fc3, fc4 and fc1 (training rows p 0.025;
 # the drift probe's plan of the nine loadcells 0.47), and the decision
 # rejected it on the held-out rows (p 1). Since stop 70 a curve has the
-# other effects of its group as rivals (decision_rivals(); docs/residual.md,
+# other effects of its group as rivals (decision_rivals(); docs/residual-experiments.md,
 # "Rivals: the held-out rows decide"): the drift probe's plan is tested
 # beside the curve at Holm's levels, and it is confirmed there (p 2.2e-11
 # on the development VM) where the curve is not. On another CPU the

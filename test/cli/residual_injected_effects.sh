@@ -14,7 +14,7 @@
 #
 # The cases and their strengths were fixed before the first run and not
 # changed after (fresh seeds 1558-1561 and 1572-1581 with the same cases:
-# docs/residual.md, "Effects added after recording"):
+# docs/residual-experiments.md, "Effects added after recording"):
 #   clean                  nothing confirmed, no model written;
 #   delay:fc3:2            one loadcell 2 steps late: its delay, fc3 the winner;
 #   drift:f:0.002          every tension drifts with its load at 0.002 /s: a
@@ -31,7 +31,7 @@
 # control). The rules: test/cli/injected_effect_check.py.
 #
 # SEED (default 11) records the clean logs with another seed. Seed 1569
-# (docs/residual.md, "The family alone beside its group"): the 2-step delay
+# (docs/residual-experiments.md, "The family alone beside its group"): the 2-step delay
 # on fc3 alone also passed the test on other loadcells (through the
 # network, which reads fc3), the delay planned on fc3 and those lost the
 # selection on the training rows (p 0.998), and stop 50's code confirmed

@@ -12,7 +12,7 @@
 # candidate per effect the cross-talk's one place went to the fingertips
 # and the leak was never tried (stop 61: "unexplained structure"). Since
 # stop 62 a cross-talk between groups is a candidate of its own beside one
-# within a group (plan_candidates; docs/residual.md, "A cross-talk between
+# within a group (plan_candidates; docs/residual-experiments.md, "A cross-talk between
 # groups is its own candidate"): confirmed at p 1.3e-10 on this machine.
 # Seed 2242 was a development seed of this step (the miss it mends).
 # About 40 s on the development VM.

@@ -11,7 +11,7 @@
 # group, was never tested until stop 88, and the run ended with
 # "unexplained structure". Since then every choice has the plans of the
 # groups it does not hold that gained more than it as rivals
-# (decision_rivals(), rival_gain_floor(); docs/residual.md, "Every
+# (decision_rivals(), rival_gain_floor(); docs/residual-experiments.md, "Every
 # choice's rivals: the plans of other groups that gained more"): friction
 # is tested beside the curve, confirmed (p 3.3e-4, Holm's level 0.005) and
 # applied.

@@ -5,7 +5,7 @@
 # default: the delay must be aligned on at least 8 of the 9 loadcells (the
 # ninth, a loadcell that rarely touches anything, may stay late: the test of
 # every channel of the group has little power on it), not on the few its
-# family alone holds (docs/residual.md, "Wider plans,
+# family alone holds (docs/residual-experiments.md, "Wider plans,
 # tested after the confirmation"). Before stop 52 the family alone (fc4,
 # fc3, fc1, fc2) was confirmed and applied, the five other loadcells stayed
 # late and the fixed model predicted fc6 1.33 times worse than fine-tuning

@@ -4,7 +4,7 @@
 # LOGS --fix` with the plant's rated ranges and every other setting a
 # default: the rail must be named with its level (within 10 % of 2 N, the
 # detection bench's rule), not the calibration curve that imitates it
-# (docs/residual.md, "The simpler account: a rail before a curve"). Before
+# (docs/residual-experiments.md, "The simpler account: a rail before a curve"). Before
 # stop 53 the selection chose a curve of fc4 and six other loadcells as
 # the clearest gain, the decision confirmed it (p 0.0094) and it was
 # applied. Now the rail of the curve's lead channel, confirmed against

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Of confirmed plans the held-out rows cannot tell apart, the one changing
 # the fewest channels is applied (--fix-tie-break fewest-channels, the
-# default since stop 91; docs/residual.md, "Ties among confirmed plans
+# default since stop 91; docs/residual-experiments.md, "Ties among confirmed plans
 # (stop 91)"). Fresh plant logs (the four grasps of docs/residual.md, 300
 # rows, recorded with SEED and the plant effect CASE), through
 # `hadynet residual MODEL LOGS --fix` with the plant's rated ranges and

@@ -15,7 +15,7 @@
 # finds friction itself (the delay's alignment absorbs nothing of it), and
 # that path passes too, but a round-2 candidate carried from round 1 must
 # be labelled so in the JSON. Seed 2283 was a development seed of this step
-# (the miss it mends; docs/residual.md, "An earlier round's candidates").
+# (the miss it mends; docs/residual-experiments.md, "An earlier round's candidates").
 # About 60 s on the development VM.
 #   residual_rounds_earlier_test.sh HADYNET MODEL WORKDIR
 set -uo pipefail

@@ -12,7 +12,7 @@
 # leaves a small 1-step residual. Until stop 89 the screen proposed nothing and the run
 # ended "no significant effect". Since stop 90 an upper rail is a candidate
 # down to --fix-upper-rail-floor (0: any excess over the null) when every
-# other test of the screen passes (docs/residual.md, "An upper rail below
+# other test of the screen passes (docs/residual-experiments.md, "An upper rail below
 # the candidates' floor (stop 90)").
 # Checked: a rail below the candidates' floor is among the candidates (the
 # rule let it in), it is confirmed and applied; it is named (every rail

@@ -410,7 +410,7 @@ TEST(SensorReadout, ReadsALogsFrameBackAsTheLog) {
 // whose gain over fine-tuning alone on the selection's rows is significant;
 // else the clearest gain (the largest positive Diebold-Mariano statistic),
 // not the screen's first, which on fresh logs is often the model's own
-// misfit (docs/residual.md, "Detection on fresh logs"); not judged or no
+// misfit (docs/residual-experiments.md, "Detection on fresh logs"); not judged or no
 // gain: the screen's first.
 // The plan's curves are fitted as one (CalibrationCurves::refine): on the
 // union of the channels' knots, by coordinate search from the identity. A

@@ -111,7 +111,7 @@ inline constexpr SensorCurve kSensorCurve{
            "(compressive): it reads 9.5 % above the plant's at the top knot (0.1 % before), fc3 measures "
            "1.004× fine-tuning alone's (0.85×) on these logs of the model's training seed, where fine-tuning "
            "alone does best, and the family channels 0.69-0.90× before (fc5 the worst; 0.62-0.82×); on fresh "
-           "curve sets the shape names 10 of 20 against 7 (docs/residual.md, \"A curve that bends one way\")"};
+           "curve sets the shape names 10 of 20 against 7 (docs/residual-experiments.md, \"A curve that bends one way\")"};
 
 // Plant: fingertip loadcell i adds 0.35 x its neighbour's force (crosstalk).
 struct Crosstalk {

@@ -210,7 +210,7 @@ TEST(PlantEffects, CrosstalkIsNamedWithAPlantPairAndGain) {
   // of one): with no chain, removing each pair's measured source is exact.
   // Nor a pair whose reverse is significant too (a mutual pair, as the
   // plant's fc3 <-> fc4: each reads the other, so removing one side against
-  // its measured source is biased; docs/residual.md, stop 63). A target
+  // its measured source is biased; docs/residual-experiments.md, stop 63). A target
   // whose source is left out takes no lesser pair.
   const std::vector<Augmentation> two = plan_candidates(o.data, o.attribution, 2);
   ASSERT_EQ(two.size(), 2u);

@@ -267,7 +267,7 @@ Augmentation planned_for(const ResidualData& data, const Attribution& attributio
 // each channel's share. On stop 86's curve sets 4282, 4368, 4383, 4447 and
 // 4448 (development sets of this rule) no loadcell curve reached the five
 // candidates behind the tendons' curve of one channel and cross-talks
-// (docs/residual.md, "A curve stands at its group's summed excess share").
+// (docs/residual-experiments.md, "A curve stands at its group's summed excess share").
 std::vector<const HypothesisResult*> planning_order(const ResidualData& data, const Attribution& attribution) {
   std::map<std::string, double> summed_curve_share;  // group -> summed floor_statistic of its significant curves
   std::vector<const HypothesisResult*> order;
@@ -314,12 +314,12 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
   // misfit between neighbouring fingertips (fc2 -> fc1, gain 0.50) took
   // cross-talk's one place on the tension leak's set 2242, where the
   // plant's f5 -> fc6 ranked fourth at gain 0.165 and was never tried
-  // (docs/residual.md, "A cross-talk between groups is its own candidate").
+  // (docs/residual-experiments.md, "A cross-talk between groups is its own candidate").
   // A calibration curve's class is its group as well: the curve of one
   // kind of sensor and that of another are two mechanisms too, and on
   // fresh sets a curve of the tendons f3/f4 (the model's misfit of the
   // tendon it fits worst) took the curve's one place from the loadcells'
-  // (curve sets 4383, 4510, 4531; docs/residual.md, "A curve stands at its
+  // (curve sets 4383, 4510, 4531; docs/residual-experiments.md, "A curve stands at its
   // group's summed excess share").
   struct PlanClass {
     EffectKind kind;
@@ -871,7 +871,7 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   // The parts of a calibration curve's fine-tuning (tune(): the curve
   // refitted before each but the first; 4: after 5, 10 and 15 of the
   // default 20 epochs). Chosen on development curve sets 3880-3899
-  // (docs/residual.md, "The curve refitted during fine-tuning (stop 85)"):
+  // (docs/residual-experiments.md, "The curve refitted during fine-tuning (stop 85)"):
   // the fitted curve read on average 0.91 of the plant's at its top knot
   // before fine-tuning, 0.94 after one refit half-way, 0.98 after three.
   constexpr int kCurveFits = 4;
@@ -1425,14 +1425,14 @@ FixResult fix(const HadynetModel& model, const std::vector<LogInput>& logs, cons
   };
   // A confirmed family alone: does its extended plan predict the channels it
   // adds better? (The plant's delay of every loadcell aligned on a few, the
-  // others left late: docs/residual.md, "Wider plans, tested after the
+  // others left late: docs/residual-experiments.md, "Wider plans, tested after the
   // confirmation".) Then a delay seen beyond its family, on the channels of
   // its group the test did not find it on (an acquisition chain delays
   // every channel it carries, and a channel that barely moves hides it).
   //
   // A confirmed drift: straight to every channel of its group at one rate,
   // whatever the test found (sensors of one kind age together, and the
-  // 1-step residual shows little of a drift: docs/residual.md, "A drift
+  // 1-step residual shows little of a drift: docs/residual-experiments.md, "A drift
   // across its group"); that plan holds its extended plan's channels, so
   // the one test replaces both. Its plan is the applied one before
   // re-estimation, so that each fold re-estimates the rate on its own

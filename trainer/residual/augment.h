@@ -43,7 +43,7 @@ namespace hadynet::trainer::residual {
 inline constexpr double kDefaultFixMinExcessNull = 1.0;
 // FixOptions::upper_rail_floor's default: an upper rail needs an excess
 // share of at least 0 (it explains at least what it does on the null), not
-// the candidates' floor (docs/residual.md, "An upper rail below the
+// the candidates' floor (docs/residual-experiments.md, "An upper rail below the
 // candidates' floor (stop 90)").
 inline constexpr double kDefaultFixUpperRailFloor = 0.0;
 // FixOptions::drift_probe_alpha's default. The probe only proposes: the
@@ -58,7 +58,7 @@ inline constexpr double kDefaultFixUpperRailFloor = 0.0;
 // on 40 clean sets (2430-2449, 2475-2494) its smallest was 0.18, and on the
 // six cross-talk sets where it fell between 0.05 and 0.1 (2421, 2424,
 // 2428 at 0.2 and 0.35, 2452, 2467) its candidate was not chosen
-// (docs/residual.md, "A drift probe of the unchanged network", "The drift
+// (docs/residual-experiments.md, "A drift probe of the unchanged network", "The drift
 // probe's place and level (stop 65)").
 inline constexpr double kDefaultDriftProbeAlpha = 0.1;
 
@@ -80,13 +80,13 @@ std::optional<TieBreak> tie_break_named(const std::string& name);
 // mean over the judged channels of each channel's 1-step error in the
 // model's standardised units, squared (the training loss's) or absolute.
 // The tests' null is equal expected loss either way. The squared error's
-// per-row differences are heavy-tailed on contact-rich logs (docs/residual.md,
+// per-row differences are heavy-tailed on contact-rich logs (docs/residual-experiments.md,
 // "The decision's loss"); the absolute error's are lighter, but they also
 // make a small steady gain on channels a change does not touch
 // significant (clean fresh sets 2121 and 2126: a curve compressing the
 // band of loadcells at rest, confirmed at p 8e-5 on the lengths' 0.94-0.98
 // of fine-tuning alone's RMSE, with any window order): the squared error
-// is the default (docs/residual.md, "Back to the squared loss").
+// is the default (docs/residual-experiments.md, "Back to the squared loss").
 // --decision-loss.
 enum class DecisionLoss { kSquared, kAbsolute };
 const char* decision_loss_name(DecisionLoss loss);  // "squared" or "absolute"
@@ -110,7 +110,7 @@ std::optional<DecisionScale> decision_scale_named(const std::string& name);
 //   kLogs: each log of each fold in its own level first
 //          (relative_to_segment_level): every log counts by its relative
 //          difference. Tried as the default in stop 77 and not kept: on
-//          100 fresh sets it named as many (docs/residual.md, "Each log in
+//          100 fresh sets it named as many (docs/residual-experiments.md, "Each log in
 //          its own level, tried and not kept as the default").
 enum class DecisionPooling { kRows, kLogs };
 const char* decision_pooling_name(DecisionPooling pooling);  // "rows" or "logs"
@@ -159,7 +159,7 @@ struct FixOptions {
   // angles, which the network predicts well (fit 75-90 %) and the standard
   // deviation's unit all but ignores (curve sets 2145-2154: 0.56-0.93 of
   // fine-tuning alone's RMSE there, not confirmed at p 0.011-0.15).
-  // docs/residual.md, "Every channel in its own residual's unit (stop 61)".
+  // docs/residual-experiments.md, "Every channel in its own residual's unit (stop 61)".
   DecisionScale decision_scale = DecisionScale::kResidual;  // --decision-scale
   DecisionPooling decision_pooling = DecisionPooling::kRows;  // --decision-pooling
   // How the selection compares the candidates on the training rows
@@ -171,7 +171,7 @@ struct FixOptions {
   // largest positive one (best_candidate). Both in the standard
   // deviation's unit. kScreenOrder stays the default: with kEveryChannel
   // (and the residual's unit in the selection) a curve took the suite's
-  // injected tension leak and loadcell delay (docs/residual.md, "Every
+  // injected tension leak and loadcell delay (docs/residual-experiments.md, "Every
   // channel in its own residual's unit (stop 61)").
   SelectionRule selection = SelectionRule::kScreenOrder;
   // Of the confirmed plans (the choice and its rivals), which is applied.
@@ -182,7 +182,7 @@ struct FixOptions {
   // that changes the fewest channels (Augmentation::channels), the larger
   // mean gain among equally few: where the held-out rows cannot tell two
   // confirmed accounts apart, the one that changes less of the model. The
-  // default since stop 91 (docs/residual.md, "Ties among confirmed plans
+  // default since stop 91 (docs/residual-experiments.md, "Ties among confirmed plans
   // (stop 91)"). --fix-tie-break.
   TieBreak tie_break = TieBreak::kFewestChannels;
   // How many of the screen's candidates may be tried (plan_candidates: the
@@ -194,7 +194,7 @@ struct FixOptions {
   // clearest gain (chosen_candidate), goes to the decision; none when none
   // gains.
   // 1: the screen's winner alone. 5 was chosen on development seeds 771-775
-  // (docs/residual.md, "Detection on fresh logs"), when every candidate was
+  // (docs/residual-experiments.md, "Detection on fresh logs"), when every candidate was
   // another effect; since stop 51 a family alone takes one of them. The
   // drift probe (drift_probe.h) takes a place left when the screen proposes
   // no load drift of its group (or the only place, when no screened
@@ -211,7 +211,7 @@ struct FixOptions {
   // (why_not_fixable) can then differ for candidates above the screen's
   // floor as well. --fix-min-excess-null. Unset: the screen's floor; above it:
   // the screen's floor (the CLI refuses it). 1 since stop 48, when the
-  // decision judges two folds (docs/residual.md, "Candidates down to 1 by
+  // decision judges two folds (docs/residual-experiments.md, "Candidates down to 1 by
   // default"): on fresh logs more effects named, no clean set confirmed;
   // with one fold (stop 45) it made more wrong fixes and was not the default.
   std::optional<double> min_excess_null = kDefaultFixMinExcessNull;
@@ -251,7 +251,7 @@ struct FixOptions {
   // the 2-step loadcell delay of two-effect set 2281 read a gain of 0.41
   // (0.53 on rows the fine-tuning never saw) against 0.74 before, below
   // the screen's bound of 0.5, so round 2's screen proposed nothing
-  // (docs/residual.md, "An earlier round's candidates"). The selection and
+  // (docs/residual-experiments.md, "An earlier round's candidates"). The selection and
   // the decision judge them as any. nullptr or empty: none.
   const std::vector<Augmentation>* earlier_candidates = nullptr;
 };
@@ -417,7 +417,7 @@ struct CalibrationCurves : ModelChange {
   // `tuned_epochs`: its epochs, for the description). refine() fits on the
   // unchanged network, which learnt part of the curve from the curved data
   // and preferred a flatter curve than the plant's; fine-tuning cannot move
-  // the curve afterwards (docs/residual.md, "The curve refitted during
+  // the curve afterwards (docs/residual-experiments.md, "The curve refitted during
   // fine-tuning (stop 85)").
   void refit(Augmentation& a, const SensorModel& before, const TrainingRmse& tuned_rmse, int tuned_epochs);
   bool carried_before_tuning() const { return true; }  // refine() fitted it
@@ -478,7 +478,7 @@ struct Augmentation {
   // loadcell's own monotone reading, not what the other channels receive
   // from it. On development seeds 1797-1801 the fixed model's held-out
   // RMSE on the other channels was 0.70-0.79 of fine-tuning alone's, on
-  // the curved ones 0.81-0.97 (docs/residual.md, "Judged on every
+  // the curved ones 0.81-0.97 (docs/residual-experiments.md, "Judged on every
   // channel").
   bool judged_on_every_channel = false;
   // Why --fix cannot add it ("" when it can; change is then meaningless).
@@ -540,14 +540,14 @@ std::vector<Augmentation> plan_candidates(const ResidualData& data, const Attrib
 // tests it instead when, on those rows, it gains over fine-tuning alone and
 // predicts the channels either plan changes better than the chosen plan
 // (the mean of the loss difference, CandidateTrial::group_drift_gain,
-// positive; docs/residual.md, "A drift family gives way to its group",
+// positive; docs/residual-experiments.md, "A drift family gives way to its group",
 // stop 69): the probe saw the drift on the whole group with the unchanged
 // network, and sensors of one kind age together, unless their rates differ
 // so much that one rate for the group predicts worse.
 bool gives_way_to_group_drift(const std::vector<Augmentation>& planned, std::size_t chosen, std::size_t probed);
 
 // The plans the held-out rows decide between with the selection's choice
-// planned[chosen] (docs/residual.md, "Rivals: the held-out rows decide",
+// planned[chosen] (docs/residual-experiments.md, "Rivals: the held-out rows decide",
 // stop 70), each an addable plan: every plan that holds no channel of
 // planned[chosen]'s groups (which fix() tests only when it gained more
 // than the choice, but a drift's probe plans when they gained at all:
@@ -748,7 +748,7 @@ struct DriftProbe {
 // on fresh logs is often the model's own misfit); 0 (the screen's first)
 // when none is judged. None (std::nullopt) when candidates were judged and
 // none gains there: the training rows support none of them, so the
-// decision tests none ("unexplained structure" untested; docs/residual.md,
+// decision tests none ("unexplained structure" untested; docs/residual-experiments.md,
 // "No gain, no decision").
 std::optional<std::size_t> chosen_candidate(const std::vector<CandidateTrial>& candidates, double alpha);
 

@@ -1,4 +1,4 @@
-// The drift probe of --fix (docs/residual.md, "A drift probe of the
+// The drift probe of --fix (docs/residual-experiments.md, "A drift probe of the
 // unchanged network"): a second screen, for the one effect the regression
 // screen rarely lists.
 //

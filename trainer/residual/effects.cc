@@ -169,7 +169,7 @@ Features features(const Hypothesis& h, const ResidualLog& log) {
 // logs, seen after the bound was chosen); weaker channels of the same delay
 // (down to 0.46) still join by the plan's extension, which needs no bound.
 // The margin is thin on the weakest sets. Its false positives were measured
-// on fresh clean logs afterwards (docs/residual.md, "Detection on fresh
+// on fresh clean logs afterwards (docs/residual-experiments.md, "Detection on fresh
 // logs": 0 of 40).
 constexpr double kMinGain = 0.5;
 bool plausible(double gain, const Eigen::VectorXd&) { return gain >= kMinGain; }
@@ -183,7 +183,7 @@ bool plausible(double gain, const Eigen::VectorXd&) { return gain >= kMinGain; }
 // logs of development seeds 871-875 (1- and 2-step delays, 5 sets each) the
 // groups a loadcell delay does not touch read median gains of 0.14-0.38,
 // and with commands acting late every group read 0.59-0.84
-// (docs/residual.md, "Detection on fresh logs"). kShownGain is the gain
+// (docs/residual-experiments.md, "Detection on fresh logs"). kShownGain is the gain
 // bound's value, the middle of that gap; the margin is about 0.1 on each
 // side. One other group is enough: a loadcell delay and a weak delay of
 // another group that ranks above it would be taken for a dead time (not
@@ -238,7 +238,7 @@ std::string groups_text(const GroupGains& shown) {
 // sets from a lead of 1 or 3 steps to 2 and agreed with the lead on the
 // rest; a plurality alone would also have moved two sets of a dead time
 // beside a rail (4 of 9 voters for 3 and for 5 steps) off the plant's 2
-// (docs/residual.md, "A sensor delay's steps from its group (stop 84)").
+// (docs/residual-experiments.md, "A sensor delay's steps from its group (stop 84)").
 struct GroupDelay {
   const HypothesisResult* lead = nullptr;
   int voters = 0, votes = 0;  // the voting channels, and those naming the lead's steps
@@ -1265,7 +1265,7 @@ bool CalibrationCurves::tops_together(const std::vector<double>& tops, double lo
 
 // Chosen on stop 85's curve sets 4440-4469, 4366, 4373 and 4375, where the copy
 // on a loadcell at rest raised its held-out error up to 2.1 times
-// (docs/residual.md, "The curve's copy only where a channel carries load
+// (docs/residual-experiments.md, "The curve's copy only where a channel carries load
 // (stop 86)").
 bool CalibrationCurves::carries_load(const std::vector<double>& sorted, double fitted_span, int min_rows) {
   if (sorted.empty()) return false;
@@ -1288,7 +1288,7 @@ bool CalibrationCurves::flat_at_end(const SensorCurve& curve, int side) {
 // 7/8 quantile rested on a few rows each, and the fitted readings at the
 // top knot ranged 0.67-2.10 times the plant's on development seed 1798
 // (one curve: 0.65-1.26 at every knot above 1 N on seeds 1797-1801;
-// docs/residual.md, "One curve for the group"). Its knots are the union of the channels' own
+// docs/residual-experiments.md, "One curve for the group"). Its knots are the union of the channels' own
 // (knot_levels: each channel's quantiles, so the curve has knots where any
 // channel has rows), within 1e-4 of their range merged. Its segment slopes
 // by coordinate search (each slope times 0.5, 0.7, 0.85, 0.93, 1/0.93,
@@ -1300,7 +1300,7 @@ bool CalibrationCurves::flat_at_end(const SensorCurve& curve, int side) {
 // gauge's or a loadcell's compression, a thermistor's exponential), and an
 // unconstrained search followed the noise of a loadcell at rest: flat at
 // 0 N, then steep (stop 73's curve sets 3320-3339, development: named on 12
-// of 20 unconstrained, 14 of 20 with the shape; docs/residual.md, "A curve
+// of 20 unconstrained, 14 of 20 with the shape; docs/residual-experiments.md, "A curve
 // that bends one way"). The curve stays anchored at its lowest
 // knot. The loss is the unchanged network's error of every channel in the
 // measured frame over windows of its N_train steps (training_rmse.windows:
@@ -1317,7 +1317,7 @@ bool CalibrationCurves::flat_at_end(const SensorCurve& curve, int side) {
 // passed on 34 of 50 development sets against 30 (stop 79's 3795-3824 and
 // 3880-3899), on fresh ones 46 of 70 against 45, and the rail or the dead
 // time was named on 3 of 140 fresh sets where a curve fitted on the 1-step
-// error took its place (docs/residual.md, "The curve fitted
+// error took its place (docs/residual-experiments.md, "The curve fitted
 // on the loss the network was trained on"). `fitted` is left as
 // it is: the search starts from the identity, not from a fitted parameter.
 // With a rated top above the channels' levels (rated_top) the curve is
@@ -1328,14 +1328,14 @@ bool CalibrationCurves::flat_at_end(const SensorCurve& curve, int side) {
 // output, and without that end the fit's top segment, which rests on a few
 // rows of one grasp's peak, dipped below the body of the curve (stop 78:
 // 0.72 of the plant's curve at the top knot where the body read 0.81;
-// docs/residual.md, "The curve through its rated top (stop 79)"). Not
+// docs/residual-experiments.md, "The curve through its rated top (stop 79)"). Not
 // when the fit without it ends flat (flat_at_end) where the group's
 // channels top out together (tops_together): a rail's signature, which the
 // rail's simpler account reads, and which the rated top would hide (a 2 N
 // rail under a 50 N rated top: stop 79's fresh sets 3750 and 3751). A flat
 // end where one channel alone reaches the top is one grasp's peak, and the
 // rated top holds it up (stop 83: the fit ended flat on 2 of 20
-// development curve sets and 1 of 20 rail sets; docs/residual.md, "A flat
+// development curve sets and 1 of 20 rail sets; docs/residual-experiments.md, "A flat
 // top where one channel peaks (stop 83)"). fix() refits the curve during
 // fine-tuning (refit): the unchanged network, trained on the curved data,
 // prefers a flatter curve than the plant's.
@@ -1515,11 +1515,11 @@ const HypothesisResult* clearer_of_two(const ResidualData& data, const Attributi
 // decision did not confirm; without it, confirmed at p 4e-6 and 5e-8. A
 // target whose best pair is mutual takes no lesser pair either (on
 // development sets 2410 and 2417 the next one was the model's misfit,
-// fc7 -> fc4 and fc7 -> fc3; docs/residual.md, "A mutual pair is not
+// fc7 -> fc4 and fc7 -> fc3; docs/residual-experiments.md, "A mutual pair is not
 // extended"). The channels of one sensor array pick up their neighbours
 // (the plant's fingertips each pick up one), and the winner's pair alone
 // left the other targets to a curve of the whole group, which won the
-// decision on 2 of 10 development cross-talk sets (docs/residual.md, "Cross-talk in
+// decision on 2 of 10 development cross-talk sets (docs/residual-experiments.md, "Cross-talk in
 // a group"). With a chain fc0 <- fc1 <- fc2 the removal and the sensor
 // model differ by k1 k2 fc2; the group's pairs taken with chains gained
 // less than the winner's alone on the selection's rows of all 10 of those

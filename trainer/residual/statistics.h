@@ -82,7 +82,7 @@ DieboldMariano diebold_mariano(const Segments& loss_a, const Segments& loss_b, i
 // weighs every log (and fold) by its relative difference, not by its size.
 // Without it the log with the largest errors carries the test: a hard
 // grasp's squared errors are ten times another's and heavy-tailed, and its
-// fine-tuning noise hides a gain most logs show (docs/residual.md, "Each
+// fine-tuning noise hides a gain most logs show (docs/residual-experiments.md, "Each
 // log in its own level"; --decision-pooling logs). Equal accuracy within
 // each log stays equal accuracy. A segment of level 0 (or empty) is left
 // as it is.
