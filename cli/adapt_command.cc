@@ -14,6 +14,7 @@
 #include "cli/options.h"
 #include "cli/pb_adapt_common.h"
 #include "cli/pb_map_plot.h"
+#include "cli/threads_option.h"
 #include "cli/trainer_inputs.h"
 #include "trainer/model_file.h"
 #include "trainer/pb_adaptation.h"
@@ -76,6 +77,7 @@ int run_adapt(int argc, char** argv) {
               "trajectory is printed as CSV and, with --plot, drawn on the map of the trained PBs.",
               "MODEL LOG|DIR... [options]");
   add_adapt_options(opt);
+  add_threads_option(opt, "1");
   opt.flag("online", "stream the logs step by step (paper: start at 100 windows, newest 200, 3 epochs)");
   opt.value("start-windows", "N", "online: windows before the first update", "100");
   opt.value("max-windows", "N", "online: newest windows kept", "200");
@@ -86,6 +88,7 @@ int run_adapt(int argc, char** argv) {
   opt.value("json", "FILE", "offline: write the results as JSON");
   if (!opt.parse(argc, argv)) return 2;
   if (opt.help_requested()) return 0;
+  if (!apply_threads_option(opt, "adapt")) return 2;
   if (opt.positional().size() < 2) {
     std::fprintf(stderr, "hadynet adapt: give MODEL and logs (see --help)\n");
     return 2;

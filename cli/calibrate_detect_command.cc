@@ -12,6 +12,7 @@
 #include "cli/error_text.h"
 #include "cli/options.h"
 #include "cli/pb_adapt_common.h"
+#include "cli/threads_option.h"
 #include "cli/trainer_inputs.h"
 #include "trainer/detection.h"
 #include "trainer/model_file.h"
@@ -27,12 +28,14 @@ int run_calibrate_detect(int argc, char** argv) {
               "with the calibration to --out.",
               "MODEL LOG|DIR... --out MODEL [options]");
   add_adapt_options(opt);
+  add_threads_option(opt, "1");
   opt.value("out", "MODEL", "model file to write (may be MODEL itself)");
   opt.value("detect-steps", "N", "N_detect: prediction horizon of detection (<= the model's N_train)", "5");
   opt.value("pb", "PB", "adapt (fit to these logs), zero, a state of the model, or values", "adapt");
   opt.value("threshold", "C", "C_detect instead of the default rule");
   if (!opt.parse(argc, argv)) return 2;
   if (opt.help_requested()) return 0;
+  if (!apply_threads_option(opt, "calibrate-detect")) return 2;
   if (opt.positional().size() < 2 || !opt.has("out")) {
     std::fprintf(stderr, "hadynet calibrate-detect: give MODEL, logs and --out (see --help)\n");
     return 2;

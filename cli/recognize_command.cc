@@ -16,6 +16,7 @@
 #include "cli/options.h"
 #include "cli/pb_adapt_common.h"
 #include "cli/pb_map_plot.h"
+#include "cli/threads_option.h"
 #include "cli/trainer_inputs.h"
 #include "datalog/log_rules.h"
 #include "trainer/model_file.h"
@@ -37,6 +38,7 @@ int run_recognize(int argc, char** argv) {
               "(ambiguous points marked '?').",
               "MODEL LOG|DIR... [options]");
   add_adapt_options(opt);
+  add_threads_option(opt, "1");
   opt.value("plot", "PNG", "draw the PB map (PCA of the trained PBs) with the adapted PBs marked");
   opt.value("json", "FILE", "write the results as JSON");
   opt.value("metric", "M",
@@ -50,6 +52,7 @@ int run_recognize(int argc, char** argv) {
                 datalog::rules::format_number(trainer::kClearRecognitionMargin) + " nearest-state)");
   if (!opt.parse(argc, argv)) return 2;
   if (opt.help_requested()) return 0;
+  if (!apply_threads_option(opt, "recognize")) return 2;
   if (opt.positional().size() < 2) {
     std::fprintf(stderr, "hadynet recognize: give MODEL and logs (see --help)\n");
     return 2;

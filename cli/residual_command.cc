@@ -17,6 +17,7 @@
 #include "cli/options.h"
 #include "cli/residual_fix_report.h"
 #include "cli/residual_report.h"
+#include "cli/threads_option.h"
 #include "datalog/log_reader.h"
 #include "datalog/robot_profile.h"
 #include "trainer/held_out_logs.h"
@@ -24,7 +25,6 @@
 #include "trainer/residual/analysis.h"
 #include "trainer/residual/augment.h"
 #include "trainer/residual/rated_ranges.h"
-#include "trainer/work_pool.h"
 
 namespace hadynet::cli {
 
@@ -304,15 +304,16 @@ int run_residual(int argc, char** argv) {
   opt.value("fix-min-excess-null", "S",
             "with --fix and a null: the candidates --fix may try reach down to S times their channel's clean\n"
             "residual level beyond the null, below the screen's --min-excess-null (the verdict's floor); the\n"
-            "decision on held-out rows against fine-tuning alone guards what is applied (docs/residual.md,\n"
-            "\"Candidates down to 1 by default\"); never above --min-excess-null",
+            "decision on held-out rows against fine-tuning alone guards what is applied\n"
+            "(docs/residual-experiments.md, \"Candidates down to 1 by default\"); never above\n"
+            "--min-excess-null",
             num("%g", rs::kDefaultFixMinExcessNull));
   opt.value("fix-upper-rail-floor", "S",
             "with --fix and a null: an upper rail (the readings of a channel clipped at their top) is a\n"
             "candidate down to S times its channel's clean residual level beyond the null, below the\n"
             "candidates' floor (--fix-min-excess-null), when the screen finds it at Holm's level with its\n"
-            "share of the held-out residual variance and a plausible gain (docs/residual.md, \"An upper\n"
-            "rail below the candidates' floor\"); never above the candidates' floor",
+            "share of the held-out residual variance and a plausible gain (docs/residual-experiments.md,\n"
+            "\"An upper rail below the candidates' floor\"); never above the candidates' floor",
             num("%g", rs::kDefaultFixUpperRailFloor));
   opt.value("drift-probe-alpha", "A",
             "with --fix: the drift probe's family-wise level (Holm over the channel groups whose fitted rate\n"
@@ -327,7 +328,8 @@ int run_residual(int argc, char** argv) {
             "with --fix: the per-row loss of its Diebold-Mariano tests (the selection, the decision, the tests\n"
             "after it, the drift probe): the mean over the judged channels of the standardised 1-step error,\n"
             "squared or absolute (lighter-tailed differences on contact-rich logs, but it confirmed curves on\n"
-            "clean logs: docs/residual.md, \"The decision's loss\", \"Back to the squared loss\")",
+            "clean logs: docs/residual-experiments.md, \"The decision's loss\", \"Back to the squared\n"
+            "loss\")",
             rs::decision_loss_name(rs::FixOptions{}.decision_loss));
   opt.value("fix-selection", "screen-order|every-channel",
             "with --fix: how the candidates are compared on the training rows: screen-order (each on its own\n"
@@ -350,25 +352,19 @@ int run_residual(int argc, char** argv) {
   opt.value("decision-pooling", "rows|logs",
             "with --fix: how the held-out tests pool the logs' per-row losses: rows (every row as it comes:\n"
             "a log with larger errors weighs more) or logs (each log of each fold divided by its mean loss of\n"
-            "the two models compared first: every log counts by its relative difference; docs/residual.md,\n"
-            "\"Each log in its own level\")",
+            "the two models compared first: every log counts by its relative difference;\n"
+            "docs/residual-experiments.md, \"Each log in its own level\")",
             rs::decision_pooling_name(rs::FixOptions{}.decision_pooling));
   opt.flag("no-control", "with --fix: skip the fine-tune-only comparison (the decision then compares with the\n"
                         "unchanged model, a weaker guard)");
-  opt.value("threads", "N", "threads of the network's forward and backward passes (0: every core); results do not\n"
-                          "depend on it",
-            "1");
+  add_threads_option(opt, "1");
   if (!opt.parse(argc, argv)) return 2;
   if (opt.help_requested()) return 0;
   if (opt.positional().size() < 2) {
     std::fprintf(stderr, "hadynet residual: give MODEL and logs (see --help)\n");
     return 2;
   }
-  const auto threads = opt.get_int("threads", 0, 1024);
-  if (!threads) return 2;
-  trainer::set_training_threads(static_cast<int>(*threads));
-  if (trainer::training_pool().threads() > 1)  // one thread, the default, says nothing
-    std::fprintf(stderr, "hadynet residual: the network's passes on %d threads\n", trainer::training_pool().threads());
+  if (!apply_threads_option(opt, "residual")) return 2;
   const auto max_lag = opt.get_int("max-lag", 1, 1000);
   const auto max_delay = opt.get_int("max-delay", 1, 100);
   const auto fraction = opt.get_double("train-fraction", 0.1, 0.9);
