@@ -435,7 +435,8 @@
 # both codes (a search for a set where the selection chooses friction).
 # Stop 89 (a chosen curve whose group tops out together has the rail of
 # its lead channel as a rival; six other changes examined on development
-# sets and not kept: docs/residual.md): 4710-4719 and 4720-4729 every
+# sets and not kept: docs/residual-experiments.md, "Six changes to the fix,
+# examined and not kept (stop 89)"): 4710-4719 and 4720-4729 every
 # effect at its larger strength measured with stop 88's code (4710-4719
 # then development: the drift probe's level read and the rail's rule found
 # on 4713 and 4715, its curve-chosen runs and those of 4600-4609,

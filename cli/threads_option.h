@@ -1,6 +1,6 @@
-// --threads N of the trainer's subcommands (train, adapt, recognize,
-// calibrate-detect, residual): how many threads run the network's forward
-// and backward passes (trainer::training_pool(), trainer/work_pool.h).
+// --threads N of the PB and residual subcommands (adapt, recognize,
+// calibrate-detect, residual; train has its own, every core by default): how
+// many threads run the network's forward and backward passes (trainer::training_pool(), trainer/work_pool.h).
 // Results are the same bytes at any count (hadynet_network.h).
 #pragma once
 
